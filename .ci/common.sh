@@ -1,0 +1,53 @@
+# Shared set-up of the README's two commands: Debian packages, native build, add-on install.
+# Sourced by .ci/main and .ci/test; every step is idempotent.
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="$ROOT/build"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+
+PACKAGES=(blender cmake g++ pybind11-dev libopenvdb-dev libglm-dev libosd-dev libtbb-dev
+          libboost-dev googletest libgtest-dev libbenchmark-dev python3-pytest python3-numpy)
+
+install_packages() {
+  local missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "== installing: ${missing[*]}"
+    $SUDO apt-get update -q
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+  fi
+}
+
+build_native() {
+  echo "== building the native module"
+  cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+  cmake --build "$BUILD" -j "$(nproc)"
+}
+
+# Where Blender 3.4 finds user add-ons.
+addon_dir() {
+  if [ -n "${BLENDER_USER_SCRIPTS:-}" ]; then
+    echo "$BLENDER_USER_SCRIPTS/addons/plume"
+  else
+    echo "$HOME/.config/blender/3.4/scripts/addons/plume"
+  fi
+}
+
+install_addon() {
+  local dest
+  dest="$(addon_dir)"
+  echo "== installing the add-on into $dest"
+  rm -rf "$dest"
+  mkdir -p "$dest"
+  (cd "$ROOT/addon" && tar --exclude='__pycache__' -cf - .) | (cd "$dest" && tar -xf -)
+  cp "$BUILD"/native/_native*.so "$dest/"
+}
+
+setup_all() {
+  install_packages
+  build_native
+  install_addon
+}

@@ -1,0 +1,80 @@
+#pragma once
+/// \file smoke_params.h
+/// Every setting of the smoke/fire solver, with its paper symbol and default, and validate().
+
+#include "core/sampling.h"
+
+#include <glm/glm.hpp>
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace plume {
+
+/// Semi-Lagrangian (Stam 1999) or BFECC (Kim et al. 2005, smoke_surfaces.txt §3.1) advection.
+enum class Advection { SemiLagrangian, Bfecc };
+
+/// A side of the domain is open (air: p = 0, outflow; smoke_surfaces.txt's default) or a wall.
+enum class Boundary { Open, Closed };
+
+/// Sides in the order -x, +x, -y, +y, -z, +z.
+enum Side { kNegX = 0, kPosX, kNegY, kPosY, kNegZ, kPosZ };
+
+/// Settings of one bake. Units: metres, seconds. Field names are the Python names in snake_case.
+struct SmokeParams {
+  // --- Domain ---
+  glm::ivec3 resolution{32, 32, 32};  ///< cells per axis
+  float cellSize = 1.f / 32.f;         ///< Δx, metres
+  glm::vec3 origin{0.f};               ///< world position of the domain's minimum corner
+  std::array<Boundary, 6> boundaries{Boundary::Open, Boundary::Open, Boundary::Open,
+                                     Boundary::Open, Boundary::Closed, Boundary::Open};
+
+  // --- Time ---
+  float frameDt = 1.f / 24.f;  ///< seconds per frame (1/fps × time scale)
+  int substeps = 1;            ///< minimum steps per frame
+  bool useCfl = true;          ///< add steps so that no cell moves more than `cfl` cells per step
+  float cfl = 4.f;             ///< CFL number for the adaptive steps
+
+  // --- Advection ---
+  Advection advection = Advection::Bfecc;
+  Interpolation interpolation = Interpolation::MonotonicCubic;
+
+  // --- Forces (Fedkiw 2001 eq. 8, 9) ---
+  glm::vec3 gravity{0.f, 0.f, -9.81f};  ///< g; buoyancy acts against it
+  float alpha = 1.f;  ///< α: buoyancy from density (Blender's sign: > 0 makes dense smoke rise)
+  float beta = 1.f;   ///< β: buoyancy from heat, f = -g (α ρ + β (T - T_amb))
+  float ambientTemperature = 0.f;  ///< T_amb (T_0 of the fire paper)
+  glm::vec3 wind{0.f};  ///< wind velocity the air is pulled towards (m/s)
+  float windStrength = 0.f;   ///< k_w: f_wind = k_w (u_wind - u), 1/s
+  float vorticity = 0.2f;     ///< ε: vorticity confinement strength (Fedkiw 2001 eq. 11)
+  float densityDissipation = 0.f;  ///< fraction of density lost per second
+
+  // --- Pressure projection ---
+  float pressureTolerance = 1e-4f;  ///< relative residual |r|/|b| at which MGPCG stops
+  int maxPressureIterations = 200;
+
+  // --- Combustion (graph_fire_synthesis.txt eqs. 1-5) ---
+  bool combustion = false;
+  float burnRate = 4.f;         ///< r: fuel burnt per second, dF/dt = -r F
+  float sootYield = 0.5f;       ///< k_S: soot made per unit fuel burnt
+  float heatYield = 4.f;        ///< k_T: heat made per unit fuel burnt
+  float conductivity = 0.f;     ///< κ: thermal conductivity, m²/s
+  float coolingRate = 1.f;      ///< c: cooling, c ((T - T_0)/(T_max - T_0))^4 per second
+  float maxTemperature = 4.f;   ///< T_max
+  float expansion = 1.f;        ///< φ: divergence per unit of fuel burnt per second (eq. 1)
+
+  // --- Run ---
+  std::uint64_t seed = 0;
+  int threads = 0;  ///< 0: all cores
+
+  /// Throws std::invalid_argument naming the setting and its accepted range.
+  void validate() const;
+  /// World-space size of the domain.
+  glm::vec3 size() const { return glm::vec3(resolution) * cellSize; }
+};
+
+/// Upper bound on cells a bake may allocate (about 64 bytes each); validate() rejects more.
+constexpr double kMaxCells = 512.0 * 512.0 * 512.0;
+
+}  // namespace plume

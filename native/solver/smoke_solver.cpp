@@ -1,0 +1,239 @@
+#include "solver/smoke_solver.h"
+
+#include "core/parallel.h"
+#include "solver/combustion.h"
+#include "solver/forces.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace plume {
+namespace {
+
+void checkFinite(const char* name, float v) {
+  if (!std::isfinite(v))
+    throw std::invalid_argument(std::string(name) + " must be a finite number (got " +
+                                std::to_string(v) + ")");
+}
+
+void checkCells(const CellSet& set, std::size_t count, const char* what) {
+  if (!set.velocity.empty() && set.velocity.size() != set.cells.size())
+    throw std::invalid_argument(std::string(what) + ": velocity count differs from cell count");
+  for (std::uint32_t c : set.cells)
+    if (c >= count) throw std::invalid_argument(std::string(what) + ": cell index out of range");
+}
+
+}  // namespace
+
+void SourceSettings::validate() const {
+  checkFinite("density", density);
+  checkFinite("temperature", temperature);
+  checkFinite("fuel", fuel);
+  checkFinite("motion_factor", motionFactor);
+  for (int a = 0; a < 3; ++a) checkFinite("velocity", velocity[a]);
+  if (density < 0.f)
+    throw std::invalid_argument("density must be >= 0 (got " + std::to_string(density) + ")");
+  if (fuel < 0.f)
+    throw std::invalid_argument("fuel must be >= 0 (got " + std::to_string(fuel) + ")");
+}
+
+SmokeSolver::SmokeSolver(const SmokeParams& params) : mParams(params) {
+  mParams.validate();
+  const glm::ivec3 n = mParams.resolution;
+  mVelocity.resize(n);
+  mVelocityTmp.resize(n);
+  for (ScalarGrid* g : {&mDensity, &mTemperature, &mFuel, &mSoot, &mFlame, &mScalarTmp,
+                        &mPressure, &mRhs, &mDivergenceTarget})
+    g->resize(n);
+  mTemperature.fill(mParams.ambientTemperature);
+  mVorticity.resize(n);
+  mForce.resize(n);
+  mCellTypes.resize(n, kFluid);
+  mCellTypesNext.resize(n, kFluid);
+  mNoSlip.resize(n, 0);
+  mSolidVelocity.resize(n, glm::vec3(0.f));
+  // Scratch for BFECC must hold the largest face grid.
+  const std::size_t largest = std::max({mVelocity.u().count(), mVelocity.v().count(),
+                                        mVelocity.w().count()});
+  mAdvector.reserve(largest);
+  mPressureSolver.setup(mCellTypes, mParams.boundaries);
+  mCellTypesDirty = false;
+}
+
+GridFrame SmokeSolver::gridFrame() const {
+  return GridFrame{mParams.resolution, mParams.cellSize, mParams.origin, mParams.frameDt};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Emitters
+
+void SmokeSolver::clearEmitters() {
+  mSources.clear();
+  if (!mObstacles.empty()) mCellTypesDirty = true;
+  mObstacles.clear();
+}
+
+void SmokeSolver::addSource(const CellSet& cells, const SourceSettings& settings) {
+  settings.validate();
+  checkCells(cells, mDensity.count(), "source");
+  mSources.push_back({cells, settings});
+}
+
+void SmokeSolver::addObstacle(const CellSet& cells, Slip slip) {
+  checkCells(cells, mDensity.count(), "obstacle");
+  mObstacles.push_back({cells, slip});
+  mCellTypesDirty = true;
+}
+
+void SmokeSolver::setWindField(const VectorGrid& wind) {
+  if (wind.count() != 0 && wind.size() != mParams.resolution)
+    throw std::invalid_argument("wind field must have one vector per cell");
+  mWindField = wind;
+}
+
+void SmokeSolver::rebuildCellTypes() {
+  if (!mCellTypesDirty) return;
+  mCellTypesDirty = false;
+  mCellTypesNext.fill(kFluid);
+  mNoSlip.fill(0);
+  for (const Obstacle& o : mObstacles)
+    for (std::size_t n = 0; n < o.cells.cells.size(); ++n) {
+      const std::uint32_t c = o.cells.cells[n];
+      mCellTypesNext[c] = kSolid;
+      mNoSlip[c] = o.slip == Slip::NoSlip ? 1 : 0;
+      mSolidVelocity[c] = o.cells.velocity.empty() ? glm::vec3(0.f) : o.cells.velocity[n];
+    }
+  // The multigrid hierarchy is rebuilt only when the solid cells really changed (a moving
+  // obstacle changes them, a still one re-added every frame does not).
+  if (mCellTypesNext.values() != mCellTypes.values()) {
+    std::swap(mCellTypes.values(), mCellTypesNext.values());
+    mPressureSolver.setup(mCellTypes, mParams.boundaries);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Time stepping
+
+bool SmokeSolver::advanceFrame() {
+  ThreadLimit limit(mParams.threads);
+  const float h = mParams.cellSize;
+  int steps = mParams.substeps;
+  if (mParams.useCfl) {
+    // Enough steps that the fastest face moves at most `cfl` cells per step.
+    const float cellsPerFrame = maxSpeed() * mParams.frameDt / h;
+    steps = std::max(steps, int(std::ceil(cellsPerFrame / mParams.cfl)));
+  }
+  steps = std::min(steps, 1000);
+  const float dt = mParams.frameDt / float(steps);
+  StepStats stats;
+  for (int s = 0; s < steps; ++s) {
+    if (mCancel.exchange(false)) return false;
+    step(dt);
+    stats.pressureIterations += mStats.pressureIterations;
+    stats.pressureResidual = std::max(stats.pressureResidual, mStats.pressureResidual);
+  }
+  stats.substeps = steps;
+  stats.maxSpeed = maxSpeed();
+  mStats = stats;
+  ++mFrame;
+  return true;
+}
+
+void SmokeSolver::step(float dt) {
+  // Stam's fractional step, as named stages run in this order.
+  using Stage = void (SmokeSolver::*)(float);
+  static const std::pair<const char*, Stage> kStages[] = {
+      {"sources", &SmokeSolver::applySources}, {"forces", &SmokeSolver::addForces},
+      {"advect", &SmokeSolver::advect},        {"burn", &SmokeSolver::burn},
+      {"dissipate", &SmokeSolver::dissipate},  {"project", &SmokeSolver::project},
+  };
+  mStats.pressureIterations = 0;
+  mStats.pressureResidual = 0.f;
+  for (const auto& stage : kStages) (this->*stage.second)(dt);
+}
+
+void SmokeSolver::applySources(float /*dt*/) {
+  const glm::ivec3 n = mParams.resolution;
+  for (const Source& src : mSources) {
+    const SourceSettings& s = src.settings;
+    const float temperature = mParams.ambientTemperature + s.temperature;
+    for (std::size_t m = 0; m < src.cells.cells.size(); ++m) {
+      const std::uint32_t c = src.cells.cells[m];
+      // Sources keep their cells at least as dense / hot / fuelled as they are set to.
+      mDensity[c] = std::max(mDensity[c], s.density);
+      if (s.temperature != 0.f) mTemperature[c] = std::max(mTemperature[c], temperature);
+      if (mParams.combustion) mFuel[c] = std::max(mFuel[c], s.fuel);
+      glm::vec3 v = s.velocity;
+      if (!src.cells.velocity.empty()) v += s.motionFactor * src.cells.velocity[m];
+      if (v == glm::vec3(0.f)) continue;  // a still source leaves the flow alone
+      const int i = int(c % std::uint32_t(n.x));
+      const int j = int((c / std::uint32_t(n.x)) % std::uint32_t(n.y));
+      const int k = int(c / (std::uint32_t(n.x) * std::uint32_t(n.y)));
+      mVelocity.u()(i, j, k) = mVelocity.u()(i + 1, j, k) = v.x;
+      mVelocity.v()(i, j, k) = mVelocity.v()(i, j + 1, k) = v.y;
+      mVelocity.w()(i, j, k) = mVelocity.w()(i, j, k + 1) = v.z;
+    }
+  }
+}
+
+void SmokeSolver::addForces(float dt) {
+  rebuildCellTypes();
+  addBuoyancy(mVelocity, mDensity, mTemperature, mCellTypes, mParams, dt);
+  addWind(mVelocity, mWindField, mCellTypes, mParams, dt);
+  addVorticityConfinement(mVelocity, mCellTypes, mParams.vorticity, mParams.cellSize, dt,
+                          mVorticity, mForce);
+}
+
+void SmokeSolver::advect(float dt) {
+  const Advection scheme = mParams.advection;
+  const Interpolation interp = mParams.interpolation;
+  const float h = mParams.cellSize;
+  // Scalars first: every field is carried by the same (pre-advection) velocity.
+  std::vector<ScalarGrid*> scalars{&mDensity, &mTemperature};
+  if (mParams.combustion) {
+    scalars.push_back(&mFuel);
+    scalars.push_back(&mSoot);
+  }
+  for (ScalarGrid* g : scalars) {
+    mAdvector.advect(*g, mScalarTmp, kCellOffset, mVelocity, dt, h, scheme, interp);
+    std::swap(g->values(), mScalarTmp.values());
+  }
+  static const glm::vec3 kOffsets[3] = {kFaceOffsetU, kFaceOffsetV, kFaceOffsetW};
+  for (int a = 0; a < 3; ++a)
+    mAdvector.advect(mVelocity.component(a), mVelocityTmp.component(a), kOffsets[a], mVelocity,
+                     dt, h, scheme, interp);
+  std::swap(mVelocity, mVelocityTmp);
+  if (!mObstacles.empty()) zeroSolidScalars();
+}
+
+void SmokeSolver::burn(float dt) {
+  if (!mParams.combustion) return;
+  burnFuel(mFuel, mSoot, mTemperature, mFlame, mDivergenceTarget, mCellTypes, mParams, dt);
+  coolAndConduct(mTemperature, mScalarTmp, mCellTypes, mParams, dt);
+}
+
+void SmokeSolver::dissipate(float dt) {
+  if (mParams.densityDissipation <= 0.f) return;
+  const float keep = std::exp(-mParams.densityDissipation * dt);
+  const glm::ivec3 n = mParams.resolution;
+  const std::size_t slice = std::size_t(n.x) * std::size_t(n.y);
+  parallelFor(0, n.z, [&](int k) {
+    for (std::size_t c = std::size_t(k) * slice, e = c + slice; c < e; ++c) mDensity[c] *= keep;
+  });
+}
+
+void SmokeSolver::zeroSolidScalars() {
+  const glm::ivec3 n = mParams.resolution;
+  const std::size_t slice = std::size_t(n.x) * std::size_t(n.y);
+  parallelFor(0, n.z, [&](int k) {
+    for (std::size_t c = std::size_t(k) * slice, e = c + slice; c < e; ++c)
+      if (mCellTypes[c] != kFluid) {
+        mDensity[c] = mFuel[c] = mSoot[c] = mFlame[c] = 0.f;
+        mTemperature[c] = mParams.ambientTemperature;
+      }
+  });
+}
+
+}  // namespace plume

@@ -1,0 +1,134 @@
+#pragma once
+/// \file smoke_solver.h
+/// The fractional-step smoke/fire solver (Stam 1999) shared by all four pipelines:
+/// sources, forces, advection, combustion, projection, as named stages of step().
+
+#include "core/grid3.h"
+#include "core/mac_grid3.h"
+#include "solver/advection.h"
+#include "solver/emitters.h"
+#include "solver/pressure.h"
+#include "solver/smoke_params.h"
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+namespace plume {
+
+/// What a Source object puts into its cells each step.
+struct SourceSettings {
+  float density = 1.f;      ///< ρ set in source cells (the larger of this and what is there)
+  float temperature = 1.f;  ///< T - T_amb set in source cells
+  float fuel = 0.f;         ///< F set in source cells (combustion)
+  glm::vec3 velocity{0.f};  ///< initial velocity, m/s (smoke_surfaces.txt §3.2)
+  float motionFactor = 1.f; ///< share of the source object's own motion added to its velocity
+  void validate() const;
+};
+
+/// No-slip obstacles drag the air to their own velocity; free-slip ones only stop the normal part.
+enum class Slip { NoSlip, FreeSlip };
+
+/// Figures of the last frame, for progress reports and tests.
+struct StepStats {
+  int substeps = 0;
+  int pressureIterations = 0;     ///< summed over the frame's substeps
+  float pressureResidual = 0.f;   ///< largest relative residual of the frame
+  float maxSpeed = 0.f;           ///< m/s, at the end of the frame
+};
+
+/// One smoke/fire simulation. Holds all grids; allocation happens in the constructor and when
+/// obstacles change, never inside step().
+class SmokeSolver {
+ public:
+  /// Validates params (std::invalid_argument) and allocates the grids.
+  explicit SmokeSolver(const SmokeParams& params);
+
+  const SmokeParams& params() const { return mParams; }
+  GridFrame gridFrame() const;
+
+  // --- Emitters of the coming frame ---
+  void clearEmitters();
+  void addSource(const CellSet& cells, const SourceSettings& settings);
+  void addObstacle(const CellSet& cells, Slip slip);
+  /// Per-cell wind velocity (cell-centred), replacing the constant params().wind; empty = constant.
+  void setWindField(const VectorGrid& wind);
+
+  /// Advances one frame in one or more steps (params().substeps, more if CFL needs them).
+  /// Returns false when cancel() was called; the state is then mid-frame and must be discarded.
+  bool advanceFrame();
+  /// One fractional step of length dt: the stages below, in order.
+  void step(float dt);
+  /// Thread-safe: makes a running advanceFrame() return false after the current step.
+  void cancel() { mCancel.store(true); }
+
+  // --- Stages of step() (public so tests and benchmarks can run them one by one) ---
+  void applySources(float dt);
+  void addForces(float dt);          ///< buoyancy, wind, vorticity confinement
+  void advect(float dt);             ///< velocity and every scalar, chosen scheme
+  void burn(float dt);               ///< combustion eqs. 3-5 and the divergence φ of eq. 1
+  void dissipate(float dt);          ///< density loss, ρ *= e^{-d dt}
+  void project(float dt);            ///< make div u = φ with the boundary conditions
+
+  // --- State ---
+  int frame() const { return mFrame; }
+  void setFrame(int frame) { mFrame = frame; }
+  const StepStats& lastStats() const { return mStats; }
+
+  MacGrid3& velocity() { return mVelocity; }
+  const MacGrid3& velocity() const { return mVelocity; }
+  ScalarGrid& density() { return mDensity; }
+  ScalarGrid& temperature() { return mTemperature; }
+  ScalarGrid& fuel() { return mFuel; }
+  ScalarGrid& soot() { return mSoot; }
+  ScalarGrid& flame() { return mFlame; }
+  ScalarGrid& pressure() { return mPressure; }
+  const ScalarGrid& density() const { return mDensity; }
+  const ScalarGrid& temperature() const { return mTemperature; }
+  const ScalarGrid& fuel() const { return mFuel; }
+  const ScalarGrid& soot() const { return mSoot; }
+  const ScalarGrid& flame() const { return mFlame; }
+  const ScalarGrid& pressure() const { return mPressure; }
+  const FlagGrid& cellTypes() const { return mCellTypes; }
+
+  /// Largest |div u - φ| × Δx over fluid cells divided by the largest |u| (tests use it).
+  float maxDivergence() const;
+  /// Largest face speed, m/s.
+  float maxSpeed() const;
+
+ private:
+  struct Source {
+    CellSet cells;
+    SourceSettings settings;
+  };
+  struct Obstacle {
+    CellSet cells;
+    Slip slip;
+  };
+
+  void rebuildCellTypes();
+  void enforceBoundaryVelocities();
+  void applyPressureGradient();
+  float fluxSum(int i, int j, int k) const;
+  void zeroSolidScalars();
+
+  SmokeParams mParams;
+  MacGrid3 mVelocity, mVelocityTmp, mVelocityTmp2;
+  ScalarGrid mDensity, mTemperature, mFuel, mSoot, mFlame;
+  ScalarGrid mScalarTmp, mScalarTmp2;  ///< advection scratch
+  ScalarGrid mPressure, mRhs, mDivergenceTarget;
+  VectorGrid mVorticity, mForce, mWindField;
+  Advector mAdvector;
+  FlagGrid mCellTypes, mCellTypesNext;
+  VectorGrid mSolidVelocity;  ///< velocity of the obstacle in each solid cell
+  FlagGrid mNoSlip;           ///< 1 where a solid cell belongs to a no-slip obstacle
+  std::vector<Source> mSources;
+  std::vector<Obstacle> mObstacles;
+  bool mCellTypesDirty = true;
+  PressureSolver mPressureSolver;
+  std::atomic<bool> mCancel{false};
+  int mFrame = 0;
+  StepStats mStats;
+};
+
+}  // namespace plume

@@ -1,0 +1,245 @@
+// Tests of the smoke solver: the properties issue 2 names (divergence after projection, mass
+// conservation, no new extrema, symmetry, determinism across thread counts).
+#include "core/parallel.h"
+#include "solver/smoke_solver.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+namespace plume {
+namespace {
+
+SmokeParams smallParams(glm::ivec3 res) {
+  SmokeParams p;
+  p.resolution = res;
+  p.cellSize = 1.f / float(res.x);
+  p.frameDt = 1.f / 24.f;
+  p.useCfl = true;
+  p.pressureTolerance = 1e-6f;
+  p.maxPressureIterations = 500;
+  return p;
+}
+
+/// All cells whose centre lies within r cells of c.
+CellSet ball(glm::ivec3 res, glm::vec3 c, float r) {
+  CellSet s;
+  for (int k = 0; k < res.z; ++k)
+    for (int j = 0; j < res.y; ++j)
+      for (int i = 0; i < res.x; ++i)
+        if (glm::length(glm::vec3(i, j, k) + 0.5f - c) <= r)
+          s.cells.push_back(std::uint32_t(i + res.x * (j + res.y * k)));
+  return s;
+}
+
+double total(const ScalarGrid& g) {
+  double t = 0.0;
+  for (std::size_t n = 0; n < g.count(); ++n) t += g[n];
+  return t;
+}
+
+void addPlumeSource(SmokeSolver& solver, glm::ivec3 res) {
+  SourceSettings s;
+  s.density = 1.f;
+  s.temperature = 1.f;
+  solver.addSource(ball(res, glm::vec3(res.x * 0.5f, res.y * 0.5f, 3.f), 2.5f), s);
+}
+
+TEST(Projection, DivergenceFreeWithOpenSides) {
+  const glm::ivec3 res(24, 24, 32);
+  SmokeSolver solver(smallParams(res));
+  addPlumeSource(solver, res);
+  for (int f = 0; f < 6; ++f) ASSERT_TRUE(solver.advanceFrame());
+  EXPECT_GT(solver.maxSpeed(), 0.01f);
+  // max |div u| < 1e-4 max|u| / Δx  <=>  max |Δx div u| / max|u| < 1e-4.
+  EXPECT_LT(solver.maxDivergence(), 1e-4f);
+}
+
+TEST(Projection, DivergenceFreeWithObstacleAndClosedBox) {
+  const glm::ivec3 res(24, 24, 32);
+  SmokeParams p = smallParams(res);
+  p.boundaries.fill(Boundary::Closed);
+  SmokeSolver solver(p);
+  addPlumeSource(solver, res);
+  solver.addObstacle(ball(res, glm::vec3(12.f, 12.f, 16.f), 5.f), Slip::NoSlip);
+  for (int f = 0; f < 6; ++f) ASSERT_TRUE(solver.advanceFrame());
+  EXPECT_GT(solver.maxSpeed(), 0.01f);
+  EXPECT_LT(solver.maxDivergence(), 1e-4f);
+  // No flow enters the obstacle: every face of a solid cell carries the (zero) solid velocity.
+  const FlagGrid& t = solver.cellTypes();
+  const MacGrid3& u = solver.velocity();
+  for (int k = 0; k < res.z; ++k)
+    for (int j = 0; j < res.y; ++j)
+      for (int i = 0; i < res.x; ++i)
+        if (t(i, j, k) == kSolid) {
+          ASSERT_EQ(u.u()(i, j, k), 0.f);
+          ASSERT_EQ(u.w()(i, j, k + 1), 0.f);
+        }
+}
+
+TEST(Projection, DivergenceFreeWithFreeSlipObstacleAndOpenSides) {
+  const glm::ivec3 res(20, 28, 36);
+  SmokeSolver solver(smallParams(res));
+  addPlumeSource(solver, res);
+  solver.addObstacle(ball(res, glm::vec3(10.f, 14.f, 18.f), 4.f), Slip::FreeSlip);
+  for (int f = 0; f < 6; ++f) ASSERT_TRUE(solver.advanceFrame());
+  EXPECT_LT(solver.maxDivergence(), 1e-4f);
+}
+
+/// A closed box, a density blob and the flow its buoyancy makes; no sources.
+std::unique_ptr<SmokeSolver> closedBoxWithBlob(glm::ivec3 res, Advection scheme,
+                                               Interpolation interp) {
+  SmokeParams p = smallParams(res);
+  p.boundaries.fill(Boundary::Closed);
+  p.advection = scheme;
+  p.interpolation = interp;
+  p.pressureTolerance = 1e-4f;
+  p.vorticity = 0.3f;
+  auto solver = std::make_unique<SmokeSolver>(p);
+  for (std::uint32_t c : ball(res, glm::vec3(res) * glm::vec3(0.5f, 0.5f, 0.3f), 5.f).cells) {
+    solver->density()[c] = 1.f;
+    solver->temperature()[c] = 1.f;
+  }
+  return solver;
+}
+
+TEST(Advection, ClosedBoxKeepsMassOver100BfeccSteps) {
+  const glm::ivec3 res(32, 32, 32);
+  auto owner = closedBoxWithBlob(res, Advection::Bfecc, Interpolation::MonotonicCubic);
+  SmokeSolver& solver = *owner;
+  const double before = total(solver.density());
+  for (int s = 0; s < 100; ++s) solver.step(solver.params().frameDt);
+  const double after = total(solver.density());
+  EXPECT_GT(solver.maxSpeed(), 0.1f);  // the blob really moved
+  EXPECT_NEAR(after / before, 1.0, 0.01);
+}
+
+TEST(Advection, MonotonicCubicMakesNoNewExtrema) {
+  const glm::ivec3 res(32, 32, 32);
+  for (Advection scheme : {Advection::SemiLagrangian, Advection::Bfecc}) {
+    auto owner = closedBoxWithBlob(res, scheme, Interpolation::MonotonicCubic);
+    SmokeSolver& solver = *owner;
+    for (int s = 0; s < 40; ++s) {
+      solver.step(solver.params().frameDt);
+      float lo = 1e9f, hi = -1e9f;
+      for (std::size_t n = 0; n < solver.density().count(); ++n) {
+        lo = std::min(lo, solver.density()[n]);
+        hi = std::max(hi, solver.density()[n]);
+      }
+      ASSERT_GE(lo, 0.f) << "step " << s;
+      ASSERT_LE(hi, 1.f) << "step " << s;
+    }
+  }
+}
+
+TEST(Advection, ConstantWindCarriesBlobAtItsSpeed) {
+  const glm::ivec3 res(40, 12, 12);
+  SmokeParams p = smallParams(res);
+  p.alpha = p.beta = 0.f;
+  p.vorticity = 0.f;
+  SmokeSolver solver(p);
+  solver.velocity().u().fill(0.5f);  // m/s, divergence free
+  for (std::uint32_t c : ball(res, glm::vec3(10.f, 6.f, 6.f), 3.f).cells) solver.density()[c] = 1.f;
+  auto centroidX = [&] {
+    double m = 0, mx = 0;
+    for (int k = 0; k < res.z; ++k)
+      for (int j = 0; j < res.y; ++j)
+        for (int i = 0; i < res.x; ++i) {
+          m += solver.density()(i, j, k);
+          mx += solver.density()(i, j, k) * (i + 0.5);
+        }
+    return mx / m;
+  };
+  const double x0 = centroidX();
+  for (int f = 0; f < 12; ++f) ASSERT_TRUE(solver.advanceFrame());
+  // 0.5 m/s for 0.5 s = 0.25 m = 10 cells.
+  EXPECT_NEAR(centroidX() - x0, 10.0, 0.2);
+}
+
+TEST(Solver, SymmetricPlumeStaysSymmetric) {
+  const glm::ivec3 res(24, 24, 32);
+  SmokeParams p = smallParams(res);
+  p.boundaries[kNegZ] = Boundary::Closed;
+  SmokeSolver solver(p);
+  addPlumeSource(solver, res);
+  for (int s = 0; s < 50; ++s) solver.step(p.frameDt * 0.5f);
+  const ScalarGrid& d = solver.density();
+  float peak = 0.f, err = 0.f;
+  for (int k = 0; k < res.z; ++k)
+    for (int j = 0; j < res.y; ++j)
+      for (int i = 0; i < res.x; ++i) {
+        peak = std::max(peak, d(i, j, k));
+        err = std::max(err, std::fabs(d(i, j, k) - d(res.x - 1 - i, j, k)));
+        err = std::max(err, std::fabs(d(i, j, k) - d(i, res.y - 1 - j, k)));
+      }
+  EXPECT_GT(peak, 0.5f);
+  EXPECT_LT(err, 1e-4f * peak);
+}
+
+TEST(Solver, SameResultWithOneAndTwoThreads) {
+  const glm::ivec3 res(20, 24, 28);
+  auto run = [&](int threads) {
+    SmokeParams p = smallParams(res);
+    p.threads = threads;
+    p.combustion = true;
+    p.conductivity = 1e-3f;
+    auto owner = std::make_unique<SmokeSolver>(p);
+    SmokeSolver& solver = *owner;
+    SourceSettings s;
+    s.fuel = 1.f;
+    s.velocity = glm::vec3(0.1f, 0.f, 0.3f);
+    solver.addSource(ball(res, glm::vec3(9.f, 12.f, 4.f), 3.f), s);
+    solver.addObstacle(ball(res, glm::vec3(10.f, 12.f, 16.f), 3.f), Slip::FreeSlip);
+    for (int f = 0; f < 8; ++f) solver.advanceFrame();
+    return owner;
+  };
+  auto pa = run(1), pb = run(2);
+  const SmokeSolver &a = *pa, &b = *pb;
+  EXPECT_EQ(a.density().values(), b.density().values());
+  EXPECT_EQ(a.temperature().values(), b.temperature().values());
+  EXPECT_EQ(a.soot().values(), b.soot().values());
+  EXPECT_EQ(a.velocity().w().values(), b.velocity().w().values());
+}
+
+TEST(Combustion, FuelBurnsIntoSootAndHeat) {
+  const glm::ivec3 res(16, 16, 16);
+  SmokeParams p = smallParams(res);
+  p.combustion = true;
+  p.alpha = p.beta = 0.f;
+  p.vorticity = 0.f;
+  p.coolingRate = 0.f;
+  p.expansion = 0.f;
+  p.boundaries.fill(Boundary::Closed);
+  SmokeSolver solver(p);
+  solver.fuel()(8, 8, 8) = 1.f;
+  solver.burn(0.1f);
+  // F(t) = F0 e^{-r t}; S and T gain k_S and k_T times what burnt (eqs. 3-5).
+  const float burnt = 1.f - std::exp(-p.burnRate * 0.1f);
+  EXPECT_NEAR(solver.fuel()(8, 8, 8), 1.f - burnt, 1e-6f);
+  EXPECT_NEAR(solver.soot()(8, 8, 8), p.sootYield * burnt, 1e-6f);
+  EXPECT_NEAR(solver.temperature()(8, 8, 8), p.heatYield * burnt, 1e-6f);
+  EXPECT_GT(solver.flame()(8, 8, 8), 0.f);
+}
+
+TEST(Params, ValidateNamesTheSetting) {
+  SmokeParams p;
+  p.vorticity = -1.f;
+  try {
+    p.validate();
+    FAIL() << "negative vorticity accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("vorticity"), std::string::npos);
+  }
+  p = SmokeParams();
+  p.alpha = std::nanf("");
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = SmokeParams();
+  p.resolution = glm::ivec3(0, 10, 10);
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.resolution = glm::ivec3(1000, 1000, 1000);
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace plume
