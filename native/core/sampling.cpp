@@ -51,7 +51,10 @@ float monotonicCubic1D(float f0, float f1, float f2, float f3, float t) {
   // Fedkiw eq. 12: f(t) = a3 t^3 + a2 t^2 + a1 t + a0.
   const float a3 = d1 + d2 - 2.f * delta;
   const float a2 = 3.f * delta - 2.f * d1 - d2;
-  return a3 * t3 + a2 * t2 + d1 * t + f1;
+  const float value = a3 * t3 + a2 * t2 + d1 * t + f1;
+  // Exact arithmetic keeps the value between f1 and f2; the clamp also rules out rounding.
+  const float lo = f1 < f2 ? f1 : f2, hi = f1 < f2 ? f2 : f1;
+  return value < lo ? lo : (value > hi ? hi : value);
 }
 
 float sampleMonotonicCubic(const ScalarGrid& g, glm::vec3 p) {

@@ -39,6 +39,7 @@ struct SmokeParams {
   // --- Advection ---
   Advection advection = Advection::Bfecc;
   Interpolation interpolation = Interpolation::MonotonicCubic;
+  bool conserveMass = true;  ///< restore Σρ after advection (minus outflow), see mass_conservation.h
 
   // --- Forces (Fedkiw 2001 eq. 8, 9) ---
   glm::vec3 gravity{0.f, 0.f, -9.81f};  ///< g; buoyancy acts against it

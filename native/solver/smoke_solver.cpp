@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 #include "solver/combustion.h"
 #include "solver/forces.h"
+#include "solver/mass_conservation.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -142,11 +143,14 @@ bool SmokeSolver::advanceFrame() {
 }
 
 void SmokeSolver::step(float dt) {
-  // Stam's fractional step, as named stages run in this order.
+  // Stam's fractional step (forces, advection, projection) as named stages. The cycle starts at
+  // advection, as Mantaflow's does, so that density and velocity are carried by the
+  // divergence-free velocity of the last projection: carried by u + Δt f instead, smoke would
+  // be compressed and lose mass wherever buoyancy pushes it.
   using Stage = void (SmokeSolver::*)(float);
   static const std::pair<const char*, Stage> kStages[] = {
-      {"sources", &SmokeSolver::applySources}, {"forces", &SmokeSolver::addForces},
-      {"advect", &SmokeSolver::advect},        {"burn", &SmokeSolver::burn},
+      {"sources", &SmokeSolver::applySources}, {"advect", &SmokeSolver::advect},
+      {"forces", &SmokeSolver::addForces},     {"burn", &SmokeSolver::burn},
       {"dissipate", &SmokeSolver::dissipate},  {"project", &SmokeSolver::project},
   };
   mStats.pressureIterations = 0;
@@ -197,8 +201,13 @@ void SmokeSolver::advect(float dt) {
     scalars.push_back(&mSoot);
   }
   for (ScalarGrid* g : scalars) {
+    // Density-like fields (not temperature) keep their mass, less what leaves the domain.
+    const bool conserve = mParams.conserveMass && g != &mTemperature;
+    const double target =
+        conserve ? totalMass(*g) - outflowMass(*g, mVelocity, mParams.boundaries, dt, h) : 0.0;
     mAdvector.advect(*g, mScalarTmp, kCellOffset, mVelocity, dt, h, scheme, interp);
     std::swap(g->values(), mScalarTmp.values());
+    if (conserve) restoreMass(*g, target);
   }
   static const glm::vec3 kOffsets[3] = {kFaceOffsetU, kFaceOffsetV, kFaceOffsetW};
   for (int a = 0; a < 3; ++a)

@@ -1,7 +1,7 @@
 #pragma once
 /// \file smoke_solver.h
 /// The fractional-step smoke/fire solver (Stam 1999) shared by all four pipelines:
-/// sources, forces, advection, combustion, projection, as named stages of step().
+/// sources, advection, forces, combustion, projection, as named stages of step().
 
 #include "core/grid3.h"
 #include "core/mac_grid3.h"
@@ -64,8 +64,8 @@ class SmokeSolver {
 
   // --- Stages of step() (public so tests and benchmarks can run them one by one) ---
   void applySources(float dt);
-  void addForces(float dt);          ///< buoyancy, wind, vorticity confinement
   void advect(float dt);             ///< velocity and every scalar, chosen scheme
+  void addForces(float dt);          ///< buoyancy, wind, vorticity confinement
   void burn(float dt);               ///< combustion eqs. 3-5 and the divergence φ of eq. 1
   void dissipate(float dt);          ///< density loss, ρ *= e^{-d dt}
   void project(float dt);            ///< make div u = φ with the boundary conditions

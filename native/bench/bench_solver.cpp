@@ -1,0 +1,190 @@
+/// \file bench_solver.cpp
+/// Google Benchmark of the smoke solver: whole steps, each stage of step(), and VDB output, on a
+/// warmed-up plume (BFECC + monotonic cubic, vorticity confinement, buoyancy, spherical source on
+/// a closed floor, open sides). Not a test: run build/native/plume_bench by hand.
+
+#include "io/vdb_frame.h"
+#include "solver/emitters.h"
+#include "solver/smoke_solver.h"
+
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <utility>
+
+namespace plume {
+namespace {
+
+constexpr int kWarmupSteps = 4;
+
+/// Peak resident set of the process so far, MB (Linux reports ru_maxrss in kB).
+double peakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) / 1024.0;
+}
+
+/// UV sphere of radius r around c: the source mesh.
+EmitterMesh sphere(glm::vec3 c, float r, int rings = 16, int segments = 32) {
+  EmitterMesh m;
+  m.name = "bench source";
+  m.vertices.push_back(c + glm::vec3(0, 0, r));
+  for (int a = 1; a < rings; ++a) {
+    const double th = M_PI * a / rings;
+    for (int b = 0; b < segments; ++b) {
+      const double ph = 2 * M_PI * b / segments;
+      m.vertices.push_back(c + r * glm::vec3(std::sin(th) * std::cos(ph),
+                                             std::sin(th) * std::sin(ph), std::cos(th)));
+    }
+  }
+  m.vertices.push_back(c - glm::vec3(0, 0, r));
+  const int south = int(m.vertices.size()) - 1;
+  auto ring = [&](int a, int b) { return 1 + (a - 1) * segments + (b % segments); };
+  for (int b = 0; b < segments; ++b) m.triangles.push_back({0, ring(1, b), ring(1, b + 1)});
+  for (int a = 1; a + 1 < rings; ++a)
+    for (int b = 0; b < segments; ++b) {
+      m.triangles.push_back({ring(a, b), ring(a + 1, b), ring(a + 1, b + 1)});
+      m.triangles.push_back({ring(a, b), ring(a + 1, b + 1), ring(a, b + 1)});
+    }
+  for (int b = 0; b < segments; ++b)
+    m.triangles.push_back({south, ring(rings - 1, b + 1), ring(rings - 1, b)});
+  return m;
+}
+
+SmokeParams benchParams(int n, bool fire) {
+  SmokeParams p;
+  p.resolution = glm::ivec3(n);
+  p.cellSize = 1.f / float(n);
+  p.advection = Advection::Bfecc;
+  p.interpolation = Interpolation::MonotonicCubic;
+  p.vorticity = 0.3f;
+  p.alpha = 1.f;
+  p.beta = 1.f;
+  p.boundaries = {Boundary::Open, Boundary::Open,   Boundary::Open,
+                  Boundary::Open, Boundary::Closed, Boundary::Open};
+  p.combustion = fire;
+  return p;
+}
+
+/// One warmed-up solver per (resolution, fire), built once: Google Benchmark calls each
+/// benchmark function several times while it sizes the iteration count.
+SmokeSolver& warmSolver(int n, bool fire) {
+  static std::map<std::pair<int, bool>, std::unique_ptr<SmokeSolver>> cache;
+  auto& slot = cache[{n, fire}];
+  if (!slot) {
+    slot = std::make_unique<SmokeSolver>(benchParams(n, fire));
+    SourceSettings settings;
+    settings.density = 1.f;
+    settings.temperature = 2.f;
+    settings.fuel = fire ? 1.f : 0.f;
+    const CellSet cells = voxelizeSource(sphere({0.5f, 0.5f, 0.15f}, 0.12f), slot->gridFrame());
+    slot->addSource(cells, settings);
+    const float dt = slot->params().frameDt;
+    for (int s = 0; s < kWarmupSteps; ++s) slot->step(dt);
+  }
+  return *slot;
+}
+
+/// Everything a stage reads or writes, to run the same stage again from the same input.
+struct Snapshot {
+  MacGrid3 velocity;
+  ScalarGrid density, temperature, fuel, soot, flame, pressure;
+  explicit Snapshot(const SmokeSolver& s)
+      : velocity(s.velocity()), density(s.density()), temperature(s.temperature()),
+        fuel(s.fuel()), soot(s.soot()), flame(s.flame()), pressure(s.pressure()) {}
+  void restore(SmokeSolver& s) const {
+    s.velocity() = velocity;
+    s.density() = density;
+    s.temperature() = temperature;
+    s.fuel() = fuel;
+    s.soot() = soot;
+    s.flame() = flame;
+    s.pressure() = pressure;
+  }
+};
+
+void BM_Step(benchmark::State& state) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false);
+  const float dt = solver.params().frameDt;
+  double iterations = 0.0;
+  for (auto _ : state) {
+    solver.step(dt);
+    iterations += solver.lastStats().pressureIterations;
+  }
+  state.counters["steps_per_s"] = benchmark::Counter(double(state.iterations()),
+                                                     benchmark::Counter::kIsRate);
+  state.counters["pressure_iters"] = iterations / double(state.iterations());
+  state.counters["peak_rss_MB"] = peakRssMb();
+}
+BENCHMARK(BM_Step)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Times `stage` alone, each iteration from the state the previous stages of a step leave.
+template <typename Stage>
+void stageBenchmark(benchmark::State& state, bool fire, int before, Stage stage) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), fire);
+  const float dt = solver.params().frameDt;
+  using Member = void (SmokeSolver::*)(float);
+  const Member order[] = {&SmokeSolver::applySources, &SmokeSolver::addForces,
+                          &SmokeSolver::advect, &SmokeSolver::burn, &SmokeSolver::project};
+  const Snapshot start(solver);
+  for (int s = 0; s < before; ++s) (solver.*order[s])(dt);
+  const Snapshot input(solver);
+  for (auto _ : state) {
+    state.PauseTiming();
+    input.restore(solver);
+    state.ResumeTiming();
+    stage(solver, dt);
+  }
+  start.restore(solver);
+  state.counters["cells_per_s"] = benchmark::Counter(
+      double(state.iterations()) * double(solver.density().count()), benchmark::Counter::kIsRate);
+  state.counters["peak_rss_MB"] = peakRssMb();
+}
+
+void BM_Stage_applySources(benchmark::State& state) {
+  stageBenchmark(state, false, 0, [](SmokeSolver& s, float dt) { s.applySources(dt); });
+}
+void BM_Stage_addForces(benchmark::State& state) {
+  stageBenchmark(state, false, 1, [](SmokeSolver& s, float dt) { s.addForces(dt); });
+}
+void BM_Stage_advect(benchmark::State& state) {
+  stageBenchmark(state, false, 2, [](SmokeSolver& s, float dt) { s.advect(dt); });
+}
+void BM_Stage_burn(benchmark::State& state) {
+  stageBenchmark(state, /*fire=*/true, 3, [](SmokeSolver& s, float dt) { s.burn(dt); });
+}
+void BM_Stage_project(benchmark::State& state) {
+  double iterations = 0.0;
+  stageBenchmark(state, false, 4, [&](SmokeSolver& s, float dt) {
+    s.project(dt);
+    iterations += s.lastStats().pressureIterations;
+  });
+  state.counters["pressure_iters"] = iterations / double(state.iterations());
+}
+BENCHMARK(BM_Stage_applySources)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stage_addForces)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stage_advect)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stage_burn)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stage_project)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_WriteVdb(benchmark::State& state) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "plume_bench_frame.vdb").string();
+  for (auto _ : state) writeVdbFrame(path, solver);
+  std::error_code ec;
+  state.counters["file_MB"] = double(std::filesystem::file_size(path, ec)) / (1024.0 * 1024.0);
+  std::filesystem::remove(path, ec);
+  state.counters["peak_rss_MB"] = peakRssMb();
+}
+BENCHMARK(BM_WriteVdb)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace plume
+
+BENCHMARK_MAIN();

@@ -1,0 +1,22 @@
+#pragma once
+/// \file bindings.h
+/// One bind function per component; module.cpp calls them in order (enums first, since the
+/// other bindings use them as argument types and defaults).
+
+#include <pybind11/pybind11.h>
+
+#include <string>
+
+namespace plume::bindings {
+
+/// SmokeParams, SourceSettings, SmokeSolver (bind_solver.cpp).
+void bindSolver(pybind11::module_& m);
+/// vdb_grid_names, read_vdb_grid (bind_io.cpp).
+void bindIo(pybind11::module_& m);
+
+/// A path argument given as str or os.PathLike, as a std::string (needs the GIL).
+inline std::string pathArg(const pybind11::object& path) {
+  return pybind11::str(pybind11::module_::import("os").attr("fspath")(path)).cast<std::string>();
+}
+
+}  // namespace plume::bindings

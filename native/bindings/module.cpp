@@ -1,0 +1,42 @@
+/// \file module.cpp
+/// The Python module plume._native: enums shared by every component, then each component's
+/// bindings. Only conversions and docstrings live in bindings/; the work is in the core.
+
+#include "bindings/bindings.h"
+
+#include "solver/smoke_params.h"
+#include "solver/smoke_solver.h"
+
+namespace py = pybind11;
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() =
+      "Plume native core: smoke/fire grid solver (Stam 1999; Fedkiw, Stam & Jensen 2001; the\n"
+      "combustion model of Graph-based Fire Synthesis) and its VDB/state files.\n"
+      "Arrays are float32 copies shaped (nx, ny, nz), indexed [i, j, k]; cell (i, j, k) is centred\n"
+      "at origin + (i + 0.5, j + 0.5, k + 0.5) * cell_size.";
+  m.attr("__version__") = "0.1.0";
+
+  py::enum_<plume::Advection>(m, "Advection",
+                              "Advection scheme: semi-Lagrangian (Stam 1999) or BFECC (Kim et al. "
+                              "2005, smoke_surfaces §3.1).")
+      .value("SEMI_LAGRANGIAN", plume::Advection::SemiLagrangian)
+      .value("BFECC", plume::Advection::Bfecc);
+  py::enum_<plume::Interpolation>(
+      m, "Interpolation",
+      "How grids are sampled between samples: trilinear or monotonic cubic (Fedkiw 2001 §5).")
+      .value("LINEAR", plume::Interpolation::Linear)
+      .value("MONOTONIC_CUBIC", plume::Interpolation::MonotonicCubic);
+  py::enum_<plume::Boundary>(m, "Boundary",
+                             "A domain side: OPEN (air, p = 0, outflow) or CLOSED (a wall).")
+      .value("OPEN", plume::Boundary::Open)
+      .value("CLOSED", plume::Boundary::Closed);
+  py::enum_<plume::Slip>(m, "Slip",
+                         "Obstacle wall condition: NO_SLIP drags the air to the obstacle's "
+                         "velocity, FREE_SLIP only stops the normal part.")
+      .value("NO_SLIP", plume::Slip::NoSlip)
+      .value("FREE_SLIP", plume::Slip::FreeSlip);
+
+  plume::bindings::bindSolver(m);
+  plume::bindings::bindIo(m);
+}

@@ -1,0 +1,268 @@
+/// \file state_file.cpp
+/// Solver checkpoint. Layout (little-endian):
+///   "PLUMESTATE" | u32 version = 1 | i32 frame | i32 nx, ny, nz | u32 grid count
+///   per grid: u32 name length | name bytes | u64 value count | f32 values
+///   u64 FNV-1a 64 checksum of every byte before it.
+/// Reading checks the header against the solver, then the exact file size, then the checksum,
+/// before any grid is parsed; the solver is only touched once everything has been read.
+
+#include "io/state_file.h"
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace plume {
+namespace {
+
+constexpr char kMagic[10] = {'P', 'L', 'U', 'M', 'E', 'S', 'T', 'A', 'T', 'E'};
+constexpr std::uint32_t kVersion = 1;
+constexpr std::size_t kHeaderSize = sizeof(kMagic) + 4 + 4 + 3 * 4 + 4;
+
+/// The grids of the state, in file order.
+struct GridRef {
+  const char* name;
+  ScalarGrid* grid;
+};
+
+std::vector<GridRef> stateGrids(SmokeSolver& s) {
+  MacGrid3& vel = s.velocity();
+  return {{"velocity_u", &vel.u()},       {"velocity_v", &vel.v()},
+          {"velocity_w", &vel.w()},       {"density", &s.density()},
+          {"temperature", &s.temperature()}, {"fuel", &s.fuel()},
+          {"soot", &s.soot()},           {"flame", &s.flame()},
+          {"pressure", &s.pressure()}};
+}
+
+bool hostIsLittleEndian() {
+  const std::uint32_t one = 1;
+  unsigned char b;
+  std::memcpy(&b, &one, 1);
+  return b == 1;
+}
+
+/// FNV-1a, 64 bit, over a byte range, continuing from `hash`.
+std::uint64_t fnv1a(const unsigned char* data, std::size_t size,
+                    std::uint64_t hash = 0xcbf29ce484222325ull) {
+  for (std::size_t n = 0; n < size; ++n) {
+    hash ^= data[n];
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+/// Appends little-endian bytes to a buffer.
+class Writer {
+ public:
+  void bytes(const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    mBuf.insert(mBuf.end(), c, c + n);
+  }
+  template <typename T>
+  void integer(T v) {
+    for (std::size_t b = 0; b < sizeof(T); ++b)
+      mBuf.push_back(static_cast<unsigned char>((static_cast<std::uint64_t>(v) >> (8 * b)) & 0xff));
+  }
+  void floats(const std::vector<float>& v) {
+    const std::size_t start = mBuf.size();
+    mBuf.resize(start + 4 * v.size());
+    if (hostIsLittleEndian()) {
+      std::memcpy(mBuf.data() + start, v.data(), 4 * v.size());
+    } else {
+      for (std::size_t n = 0; n < v.size(); ++n) {
+        std::uint32_t u;
+        std::memcpy(&u, &v[n], 4);
+        for (int b = 0; b < 4; ++b) mBuf[start + 4 * n + b] = (u >> (8 * b)) & 0xff;
+      }
+    }
+  }
+  std::vector<unsigned char>& buffer() { return mBuf; }
+
+ private:
+  std::vector<unsigned char> mBuf;
+};
+
+/// Reads little-endian values from a buffer whose size has already been checked.
+class Reader {
+ public:
+  Reader(const std::vector<unsigned char>& buf, const std::string& path) : mBuf(buf), mPath(path) {}
+  void need(std::size_t n) const {
+    if (mPos + n > mBuf.size() || mPos + n < mPos)
+      throw std::runtime_error("state file '" + mPath + "' is truncated");
+  }
+  template <typename T>
+  T integer() {
+    need(sizeof(T));
+    std::uint64_t v = 0;
+    for (std::size_t b = 0; b < sizeof(T); ++b) v |= std::uint64_t(mBuf[mPos + b]) << (8 * b);
+    mPos += sizeof(T);
+    return static_cast<T>(v);
+  }
+  std::string string(std::size_t n) {
+    need(n);
+    std::string s(reinterpret_cast<const char*>(mBuf.data() + mPos), n);
+    mPos += n;
+    return s;
+  }
+  void floats(std::vector<float>& out, std::size_t n) {
+    need(4 * n);
+    out.resize(n);
+    if (hostIsLittleEndian()) {
+      std::memcpy(out.data(), mBuf.data() + mPos, 4 * n);
+    } else {
+      for (std::size_t m = 0; m < n; ++m) {
+        std::uint32_t u = 0;
+        for (int b = 0; b < 4; ++b) u |= std::uint32_t(mBuf[mPos + 4 * m + b]) << (8 * b);
+        std::memcpy(&out[m], &u, 4);
+      }
+    }
+    mPos += 4 * n;
+  }
+  std::size_t position() const { return mPos; }
+
+ private:
+  const std::vector<unsigned char>& mBuf;
+  const std::string& mPath;
+  std::size_t mPos = 0;
+};
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error("state file '" + path + "' " + what);
+}
+
+}  // namespace
+
+void writeState(const std::string& path, const SmokeSolver& solver) {
+  // stateGrids only reads through these pointers here.
+  auto grids = stateGrids(const_cast<SmokeSolver&>(solver));
+  const glm::ivec3 n = solver.params().resolution;
+  Writer w;
+  std::size_t total = kHeaderSize + 8;
+  for (const GridRef& g : grids) total += 4 + std::strlen(g.name) + 8 + 4 * g.grid->count();
+  w.buffer().reserve(total);
+  w.bytes(kMagic, sizeof(kMagic));
+  w.integer<std::uint32_t>(kVersion);
+  w.integer<std::int32_t>(solver.frame());
+  w.integer<std::int32_t>(n.x);
+  w.integer<std::int32_t>(n.y);
+  w.integer<std::int32_t>(n.z);
+  w.integer<std::uint32_t>(std::uint32_t(grids.size()));
+  for (const GridRef& g : grids) {
+    const std::size_t len = std::strlen(g.name);
+    w.integer<std::uint32_t>(std::uint32_t(len));
+    w.bytes(g.name, len);
+    w.integer<std::uint64_t>(std::uint64_t(g.grid->count()));
+    w.floats(g.grid->values());
+  }
+  const std::uint64_t sum = fnv1a(w.buffer().data(), w.buffer().size());
+  w.integer<std::uint64_t>(sum);
+
+  const std::string tmp = path + ".tmp";
+  bool ok = false;
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (out) {
+      out.write(reinterpret_cast<const char*>(w.buffer().data()),
+                std::streamsize(w.buffer().size()));
+      out.flush();
+      ok = bool(out);
+      out.close();
+      ok = ok && !out.fail();
+    }
+  }
+  if (!ok) {
+    std::remove(tmp.c_str());
+    fail(path, "cannot be written (missing directory, no permission or disk full?)");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    fail(path, "cannot be written: renaming the temporary file '" + tmp + "' failed");
+  }
+}
+
+void readState(const std::string& path, SmokeSolver& solver) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) fail(path, "cannot be opened");
+  const std::streamoff fileSize = in.tellg();
+  if (fileSize < std::streamoff(kHeaderSize + 8)) fail(path, "is truncated (shorter than its header)");
+  in.seekg(0);
+
+  // Header first: it says whether this file can belong to this solver at all.
+  std::vector<unsigned char> header(kHeaderSize);
+  if (!in.read(reinterpret_cast<char*>(header.data()), std::streamsize(kHeaderSize)))
+    fail(path, "cannot be read");
+  Reader h(header, path);
+  if (h.string(sizeof(kMagic)) != std::string(kMagic, sizeof(kMagic)))
+    fail(path, "is not a Plume state file (bad magic)");
+  const std::uint32_t version = h.integer<std::uint32_t>();
+  if (version != kVersion) {
+    std::ostringstream s;
+    s << "has version " << version << "; this build reads version " << kVersion;
+    fail(path, s.str());
+  }
+  const std::int32_t frame = h.integer<std::int32_t>();
+  glm::ivec3 res;
+  res.x = h.integer<std::int32_t>();
+  res.y = h.integer<std::int32_t>();
+  res.z = h.integer<std::int32_t>();
+  const glm::ivec3 expect = solver.params().resolution;
+  if (res != expect) {
+    std::ostringstream s;
+    s << "has resolution " << res.x << "x" << res.y << "x" << res.z << "; the domain has "
+      << expect.x << "x" << expect.y << "x" << expect.z;
+    fail(path, s.str());
+  }
+  auto grids = stateGrids(solver);
+  const std::uint32_t gridCount = h.integer<std::uint32_t>();
+  if (gridCount != grids.size()) {
+    std::ostringstream s;
+    s << "has " << gridCount << " grids; expected " << grids.size();
+    fail(path, s.str());
+  }
+  // The exact size the solver's grids need; only then is anything allocated from the file.
+  std::size_t expectedSize = kHeaderSize + 8;
+  for (const GridRef& g : grids) expectedSize += 4 + std::strlen(g.name) + 8 + 4 * g.grid->count();
+  if (std::size_t(fileSize) != expectedSize) {
+    std::ostringstream s;
+    s << "has " << fileSize << " bytes; a state of this domain has " << expectedSize
+      << " (truncated or corrupt)";
+    fail(path, s.str());
+  }
+  std::vector<unsigned char> buf(expectedSize);
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(expectedSize)))
+    fail(path, "cannot be read");
+
+  Reader r(buf, path);
+  {
+    Reader tail(buf, path);
+    tail.string(expectedSize - 8);
+    if (fnv1a(buf.data(), expectedSize - 8) != tail.integer<std::uint64_t>())
+      fail(path, "is corrupt (checksum mismatch)");
+  }
+  r.string(kHeaderSize);
+  std::vector<std::vector<float>> values(grids.size());
+  for (std::size_t g = 0; g < grids.size(); ++g) {
+    const std::uint32_t len = r.integer<std::uint32_t>();
+    const std::string expectName = grids[g].name;
+    if (len != expectName.size() || r.string(len) != expectName)
+      fail(path, "is corrupt: expected grid '" + expectName + "' at this position");
+    const std::uint64_t count = r.integer<std::uint64_t>();
+    if (count != grids[g].grid->count()) {
+      std::ostringstream s;
+      s << "is corrupt: grid '" << expectName << "' has " << count << " values; expected "
+        << grids[g].grid->count();
+      fail(path, s.str());
+    }
+    r.floats(values[g], std::size_t(count));
+  }
+  if (r.position() + 8 != expectedSize) fail(path, "is corrupt (unexpected trailing bytes)");
+
+  // Everything checked: commit.
+  for (std::size_t g = 0; g < grids.size(); ++g) grids[g].grid->values().swap(values[g]);
+  solver.setFrame(frame);
+}
+
+}  // namespace plume

@@ -1,0 +1,211 @@
+/// \file vdb_frame.cpp
+/// Per-frame VDB files: dense solver grids to sparse OpenVDB grids (zero voxels skipped) and back.
+
+#include "io/vdb_frame.h"
+
+#include "core/parallel.h"
+
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+
+#include <cstdio>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+namespace plume {
+namespace {
+
+void initializeOpenVdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+/// Cell (i,j,k) is voxel (i,j,k): voxel size Δx, voxel centre origin + (i+½, j+½, k+½) Δx.
+openvdb::math::Transform::Ptr cellTransform(const SmokeParams& p) {
+  auto xform = openvdb::math::Transform::createLinearTransform(double(p.cellSize));
+  xform->postTranslate(openvdb::Vec3d(double(p.origin.x) + 0.5 * double(p.cellSize),
+                                      double(p.origin.y) + 0.5 * double(p.cellSize),
+                                      double(p.origin.z) + 0.5 * double(p.cellSize)));
+  return xform;
+}
+
+openvdb::CoordBBox cellBox(glm::ivec3 n) {
+  return openvdb::CoordBBox(openvdb::Coord(0, 0, 0), openvdb::Coord(n.x - 1, n.y - 1, n.z - 1));
+}
+
+/// A fog-volume float grid holding the non-zero cells of `values` (x-fastest, solver layout).
+/// copyFromDense converts leaf-sized blocks in parallel (TBB).
+openvdb::FloatGrid::Ptr floatGrid(const std::string& name, const float* values, glm::ivec3 n,
+                                  const openvdb::math::Transform::Ptr& xform) {
+  auto grid = openvdb::FloatGrid::create(/*background=*/0.f);
+  // Dense only reads here; it wants a mutable pointer because it can also be written to.
+  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(cellBox(n),
+                                                                const_cast<float*>(values));
+  openvdb::tools::copyFromDense(dense, *grid, /*tolerance=*/0.f);
+  grid->setName(name);
+  grid->setTransform(xform);
+  grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+  return grid;
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error("VDB file '" + path + "': " + what);
+}
+
+}  // namespace
+
+void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
+  initializeOpenVdb();
+  const SmokeParams& p = solver.params();
+  const glm::ivec3 n = p.resolution;
+  const auto xform = cellTransform(p);
+  const int slabs = n.z;
+  const std::size_t slab = std::size_t(n.x) * std::size_t(n.y);
+
+  openvdb::GridPtrVec grids;
+  {
+    // Blender's Principled Volume reads `density`: what it shows is smoke plus soot.
+    std::vector<float> density(solver.density().count());
+    const float* d = solver.density().data();
+    const float* s = solver.soot().data();
+    parallelFor(0, slabs, [&](int k) {
+      for (std::size_t m = std::size_t(k) * slab, e = m + slab; m < e; ++m) density[m] = d[m] + s[m];
+    });
+    grids.push_back(floatGrid("density", density.data(), n, xform));
+  }
+  grids.push_back(floatGrid("temperature", solver.temperature().data(), n, xform));
+  if (p.combustion) grids.push_back(floatGrid("flame", solver.flame().data(), n, xform));
+  {
+    // Cell-centred velocity: the mean of each cell's two faces per axis.
+    std::vector<openvdb::Vec3s> velocity(solver.density().count());
+    const MacGrid3& mac = solver.velocity();
+    parallelFor(0, slabs, [&](int k) {
+      for (int j = 0; j < n.y; ++j)
+        for (int i = 0; i < n.x; ++i) {
+          const glm::vec3 c = mac.cellCenter(i, j, k);
+          velocity[std::size_t(i) + std::size_t(n.x) * (std::size_t(j) + std::size_t(n.y) * k)] =
+              openvdb::Vec3s(c.x, c.y, c.z);
+        }
+    });
+    auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+    openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dense(cellBox(n),
+                                                                           velocity.data());
+    openvdb::tools::copyFromDense(dense, *grid, /*tolerance=*/openvdb::Vec3s(0.f));
+    grid->setName("velocity");
+    grid->setTransform(xform);
+    grid->setGridClass(openvdb::GRID_UNKNOWN);
+    grid->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    grids.push_back(grid);
+  }
+
+  const std::string tmp = path + ".tmp";
+  try {
+    openvdb::MetaMap meta;
+    meta.insertMeta("creator", openvdb::StringMetadata("plume"));
+    meta.insertMeta("frame", openvdb::Int32Metadata(solver.frame()));
+    {
+      openvdb::io::File file(tmp);
+      if (openvdb::io::File::hasBloscCompression())
+        file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+      file.write(grids, meta);
+      file.close();
+    }
+    // io::File::write does not report a failed stream (a full disk): read the grid descriptors
+    // back, which fails on a short file.
+    openvdb::io::File check(tmp);
+    check.open(/*delayLoad=*/true);
+    std::size_t written = 0;
+    for (auto it = check.beginName(); it != check.endName(); ++it) ++written;
+    check.close();
+    if (written != grids.size()) throw std::runtime_error("grids missing after writing");
+  } catch (const std::exception& e) {
+    std::remove(tmp.c_str());
+    fail(path, std::string("cannot be written: ") + e.what());
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    fail(path, "cannot rename the temporary file '" + tmp + "' to it");
+  }
+}
+
+std::vector<std::string> vdbGridNames(const std::string& path) {
+  initializeOpenVdb();
+  std::vector<std::string> names;
+  try {
+    openvdb::io::File file(path);
+    file.open(/*delayLoad=*/true);
+    for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(it.gridName());
+    file.close();
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot be read: ") + e.what());
+  }
+  return names;
+}
+
+namespace {
+
+/// Copies the active bounding box of a grid into a dense x-fastest array.
+template <typename GridT>
+void readDense(const GridT& grid, DenseGrid& out, const std::string& path) {
+  const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+  out.min = glm::ivec3(box.min().x(), box.min().y(), box.min().z());
+  if (box.empty()) {
+    out.size = glm::ivec3(0);
+    return;
+  }
+  const openvdb::Coord dim = box.dim();
+  const double count = double(dim.x()) * dim.y() * dim.z() * out.components;
+  // A file is never trusted: refuse boxes no solver could have written.
+  if (count > 1024.0 * 1024.0 * 1024.0)
+    fail(path, "grid '" + out.name + "' spans too many voxels to read densely");
+  out.size = glm::ivec3(dim.x(), dim.y(), dim.z());
+  using ValueT = typename GridT::ValueType;
+  std::vector<ValueT> values(std::size_t(dim.x()) * dim.y() * dim.z(), grid.background());
+  openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(box, values.data());
+  openvdb::tools::copyToDense(grid, dense);
+  if constexpr (std::is_same_v<ValueT, float>) {
+    out.values = std::move(values);
+  } else {
+    out.values.resize(values.size() * 3);
+    for (std::size_t m = 0; m < values.size(); ++m)
+      for (int c = 0; c < 3; ++c) out.values[3 * m + std::size_t(c)] = values[m][c];
+  }
+}
+
+}  // namespace
+
+DenseGrid readVdbGrid(const std::string& path, const std::string& name) {
+  initializeOpenVdb();
+  openvdb::GridBase::Ptr base;
+  bool found = false;
+  try {
+    openvdb::io::File file(path);
+    file.open(/*delayLoad=*/true);
+    found = file.hasGrid(name);
+    if (found) base = file.readGrid(name);
+    file.close();
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot be read: ") + e.what());
+  }
+  if (!found || !base) fail(path, "has no grid named '" + name + "'");
+  DenseGrid out;
+  out.name = name;
+  out.voxelSize = float(base->voxelSize()[0]);
+  const openvdb::Vec3d w0 = base->indexToWorld(openvdb::Vec3d(0.0));
+  out.worldOfVoxelZero = glm::vec3(float(w0[0]), float(w0[1]), float(w0[2]));
+  if (auto g = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) {
+    out.components = 1;
+    readDense(*g, out, path);
+  } else if (auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base)) {
+    out.components = 3;
+    readDense(*v, out, path);
+  } else {
+    fail(path, "grid '" + name + "' is of type " + base->type() + "; expected float or vec3s");
+  }
+  return out;
+}
+
+}  // namespace plume

@@ -1,0 +1,629 @@
+/// \file pressure.cpp
+/// MGPCG (McAdams, Sifakis & Teran 2010): conjugate gradients on the 7-point pressure operator,
+/// preconditioned by one symmetric multigrid V-cycle on a cell-centred hierarchy.
+///
+/// Storage: every vector of the hierarchy is padded by one ghost cell on each side. Ghost cells
+/// and solid cells hold 0 in every vector at all times and have diag = 0, so the inner loops need
+/// no bounds checks and no branch on the cell type: a neighbour that is solid or outside the
+/// domain contributes x_n = 0, and open sides are already counted in the diagonal.
+
+#include "solver/pressure.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "core/parallel.h"
+
+namespace plume {
+namespace {
+
+/// Jacobi damping ω. The smoother S = ω D⁻¹ is convergent in the A-norm (which makes the V-cycle
+/// SPD) iff 2 D/ω - A is SPD; Gershgorin gives λ_max(D⁻¹A) <= 2, so any ω < 1 is safe. 6/7, the
+/// optimal smoothing factor of the 3-D 7-point Laplacian, also measured best (vs 2/3 .. 0.9).
+constexpr float kOmega = 6.f / 7.f;
+// Pre- and post-smoothing sweeps are 2 each (equal counts keep the V-cycle symmetric): V(2,2)
+// needed the least time per solve (V(1,1): 1.6x the iterations; V(3,3): about even).
+constexpr int kMaxLevels = 16;
+/// Coarsening stops before the smallest axis drops below this many cells...
+constexpr int kMinCoarseCells = 4;
+/// ...unless the banded Cholesky factor of the coarsest level would cost more than this many
+/// flops (n w²), in which case coarsening continues (thin domains).
+constexpr double kMaxBandFlops = 1.6e7;
+/// Restarts of CG from the true residual (see solve()).
+constexpr int kMaxRestarts = 2;
+/// Rounding a float p changes A p by 2e-7 .. 3.4e-7 |p| (measured; ≈ √42 × the rms rounding
+/// error), so the true relative residual cannot go much below that times |p|/|b|.
+constexpr double kRoundOffFloor = 3e-7;
+
+/// Restriction weight. Level l's operator is the rediscretized stencil, i.e. H_l²·(-∇²) with
+/// H_l = 2^l Δx (our fine operator is Δx²·(-∇²)). For a smooth error e with -∇²e = f the fine
+/// residual is r_h ≈ h² f per cell, while the coarse equation A_H e_H = H² f = 4 h² f needs
+/// 4 × (average of the 8 children) = ½ × (sum of the children). With piecewise constant
+/// prolongation P this restriction is R = ½ Pᵀ, which keeps the V-cycle symmetric.
+constexpr float kRestrict = 0.5f;
+
+/// One level of the hierarchy (padded storage, see the file comment).
+struct Level {
+  glm::ivec3 n{0};
+  std::ptrdiff_t sy = 0, sz = 0;  ///< padded strides
+  std::vector<float> diag;        ///< fluid neighbours + air neighbours; 0 on solid and ghosts
+  std::vector<float> wInv;        ///< ω / diag on fluid cells, else 0
+  std::vector<float> b, x, t;     ///< rhs, solution, scratch (level 0: CG's r, z and q)
+  std::vector<float> rows;        ///< residual rows for the restriction, one per coarse slice
+
+  std::size_t at(int i, int j, int k) const {
+    return std::size_t((i + 1) + sy * (j + 1) + sz * (k + 1));
+  }
+  std::size_t padded() const { return std::size_t(n.x + 2) * (n.y + 2) * (n.z + 2); }
+};
+
+template <typename RowFn>
+void forRows(glm::ivec3 n, const RowFn& fn) {
+  parallelFor(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j) fn(j, k);
+  });
+}
+
+/// Σ a_i b_i (b = nullptr: Σ a_i): float products summed in double in four fixed lanes i mod 4
+/// (deterministic; vectorized).
+double dotRow(const float* a, const float* b, int n) {
+  double s[4] = {0, 0, 0, 0};
+  int i = 0;
+  if (b)
+    for (; i + 4 <= n; i += 4)
+      for (int l = 0; l < 4; ++l) s[l] += double(a[i + l] * b[i + l]);
+  else
+    for (; i + 4 <= n; i += 4)
+      for (int l = 0; l < 4; ++l) s[l] += a[i + l];
+  for (; i < n; ++i) s[0] += double(a[i]) * (b ? b[i] : 1.f);
+  return (s[0] + s[1]) + (s[2] + s[3]);
+}
+
+/// v where `mask` (diag or wInv: 0 exactly on solid cells) is nonzero, else 0. Bitwise, since
+/// GCC does not if-convert float compares (they may trap), which would keep loops scalar.
+inline float keepIf(float mask, float v) {
+  std::uint32_t vb, mb;
+  std::memcpy(&vb, &v, 4);
+  std::memcpy(&mb, &mask, 4);
+  vb &= 0u - std::uint32_t(mb != 0);
+  std::memcpy(&v, &vb, 4);
+  return v;
+}
+
+/// Sum of the 6 neighbours of every cell in a padded row.
+#define PLUME_NEIGHBOURS(v, i) (v[i - 1] + v[i + 1] + v[i - sy] + v[i + sy] + v[i - sz] + v[i + sz])
+
+/// The first two Jacobi sweeps from x = 0, fused: x1 = W b, x2 = (1-ω) x1 + W (b + N x1)
+/// = W ((2-ω) b + N (W b)), where N sums the neighbours.
+void smoothFromZero(Level& L) {
+  const std::ptrdiff_t sy = L.sy, sz = L.sz;
+  const int nx = L.n.x;
+  forRows(L.n, [&](int j, int k) {
+    const std::size_t o = L.at(0, j, k);
+    const float* __restrict b = L.b.data() + o;
+    const float* __restrict w = L.wInv.data() + o;
+    float* __restrict y = L.x.data() + o;
+    for (int i = 0; i < nx; ++i) {
+      const float s = w[i - 1] * b[i - 1] + w[i + 1] * b[i + 1] + w[i - sy] * b[i - sy] +
+                      w[i + sy] * b[i + sy] + w[i - sz] * b[i - sz] + w[i + sz] * b[i + sz];
+      y[i] = w[i] * ((2.f - kOmega) * b[i] + s);
+    }
+  });
+}
+
+/// One damped Jacobi sweep on a row, y = x + W (b - A x) = (1-ω) x + W (b + N x).
+void smoothRow(const Level& L, const float* __restrict x, float* __restrict y, std::size_t o) {
+  const std::ptrdiff_t sy = L.sy, sz = L.sz;
+  const float* __restrict b = L.b.data() + o;
+  const float* __restrict w = L.wInv.data() + o;
+  x += o;
+  y += o;
+  const int nx = L.n.x;
+  for (int i = 0; i < nx; ++i)
+    y[i] = (1.f - kOmega) * x[i] + w[i] * (b[i] + PLUME_NEIGHBOURS(x, i));
+}
+
+void smooth(Level& L) {
+  forRows(L.n, [&](int j, int k) { smoothRow(L, L.x.data(), L.t.data(), L.at(0, j, k)); });
+  std::swap(L.x, L.t);
+}
+
+/// s = b - A x on one row (0 on solid cells).
+void residualRow(const Level& L, std::size_t o, float* __restrict s) {
+  const std::ptrdiff_t sy = L.sy, sz = L.sz;
+  const float* __restrict x = L.x.data() + o;
+  const float* __restrict b = L.b.data() + o;
+  const float* __restrict d = L.diag.data() + o;
+  const int nx = L.n.x;
+  for (int i = 0; i < nx; ++i) s[i] = keepIf(d[i], b[i] - d[i] * x[i] + PLUME_NEIGHBOURS(x, i));
+}
+
+/// c_I += ½ (s_2I + s_2I+1): a residual row restricted along x.
+void restrictPairs(int n, const float* __restrict s, float* __restrict c) {
+  for (int ic = 0; ic < n; ++ic) c[ic] += kRestrict * (s[2 * ic] + s[2 * ic + 1]);
+}
+
+/// Coarse rhs = R (b - A x), R = ½ × sum of the children (see kRestrict).
+void restrictResidual(Level& F, Level& C) {
+  parallelFor(0, C.n.z, [&](int kc) {
+    float* s = F.rows.data() + std::size_t(kc) * (F.n.x + 2);
+    s[F.n.x] = 0.f;  // odd nx: the last coarse cell has one child along x
+    for (int jc = 0; jc < C.n.y; ++jc) std::fill_n(&C.b[C.at(0, jc, kc)], C.n.x, 0.f);
+    for (int k = 2 * kc; k < std::min(2 * kc + 2, F.n.z); ++k)
+      for (int j = 0; j < F.n.y; ++j) {
+        residualRow(F, F.at(0, j, k), s);
+        restrictPairs(C.n.x, s, &C.b[C.at(0, j >> 1, kc)]);
+      }
+  });
+}
+
+/// x_2I += e_I, x_2I+1 += e_I on fluid cells: a coarse row prolonged along x.
+void prolongPairs(int n, const float* __restrict e, const float* __restrict d,
+                  float* __restrict x) {
+  for (int ic = 0; ic < n / 2; ++ic) {
+    x[2 * ic] += keepIf(d[2 * ic], e[ic]);
+    x[2 * ic + 1] += keepIf(d[2 * ic + 1], e[ic]);
+  }
+  if (n & 1) x[n - 1] += keepIf(d[n - 1], e[n / 2]);
+}
+
+/// x += P e (piecewise constant), on fluid cells only.
+void prolongAdd(Level& F, const Level& C) {
+  forRows(F.n, [&](int j, int k) {
+    const std::size_t o = F.at(0, j, k);
+    prolongPairs(F.n.x, C.x.data() + C.at(0, j >> 1, k >> 1), F.diag.data() + o, F.x.data() + o);
+  });
+}
+
+/// Direct solve on the coarsest level: banded Cholesky of the fluid cells ordered with the
+/// longest axis slowest (bandwidth = product of the two shorter axes). A pivot that vanishes
+/// (the last cell of a component with no air, e.g. the all-closed singular case) is dropped,
+/// which pins that cell to 0: x = L⁺ᵀ L⁺ b stays symmetric positive semi-definite and solves
+/// A x = b for any consistent b.
+struct BandSolver {
+  int n = 0, w = 0;
+  std::vector<std::size_t> cells;  ///< padded index of each unknown
+  std::vector<double> l;           ///< row i holds L(i, i-w .. i)
+  std::vector<double> y;
+
+  double& at(int i, int j) { return l[std::size_t(i) * (w + 1) + (w - (i - j))]; }
+
+  static double cost(glm::ivec3 s) {
+    int a[3] = {s.x, s.y, s.z};
+    std::sort(a, a + 3);
+    const double bw = double(a[0]) * a[1];
+    return bw * bw * a[0] * a[1] * a[2];
+  }
+
+  void build(const Level& L) {
+    int ax[3] = {0, 1, 2};  // fastest, middle, slowest = the longest axis
+    std::sort(ax, ax + 3, [&](int a, int b) { return L.n[a] < L.n[b]; });
+    std::vector<int> number(L.padded(), -1);
+    cells.clear();
+    glm::ivec3 c;
+    for (c[ax[2]] = 0; c[ax[2]] < L.n[ax[2]]; ++c[ax[2]])
+      for (c[ax[1]] = 0; c[ax[1]] < L.n[ax[1]]; ++c[ax[1]])
+        for (c[ax[0]] = 0; c[ax[0]] < L.n[ax[0]]; ++c[ax[0]]) {
+          const std::size_t o = L.at(c.x, c.y, c.z);
+          if (L.diag[o] > 0.f) {
+            number[o] = int(cells.size());
+            cells.push_back(o);
+          }
+        }
+    n = int(cells.size());
+    const std::ptrdiff_t off[3] = {1, L.sy, L.sz};
+    w = 0;
+    for (int i = 0; i < n; ++i)
+      for (std::ptrdiff_t s : off)
+        if (number[cells[i] + s] >= 0) w = std::max(w, number[cells[i] + s] - i);
+    l.assign(std::size_t(n) * (w + 1), 0.0);
+    y.assign(std::size_t(n), 0.0);
+    for (int i = 0; i < n; ++i) {
+      at(i, i) = L.diag[cells[i]];
+      for (std::ptrdiff_t s : off)
+        if (number[cells[i] - s] >= 0) at(i, number[cells[i] - s]) = -1.0;
+    }
+    for (int i = 0; i < n; ++i) {
+      const int j0 = std::max(0, i - w);
+      for (int j = j0; j <= i; ++j) {
+        double s = at(i, j);
+        for (int k = j0; k < j; ++k) s -= at(i, k) * at(j, k);
+        if (j < i)
+          at(i, j) = at(j, j) > 0.0 ? s / at(j, j) : 0.0;
+        else
+          at(i, i) = s > 1e-10 * L.diag[cells[i]] ? std::sqrt(s) : 0.0;
+      }
+    }
+  }
+
+  void solve(Level& L) {
+    for (int i = 0; i < n; ++i) {
+      double s = L.b[cells[i]];
+      for (int k = std::max(0, i - w); k < i; ++k) s -= at(i, k) * y[k];
+      y[i] = at(i, i) > 0.0 ? s / at(i, i) : 0.0;
+    }
+    for (int i = n - 1; i >= 0; --i) {
+      double s = y[i];
+      for (int k = i + 1; k <= std::min(n - 1, i + w); ++k) s -= at(k, i) * y[k];
+      y[i] = at(i, i) > 0.0 ? s / at(i, i) : 0.0;
+    }
+    for (int i = 0; i < n; ++i) L.x[cells[i]] = float(y[i]);
+  }
+};
+
+}  // namespace
+
+struct PressureSolver::Impl {
+  glm::ivec3 size{0};
+  bool singular = false;  ///< no open side
+  double fluidCount = 0;
+  std::vector<Level> levels;
+  BandSolver band;
+  std::vector<float> d;         ///< CG search direction (padded)
+  std::vector<double> pd;       ///< CG's p in double (unpadded): p's rounding does not add up
+  std::vector<double> rowsD;    ///< one row of doubles per slice (true residual)
+  std::vector<float> zeroRow;   ///< stands in for rows outside the domain (unpadded kernels)
+  std::vector<double> partial;  ///< per-slice partial sums, 4 per slice
+
+  void put(int k, double a, double b = 0.0, double c = 0.0) {
+    partial[std::size_t(k) * 4] = a;
+    partial[std::size_t(k) * 4 + 1] = b;
+    partial[std::size_t(k) * 4 + 2] = c;
+  }
+  double sum(int comp) const {
+    double s = 0.0;
+    for (int k = 0; k < size.z; ++k) s += partial[std::size_t(k) * 4 + comp];
+    return s;
+  }
+  std::size_t urow(int j, int k) const {
+    return std::size_t(size.x) * (j + std::size_t(size.y) * k);
+  }
+
+  /// out = (A x) on one row of an unpadded grid x, in precision T. Neighbours are masked by the
+  /// padded diag (0 on solid cells and outside), so x may hold anything on solid cells.
+  template <typename T>
+  void applyRow(const float* x, int j, int k, T* out) const {
+    const Level& L = levels[0];
+    const int nx = size.x;
+    const std::ptrdiff_t sy = L.sy, sz = L.sz, uz = std::ptrdiff_t(nx) * size.y;
+    const float* xc = x + urow(j, k);
+    const float* xjm = j > 0 ? xc - nx : zeroRow.data();
+    const float* xjp = j + 1 < size.y ? xc + nx : zeroRow.data();
+    const float* xkm = k > 0 ? xc - uz : zeroRow.data();
+    const float* xkp = k + 1 < size.z ? xc + uz : zeroRow.data();
+    const float* d = L.diag.data() + L.at(0, j, k);
+    auto cell = [&](int i, float xm, float xp) {
+      auto sel = [](float m, float v) { return T(keepIf(m, v)); };
+      const T s = sel(d[i - 1], xm) + sel(d[i + 1], xp) + sel(d[i - sy], xjm[i]) +
+                  sel(d[i + sy], xjp[i]) + sel(d[i - sz], xkm[i]) + sel(d[i + sz], xkp[i]);
+      return (T(d[i]) * sel(d[i], xc[i]) - s) * sel(d[i], 1.f) + T(0);  // + 0: no -0 on solids
+    };
+    out[0] = cell(0, 0.f, nx > 1 ? xc[1] : 0.f);
+    for (int i = 1; i < nx - 1; ++i) out[i] = cell(i, xc[i - 1], xc[i + 1]);
+    if (nx > 1) out[nx - 1] = cell(nx - 1, xc[nx - 2], 0.f);
+  }
+
+  /// V-cycle for level l's b into its x. Level 0 skips its last post-smoothing sweep, which
+  /// precondition() fuses with the dot products.
+  void vcycle(std::size_t l) {
+    Level& L = levels[l];
+    if (l + 1 == levels.size()) return band.solve(L);
+    smoothFromZero(L);
+    restrictResidual(L, levels[l + 1]);
+    vcycle(l + 1);
+    prolongAdd(L, levels[l + 1]);
+    smooth(L);
+    if (l > 0) smooth(L);
+  }
+
+  /// z = M r (level 0's x = M b); returns ρ = r·z' where z' = z - mean(z) on the fluid cells in the
+  /// singular case (the projection itself is applied by updateDirection()).
+  double precondition(float& meanZ) {
+    Level& L0 = levels[0];
+    vcycle(0);  // (a single level is solved exactly: the sweep below leaves it unchanged)
+    const int nx = size.x;
+    parallelFor(0, size.z, [&](int k) {
+      double rz = 0.0, zs = 0.0, rs = 0.0;
+      for (int j = 0; j < size.y; ++j) {
+        const std::size_t o = L0.at(0, j, k);
+        smoothRow(L0, L0.x.data(), L0.t.data(), o);
+        const float* z = L0.t.data() + o;
+        rz += dotRow(L0.b.data() + o, z, nx);
+        if (singular) {
+          zs += dotRow(z, nullptr, nx);
+          rs += dotRow(L0.b.data() + o, nullptr, nx);
+        }
+      }
+      put(k, rz, zs, rs);
+    });
+    std::swap(L0.x, L0.t);
+    if (!singular) return sum(0);
+    const double mean = sum(1) / fluidCount;
+    meanZ = float(mean);
+    return sum(0) - mean * sum(2);
+  }
+
+  /// d = z' + β d.
+  void updateDirection(double beta, float meanZ) {
+    const Level& L0 = levels[0];
+    const float bt = float(beta);
+    const int nx = size.x;
+    forRows(size, [&](int j, int k) {
+      const std::size_t o = L0.at(0, j, k);
+      const float* __restrict z = L0.x.data() + o;
+      const float* __restrict dg = L0.diag.data() + o;
+      float* __restrict dd = d.data() + o;
+      if (singular)
+        for (int i = 0; i < nx; ++i) dd[i] = keepIf(dg[i], z[i] - meanZ) + bt * dd[i];
+      else
+        for (int i = 0; i < nx; ++i) dd[i] = z[i] + bt * dd[i];
+    });
+  }
+
+  /// Mean of an unpadded field over the fluid cells.
+  float fluidMean(const float* f) {
+    const Level& L0 = levels[0];
+    parallelFor(0, size.z, [&](int k) {
+      double s = 0.0;
+      for (int j = 0; j < size.y; ++j) {
+        const float* dg = L0.diag.data() + L0.at(0, j, k);
+        const float* fr = f + urow(j, k);
+        for (int i = 0; i < size.x; ++i) s += keepIf(dg[i], fr[i]);
+      }
+      put(k, s);
+    });
+    return fluidCount > 0 ? float(sum(0) / fluidCount) : 0.f;
+  }
+
+  /// p -= meanP on fluid cells and 0 on solid ones; then r = b' - A p evaluated in double (stored
+  /// as float in level 0's b). Returns |r|², with |b'|² and |p|². b' = b - meanB on fluid cells.
+  double residual(const float* b, float meanB, float* p, float meanP, double& bb, double& pp) {
+    Level& L0 = levels[0];
+    const int nx = size.x;
+    forRows(size, [&](int j, int k) {
+      const float* dg = L0.diag.data() + L0.at(0, j, k);
+      float* pr = p + urow(j, k);
+      for (int i = 0; i < nx; ++i) pr[i] = keepIf(dg[i], pr[i] - meanP);
+    });
+    parallelFor(0, size.z, [&](int k) {
+      double sb[2] = {0, 0}, sr[2] = {0, 0};
+      double* ap = rowsD.data() + std::size_t(k) * nx;
+      for (int j = 0; j < size.y; ++j) {
+        const float* br = b + urow(j, k);
+        const float* dg = L0.diag.data() + L0.at(0, j, k);
+        float* rp = L0.b.data() + L0.at(0, j, k);
+        applyRow<double>(p, j, k, ap);
+        for (int i = 0; i < nx; ++i) {  // two fixed lanes: deterministic and vectorizable
+          const double bi = keepIf(dg[i], br[i] - meanB);
+          const double ri = keepIf(dg[i], 1.f) * (bi - ap[i]);
+          rp[i] = float(ri);
+          sb[i & 1] += bi * bi;
+          sr[i & 1] += ri * ri;
+        }
+      }
+      put(k, sb[0] + sb[1], sr[0] + sr[1], dotRow(p + urow(0, k), p + urow(0, k), nx * size.y));
+    });
+    bb = sum(0);
+    pp = sum(2);
+    return sum(1);
+  }
+
+  /// Preconditioned CG from the residual r (level 0's b) until the recurrence |r|² <= target.
+  /// p is accumulated in double and rounded once at the end.
+  void conjugateGradients(float* p, double rr, double target, int maxIterations,
+                          PressureStats& stats) {
+    Level& L0 = levels[0];
+    const int nx = size.x;
+    const std::ptrdiff_t sy = L0.sy, sz = L0.sz;
+    const std::size_t slice = std::size_t(size.x) * size.y;
+    parallelFor(0, size.z,
+                [&](int k) { std::copy_n(p + slice * k, slice, pd.data() + slice * k); });
+    float meanZ = 0.f;
+    double rho = precondition(meanZ);
+    updateDirection(0.0, meanZ);
+    while (rr > target && stats.iterations < maxIterations) {
+      ++stats.iterations;
+      // q = A d (in level 0's scratch vector), d·q and Σq.
+      float* q = L0.t.data();
+      parallelFor(0, size.z, [&](int k) {
+        double dq = 0.0, qs = 0.0;
+        for (int j = 0; j < size.y; ++j) {
+          const std::size_t o = L0.at(0, j, k);
+          const float* __restrict dd = d.data() + o;
+          const float* __restrict dg = L0.diag.data() + o;
+          float* __restrict qq = q + o;
+          for (int i = 0; i < nx; ++i)
+            qq[i] = keepIf(dg[i], dg[i] * dd[i] - PLUME_NEIGHBOURS(dd, i));
+          dq += dotRow(dd, qq, nx);
+          if (singular) qs += dotRow(qq, nullptr, nx);
+        }
+        put(k, dq, qs);
+      });
+      const double dq = sum(0);
+      if (!(dq > 0.0) || !(rho > 0.0)) break;  // converged to round-off (or breakdown)
+      const double alpha = rho / dq;
+      const float alphaF = float(alpha);
+      // Singular case: Σ_fluid A d = 0 exactly, but not in float; projecting the mean out of q
+      // keeps r in the range of A (else its null-space part stalls CG at the round-off level).
+      const float meanQ = singular ? float(sum(1) / fluidCount) : 0.f;
+      // p += α d, r -= α q, |r|².
+      parallelFor(0, size.z, [&](int k) {
+        double s = 0.0;
+        for (int j = 0; j < size.y; ++j) {
+          const std::size_t o = L0.at(0, j, k);
+          const float* __restrict dd = d.data() + o;
+          const float* __restrict qq = q + o;
+          const float* __restrict dg = L0.diag.data() + o;
+          float* __restrict rp = L0.b.data() + o;
+          double* __restrict pp = pd.data() + urow(j, k);
+          for (int i = 0; i < nx; ++i) pp[i] += alpha * dd[i];
+          if (singular)
+            for (int i = 0; i < nx; ++i) rp[i] -= keepIf(dg[i], alphaF * (qq[i] - meanQ));
+          else
+            for (int i = 0; i < nx; ++i) rp[i] -= alphaF * qq[i];
+          s += dotRow(rp, rp, nx);
+        }
+        put(k, s);
+      });
+      rr = sum(0);
+      if (rr <= target) break;
+      const double rhoNew = precondition(meanZ);
+      updateDirection(rhoNew / rho, meanZ);
+      rho = rhoNew;
+    }
+    parallelFor(0, size.z, [&](int k) {
+      for (std::size_t c = slice * k; c < slice * (k + 1); ++c) p[c] = float(pd[c]);
+    });
+  }
+};
+
+PressureSolver::PressureSolver() : mImpl(std::make_unique<Impl>()) {}
+PressureSolver::~PressureSolver() = default;
+
+void PressureSolver::setup(const FlagGrid& cellTypes, const std::array<Boundary, 6>& boundaries) {
+  Impl& m = *mImpl;
+  const glm::ivec3 n0 = cellTypes.size();
+  if (n0.x < 1 || n0.y < 1 || n0.z < 1)
+    throw std::invalid_argument("pressure solver: cell types grid must have at least 1 cell");
+  if (m.size != n0) m.d.clear();  // its ghost cells must be 0
+  m.size = n0;
+  m.singular = std::none_of(boundaries.begin(), boundaries.end(),
+                            [](Boundary b) { return b == Boundary::Open; });
+
+  // Level sizes: ceil(n/2) per axis. After 15 halvings the coarsest level is tiny for any grid
+  // that fits in memory, so its factorization is always affordable.
+  std::vector<glm::ivec3> sizes{n0};
+  while (int(sizes.size()) < kMaxLevels) {
+    const glm::ivec3 s = sizes.back();
+    const glm::ivec3 c = (s + 1) / 2;
+    if (c == s) break;  // 1 x 1 x 1
+    const int lo = std::min(c.x, std::min(c.y, c.z));
+    if (lo < kMinCoarseCells && BandSolver::cost(s) <= kMaxBandFlops) break;
+    sizes.push_back(c);
+  }
+  // Buffers keep their storage when the sizes do not change (moving obstacles); ghost cells
+  // are never written, so they stay 0.
+  m.levels.resize(sizes.size());
+  auto fit = [](auto& v, std::size_t count) {
+    if (v.size() != count) v.assign(count, 0);
+  };
+  for (std::size_t l = 0; l < sizes.size(); ++l) {
+    Level& L = m.levels[l];
+    if (L.n != sizes[l]) L = Level{};
+    L.n = sizes[l];
+    L.sy = L.n.x + 2;
+    L.sz = std::ptrdiff_t(L.n.x + 2) * (L.n.y + 2);
+    for (auto* v : {&L.diag, &L.wInv, &L.b, &L.x, &L.t}) fit(*v, L.padded());
+    if (l + 1 < sizes.size()) fit(L.rows, std::size_t(sizes[l + 1].z) * (L.n.x + 2));
+  }
+  fit(m.d, m.levels[0].padded());
+  fit(m.pd, cellTypes.count());
+  fit(m.rowsD, std::size_t(n0.x) * n0.z);
+  fit(m.zeroRow, std::size_t(n0.x));
+  m.partial.assign(std::size_t(n0.z) * 4, 0.0);
+
+  // Level 0's fluid mask (1/0, in diag for now); then per level: the count of fluid and air
+  // neighbours (in wInv), diag = that count on fluid cells, wInv = ω / diag, and the next
+  // level's mask: a coarse cell is fluid if any of its children is.
+  forRows(n0, [&](int j, int k) {
+    const std::uint8_t* t = &cellTypes(0, j, k);
+    float* f = m.levels[0].diag.data() + m.levels[0].at(0, j, k);
+    for (int i = 0; i < n0.x; ++i) f[i] = t[i] == kFluid ? 1.f : 0.f;
+  });
+  auto open = [&](int side) { return boundaries[side] == Boundary::Open ? 1.f : 0.f; };
+  for (std::size_t l = 0; l < sizes.size(); ++l) {
+    Level& L = m.levels[l];
+    const std::ptrdiff_t sy = L.sy, sz = L.sz;
+    const int nx = L.n.x;
+    forRows(L.n, [&](int j, int k) {
+      const std::size_t o = L.at(0, j, k);
+      const float* __restrict f = L.diag.data() + o;
+      float* __restrict c = L.wInv.data() + o;
+      const float air = (j == 0 ? open(kNegY) : 0.f) + (j + 1 == L.n.y ? open(kPosY) : 0.f) +
+                        (k == 0 ? open(kNegZ) : 0.f) + (k + 1 == L.n.z ? open(kPosZ) : 0.f);
+      for (int i = 0; i < nx; ++i) c[i] = PLUME_NEIGHBOURS(f, i) + air;
+      c[0] += open(kNegX);
+      c[nx - 1] += open(kPosX);
+    });
+    // A fluid cell with neither fluid nor air neighbours is decoupled: treated as solid.
+    forRows(L.n, [&](int j, int k) {
+      float* __restrict f = L.diag.data() + L.at(0, j, k);
+      float* __restrict c = L.wInv.data() + L.at(0, j, k);
+      for (int i = 0; i < nx; ++i) {
+        f[i] = keepIf(f[i], c[i]);
+        c[i] = keepIf(f[i], kOmega / f[i]);
+      }
+    });
+    if (l + 1 == sizes.size()) break;
+    Level& C = m.levels[l + 1];
+    forRows(C.n, [&](int jc, int kc) {
+      float* mask = C.diag.data() + C.at(0, jc, kc);
+      std::fill_n(mask, C.n.x, 0.f);
+      for (int k = 2 * kc; k < std::min(2 * kc + 2, L.n.z); ++k)
+        for (int j = 2 * jc; j < std::min(2 * jc + 2, L.n.y); ++j) {
+          const float* f = L.diag.data() + L.at(0, j, k);
+          for (int i = 0; i < nx; ++i)
+            if (f[i] > 0.f) mask[i >> 1] = 1.f;
+        }
+    });
+  }
+  const auto& diag0 = m.levels[0].diag;
+  m.fluidCount = double(std::count_if(diag0.begin(), diag0.end(), [](float v) { return v > 0.f; }));
+  m.band.build(m.levels.back());
+}
+
+void PressureSolver::applyOperator(const ScalarGrid& x, ScalarGrid& y) const {
+  const Impl& m = *mImpl;
+  if (m.levels.empty())
+    throw std::invalid_argument("pressure solver: setup() must be called first");
+  if (x.size() != m.size) throw std::invalid_argument("pressure solver: x size must match setup()");
+  if (y.size() != m.size) y.resize(m.size);
+  forRows(m.size, [&](int j, int k) { m.applyRow<float>(x.data(), j, k, &y(0, j, k)); });
+}
+
+PressureStats PressureSolver::solve(const ScalarGrid& rhs, ScalarGrid& pressure, float tolerance,
+                                    int maxIterations) {
+  Impl& m = *mImpl;
+  if (m.levels.empty())
+    throw std::invalid_argument("pressure solver: setup() must be called first");
+  if (rhs.size() != m.size || pressure.size() != m.size) {
+    std::ostringstream s;
+    s << "pressure solver: rhs and pressure must be " << m.size.x << "x" << m.size.y << "x"
+      << m.size.z << " like the cell types given to setup()";
+    throw std::invalid_argument(s.str());
+  }
+  float* p = pressure.data();
+  const float* b = rhs.data();
+  // Singular case: b is projected onto the range of A, i.e. made mean-free over the fluid
+  // cells. This assumes the fluid cells form one connected component, so that the null space
+  // of A is the constant on the fluid cells; p is returned mean-free too.
+  const float meanB = m.singular ? m.fluidMean(b) : 0.f;
+  PressureStats stats;
+  double last = 0.0;
+  for (int restart = 0;; ++restart) {
+    double bb = 0.0, pp = 0.0;
+    const double rr = m.residual(b, meanB, p, m.singular ? m.fluidMean(p) : 0.f, bb, pp);
+    if (bb == 0.0) {
+      pressure.fill(0.f);
+      return PressureStats{};
+    }
+    const double rel = std::sqrt(rr / bb);
+    stats.relativeResidual = float(rel);
+    // CG stops on its recurrence residual, which drifts from the true one by round-off.
+    // Restart from the true residual while that gains, but not below the round-off floor of a
+    // float p (kRoundOffFloor |p|/|b|), which no float p can beat by much.
+    if (rel <= tolerance || stats.iterations >= maxIterations) break;
+    if (restart > 0 &&
+        (restart > kMaxRestarts || rel <= kRoundOffFloor * std::sqrt(pp / bb) || rel > 0.5 * last))
+      break;
+    last = rel;
+    m.conjugateGradients(p, rr, double(tolerance) * tolerance * bb, maxIterations, stats);
+  }
+  return stats;
+}
+
+}  // namespace plume
