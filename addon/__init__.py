@@ -1,0 +1,55 @@
+"""Plume: small-scale smoke and fire for Blender, backed by the native module ``_native``.
+
+Installed as the package ``plume`` with ``_native.cpython-311-x86_64-linux-gnu.so`` beside this
+file. Only relative imports, so it also loads as a Blender 4.2+ extension (``bl_ext.*.plume``)."""
+
+import sys
+
+bl_info = {
+    "name": "Plume",
+    "author": "Plume developers",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "Properties > Physics",
+    "description": "Smoke and fire simulation with streak surfaces, toon smoke, graph fire "
+                   "and structural flames",
+    "category": "Physics",
+}
+
+if sys.version_info[:2] != (3, 11):
+    raise ImportError(
+        "Plume: the native module is built for Python 3.11, but this Blender runs Python "
+        f"{sys.version_info[0]}.{sys.version_info[1]}; use Blender 3.4-4.x with Python 3.11 "
+        "or rebuild the module against this Python")
+
+try:
+    from . import _native  # noqa: F401  (fail here, with a clear message)
+except ImportError as e:
+    import glob
+    import os
+    _here = os.path.dirname(os.path.abspath(__file__))
+    _why = (f"cannot be loaded ({e})" if glob.glob(os.path.join(_here, "_native*.so"))
+            else f"is missing (no _native*.so in {_here})")
+    raise ImportError(
+        f"Plume: the native module _native {_why}. Build it with: cmake -S . -B build "
+        "-DPython_EXECUTABLE=/usr/bin/python3 && cmake --build build -j2 --target _native, then "
+        "copy build/native/_native*.so next to the add-on's __init__.py (the README's install "
+        "command does both)") from e
+
+import bpy  # noqa: E402  (after the checks above)
+
+from . import operators, properties, ui  # noqa: E402
+
+_classes = operators.classes + ui.classes
+
+
+def register():
+    properties.register()
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)
+    properties.unregister()

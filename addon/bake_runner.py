@@ -1,0 +1,265 @@
+"""The smoke bake loop, no ``bpy``: validation, cache folder, manifest, resume, progress, cancel.
+
+    runner = BakeRunner(snapshot, _native, progress=callback)
+    runner.prepare()   # raises BakeError on bad input; writes nothing, changes nothing
+    result = runner.run()   # blocking; may run on a worker thread (the native loop drops the GIL)
+
+VDB of frame f = state after advancing (f - frame_start + 1) frames from an empty domain.
+"""
+
+import json
+import math
+import os
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import List, Optional
+
+from . import cache
+from .settings import (BakeError, to_native_params, to_native_source, validate_python_side,
+                       validate_source)
+
+
+@dataclass
+class BakeProgress:
+    """What a progress callback receives after each frame."""
+
+    frame: int
+    frames_done: int  # frames of the range available (including resumed ones)
+    frames_total: int
+    seconds_elapsed: float
+    seconds_left: float
+
+
+@dataclass
+class BakeResult:
+    frame_start: int
+    last_complete_frame: int  # frame_start - 1 when nothing is available
+    computed_frames: List[int] = field(default_factory=list)
+    resumed_from: Optional[int] = None  # first frame computed when a bake was resumed
+    cancelled: bool = False
+    seconds: float = 0.0
+
+    @property
+    def frames_done(self):
+        return self.last_complete_frame - self.frame_start + 1
+
+
+def _normalized(data):
+    """JSON round trip, so tuples/lists and ints/floats compare as they are stored."""
+    return json.loads(json.dumps(data, sort_keys=True))
+
+
+class BakeRunner:
+    """One bake of one domain from a BakeSnapshot."""
+
+    def __init__(self, snapshot, native, progress=None):
+        self.snapshot = snapshot
+        self._native = native
+        self.progress = progress
+        self._solver = None
+        self._cancel = threading.Event()
+        self._mode = None  # 'fresh', 'resume' or 'complete'
+        self._resume_last = None
+        self._manifest = None
+        self._emitter_index = None  # frame index whose emitters are loaded in the solver
+
+    # ---------------------------------------------------------------- validation
+    def prepare(self):
+        """Checks everything that can be wrong with the input, in the order of ADDON.md, and
+        decides between a fresh bake and a resume. Raises BakeError; nothing is written."""
+        snap = self.snapshot
+        validate_python_side(snap.domain_name, snap.resolution, snap.frame_start,
+                             snap.frame_end, snap.solver)
+        try:
+            params = to_native_params(snap.solver, self._native)
+        except ValueError as e:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
+        for emitter in snap.emitters:
+            if emitter.role == "SOURCE":
+                validate_source(emitter)
+        try:
+            self._solver = self._native.SmokeSolver(params)
+        except ValueError as e:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
+        except MemoryError:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': resolution "
+                            f"{tuple(snap.solver.resolution)} does not fit in memory") from None
+        # Voxelize every emitter of the first frame now, so a bad obstacle is reported before
+        # any file is written.
+        self._load_emitters(0)
+        error = cache.check_writable(snap.cache_folder)
+        if error is not None:
+            raise BakeError(f"Plume: cache_directory '{snap.cache_directory}' is not writable "
+                            f"({snap.cache_folder}: {error})")
+        self._plan()
+
+    def _load_emitters(self, index):
+        """Voxelizes the emitters for frame frame_start + index (matrices at index, index+1)."""
+        if self._emitter_index is not None and (
+                self._emitter_index == index or not any(e.animated for e in self.snapshot.emitters)):
+            return
+        solver, native = self._solver, self._native
+        solver.clear_emitters()
+        for e in self.snapshot.emitters:
+            m0, m1 = e.matrix_at(index), e.matrix_at(index + 1)
+            try:
+                if e.role == "SOURCE":
+                    solver.add_source(e.vertices, e.triangles, m0, m1,
+                                      to_native_source(e.source, native), name=e.name)
+                else:
+                    slip = getattr(native.Slip, e.slip)
+                    solver.add_obstacle(e.vertices, e.triangles, m0, m1, slip, name=e.name)
+            except ValueError as err:
+                text = str(err)
+                if e.name not in text:
+                    text = f"{e.role.lower()} '{e.name}': {text}"
+                raise BakeError(f"Plume: {text}") from None
+        self._emitter_index = index
+
+    def _plan(self):
+        """Fresh bake, resume from the checkpoint, or nothing to compute (already complete)."""
+        snap = self.snapshot
+        self._mode = "fresh"
+        m = cache.read_manifest(snap.cache_folder)
+        if m is None or m.get("frame_start") != snap.frame_start:
+            return
+        if m.get("addon_version") != snap.addon_version:
+            return  # another solver version may not continue this state bit for bit
+        if m.get("settings") != _normalized(snap.settings_dict()):
+            return
+        last = m.get("last_complete_frame")
+        if not isinstance(last, int) or last < snap.frame_start:
+            return
+        upto = min(last, snap.frame_end)
+        inputs = m.get("frame_inputs", [])
+        expected = [snap.frame_input_hash(f) for f in range(snap.frame_start, upto + 1)]
+        if inputs[:len(expected)] != expected:
+            return  # emitters moved differently: the stored frames are stale
+        present = set(cache.volume_frames(snap.cache_folder))
+        if any(f not in present for f in range(snap.frame_start, upto + 1)):
+            return
+        self._manifest = m
+        if last >= snap.frame_end:
+            self._mode = "complete"
+        elif m.get("state_frame") == last and os.path.isfile(cache.state_path(snap.cache_folder)):
+            self._mode = "resume"
+            self._resume_last = last
+
+    # ---------------------------------------------------------------- the loop
+    def cancel(self):
+        """Thread-safe: the running frame stops within one step; completed frames stay."""
+        self._cancel.set()
+        if self._solver is not None:
+            self._solver.cancel()
+
+    @property
+    def cancelled(self):
+        return self._cancel.is_set()
+
+    def run(self):
+        if self._mode is None:
+            self.prepare()
+        snap = self.snapshot
+        folder = snap.cache_folder
+        t0 = time.perf_counter()
+        result = BakeResult(frame_start=snap.frame_start, last_complete_frame=snap.frame_start - 1)
+
+        if self._mode == "complete":
+            cache.delete_plume_files(folder, frames_above=snap.frame_end)
+            m = self._manifest
+            m["frame_end"] = snap.frame_end
+            m["last_complete_frame"] = snap.frame_end
+            m["frame_inputs"] = m.get("frame_inputs", [])[:snap.frame_count]
+            m["last_run"] = {"resumed": True, "computed_frames": [], "cancelled": False}
+            cache.write_manifest(folder, m)
+            result.last_complete_frame = snap.frame_end
+            return result
+
+        first = snap.frame_start
+        manifest = self._new_manifest()
+        if self._mode == "resume":
+            try:
+                self._solver.load_state(cache.state_path(folder))
+            except RuntimeError:
+                self._mode = "fresh"  # corrupt checkpoint: load_state left the solver untouched
+        if self._mode == "resume":
+            first = self._resume_last + 1
+            result.resumed_from = first
+            result.last_complete_frame = self._resume_last
+            manifest.update(last_complete_frame=self._resume_last, state_frame=self._resume_last,
+                            frame_inputs=self._manifest.get("frame_inputs", [])[
+                                :self._resume_last - snap.frame_start + 1],
+                            frames_computed_total=self._manifest.get("frames_computed_total", 0))
+        else:
+            cache.delete_plume_files(folder)
+            cache.check_writable(folder)  # recreates the folder
+        manifest["last_run"] = {"resumed": self._mode == "resume", "computed_frames": [],
+                                "cancelled": False}
+        cache.write_manifest(folder, manifest)
+
+        try:
+            for frame in range(first, snap.frame_end + 1):
+                if self._cancel.is_set():
+                    result.cancelled = True
+                    break
+                self._load_emitters(frame - snap.frame_start)
+                if not self._solver.advance_frame():
+                    result.cancelled = True
+                    break
+                self._solver.write_vdb(cache.volume_path(folder, frame))
+                self._solver.save_state(cache.state_path(folder))
+                result.last_complete_frame = frame
+                result.computed_frames.append(frame)
+                manifest["last_complete_frame"] = frame
+                manifest["state_frame"] = frame
+                manifest["frame_inputs"].append(snap.frame_input_hash(frame))
+                manifest["frames_computed_total"] += 1
+                manifest["last_run"]["computed_frames"].append(frame)
+                cache.write_manifest(folder, manifest)
+                self._report(result, t0)
+        finally:
+            manifest["last_run"]["cancelled"] = result.cancelled
+            manifest["last_run"]["seconds"] = time.perf_counter() - t0
+            try:
+                cache.write_manifest(folder, manifest)
+            except OSError:
+                pass
+        result.seconds = time.perf_counter() - t0
+        return result
+
+    def _new_manifest(self):
+        snap = self.snapshot
+        s = snap.solver
+        return {
+            "format_version": cache.FORMAT_VERSION,
+            "addon_version": snap.addon_version,
+            "kind": cache.KIND,
+            "domain": snap.domain_name,
+            "settings": _normalized(snap.settings_dict()),
+            "frame_start": snap.frame_start,
+            "frame_end": snap.frame_end,
+            "resolution": list(s.resolution),
+            "cell_size": s.cell_size,
+            "origin": list(s.origin),
+            "combustion": s.combustion,
+            "last_complete_frame": snap.frame_start - 1,
+            "state_frame": None,
+            "frame_inputs": [],
+            "frames_computed_total": 0,
+        }
+
+    def _report(self, result, t0):
+        if self.progress is None:
+            return
+        snap = self.snapshot
+        elapsed = time.perf_counter() - t0
+        computed = len(result.computed_frames)
+        left_frames = snap.frame_end - result.last_complete_frame
+        per_frame = elapsed / computed if computed else 0.0
+        self.progress(BakeProgress(
+            frame=result.last_complete_frame,
+            frames_done=result.frames_done,
+            frames_total=snap.frame_count,
+            seconds_elapsed=elapsed,
+            seconds_left=per_frame * left_frames if math.isfinite(per_frame) else 0.0))

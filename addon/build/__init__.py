@@ -1,0 +1,1 @@
+"""Cache -> Blender data builders (bpy side)."""

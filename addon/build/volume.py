@@ -1,0 +1,121 @@
+"""Cache -> Blender data: the Volume object playing a domain's VDB sequence, and its material.
+Renders without the add-on (Blender reads the VDB files itself)."""
+
+import bpy
+
+from .. import cache
+
+SMOKE_MATERIAL = "Plume Smoke"
+FIRE_MATERIAL = "Plume Fire"
+#: Principled Volume density multiplier of the smoke material (the solver's ρ is ~1 in sources).
+SMOKE_DENSITY = 5.0
+
+
+def volume_name(domain):
+    return f"{domain.name}_smoke"
+
+
+def _file_path(path):
+    """'//'-relative when the .blend is saved (render farms see the same path), else absolute."""
+    if bpy.data.is_saved:
+        try:
+            return bpy.path.relpath(path)
+        except ValueError:  # another drive
+            return path
+    return path
+
+
+def _setup_material(mat, combustion, max_temperature):
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    out.location = (300, 0)
+    pv = nt.nodes.new("ShaderNodeVolumePrincipled")
+    pv.location = (0, 0)
+    pv.inputs["Density"].default_value = SMOKE_DENSITY
+    pv.inputs["Density Attribute"].default_value = "density"
+    pv.inputs["Temperature Attribute"].default_value = "temperature"
+    pv.inputs["Color"].default_value = (0.6, 0.6, 0.6, 1.0)
+    if combustion:
+        # Cycles multiplies the Temperature input by the attribute: map T_max to ~1800 K.
+        pv.inputs["Blackbody Intensity"].default_value = 1.0
+        pv.inputs["Temperature"].default_value = 1800.0 / max(max_temperature, 1e-3)
+        attr = nt.nodes.new("ShaderNodeAttribute")
+        attr.location = (-250, -200)
+        attr.attribute_name = "flame"
+        nt.links.new(attr.outputs["Fac"], pv.inputs["Emission Strength"])
+        pv.inputs["Emission Color"].default_value = (1.0, 0.45, 0.1, 1.0)
+    else:
+        pv.inputs["Blackbody Intensity"].default_value = 0.0
+    nt.links.new(pv.outputs["Volume"], out.inputs["Volume"])
+
+
+def material(combustion, max_temperature=4.0):
+    """The shared smoke (or fire) material; created once, then left to the artist."""
+    name = FIRE_MATERIAL if combustion else SMOKE_MATERIAL
+    mat = bpy.data.materials.get(name)
+    if mat is None:
+        mat = bpy.data.materials.new(name)
+        _setup_material(mat, combustion, max_temperature)
+    return mat
+
+
+def find_volume_object(domain):
+    """The domain's Volume object, by the stored name, else by the default name."""
+    for name in (domain.plume.domain.volume_object, volume_name(domain)):
+        ob = bpy.data.objects.get(name) if name else None
+        if ob is not None and ob.type == 'VOLUME':
+            return ob
+    return None
+
+
+def build_volume(domain, folder, frame_start, frames_done, combustion=False, max_temperature=4.0):
+    """Creates or updates the Volume object of a baked domain. Returns it (None if no frame)."""
+    if frames_done < 1:
+        remove_volume(domain)  # nothing baked (e.g. cancelled in frame 1): old frames are gone
+        return None
+    ob = find_volume_object(domain)
+    path = _file_path(cache.volume_path(folder, frame_start))
+    if ob is None:
+        vol = bpy.data.volumes.new(volume_name(domain))
+        ob = bpy.data.objects.new(volume_name(domain), vol)
+        for coll in domain.users_collection:
+            coll.objects.link(ob)
+        if not ob.users_collection:
+            bpy.context.scene.collection.objects.link(ob)
+    vol = ob.data
+    vol.grids.unload()  # a re-bake rewrote the files: do not keep the old grids in memory
+    vol.filepath = path
+    vol.is_sequence = True
+    vol.frame_start = frame_start
+    vol.frame_duration = frames_done
+    vol.frame_offset = 0
+    vol.sequence_mode = 'CLIP'
+    vol.velocity_unit = 'SECOND'  # the "velocity" grid (default name) is in m/s
+    ob.matrix_world.identity()  # the VDB voxels are in world space
+    mat = material(combustion, max_temperature)
+    if not vol.materials:
+        vol.materials.append(mat)
+    elif vol.materials[0] is None or vol.materials[0].name in (SMOKE_MATERIAL, FIRE_MATERIAL):
+        vol.materials[0] = mat
+    domain.plume.domain.volume_object = ob.name
+    domain.plume.domain.frames_baked = frames_done
+    domain.display_type = 'WIRE'
+    domain.hide_render = True
+    return ob
+
+
+def remove_volume(domain):
+    """Deletes the domain's Volume object and datablock; shows the domain again."""
+    ob = find_volume_object(domain)
+    if ob is not None:
+        vol = ob.data
+        bpy.data.objects.remove(ob, do_unlink=True)
+        if vol is not None and vol.users == 0:
+            bpy.data.volumes.remove(vol)
+    domain.plume.domain.volume_object = ""
+    domain.plume.domain.frames_baked = 0
+    domain.display_type = 'TEXTURED'
+    domain.hide_render = False
+

@@ -1,0 +1,133 @@
+"""Cache folder layout of a smoke bake (DESIGN.md "Cache folder"), no ``bpy``:
+
+    <cache_directory>/<domain name>/manifest.json
+                                    volume_<frame:04d>.vdb
+                                    state.bin            (checkpoint of the last complete frame)
+"""
+
+import json
+import os
+import re
+import uuid
+
+MANIFEST_NAME = "manifest.json"
+STATE_NAME = "state.bin"
+FORMAT_VERSION = 1
+KIND = "smoke"
+
+_VOLUME_RE = re.compile(r"^volume_(-?\d+)\.vdb$")
+
+
+def folder_name(domain_name):
+    """A domain's sub-folder name: the object name with path separators replaced."""
+    name = domain_name.replace("/", "_").replace("\\", "_").replace("\0", "_")
+    return "_" + name if name in (".", "..", "") else name
+
+
+def cache_folder(base_directory, domain_name):
+    return os.path.join(os.path.abspath(base_directory), folder_name(domain_name))
+
+
+def volume_path(folder, frame):
+    return os.path.join(folder, f"volume_{frame:04d}.vdb")
+
+
+def manifest_path(folder):
+    return os.path.join(folder, MANIFEST_NAME)
+
+
+def state_path(folder):
+    return os.path.join(folder, STATE_NAME)
+
+
+def read_manifest(folder):
+    """The manifest as a dict, or None when missing or unreadable (then the bake starts over)."""
+    try:
+        with open(manifest_path(folder), "r", encoding="utf-8") as f:
+            data = json.load(f)
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("format_version") != FORMAT_VERSION:
+        return None
+    if data.get("kind") != KIND:
+        return None
+    return data
+
+
+def write_manifest(folder, data):
+    """Atomic write: temporary name in the same folder, then os.replace."""
+    path = manifest_path(folder)
+    tmp = f"{path}.{uuid.uuid4().hex[:8]}.tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        json.dump(data, f, indent=1, sort_keys=True)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def volume_frames(folder):
+    """Frame numbers of the volume_*.vdb files present, sorted."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    frames = []
+    for name in names:
+        m = _VOLUME_RE.match(name)
+        if m:
+            frames.append(int(m.group(1)))
+    return sorted(frames)
+
+
+def plume_files(folder):
+    """Files of the folder that a bake owns: manifest.json, volume_*.vdb, state.bin, *.tmp."""
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return []
+    own = []
+    for name in names:
+        path = os.path.join(folder, name)
+        if not os.path.isfile(path):
+            continue
+        if (name in (MANIFEST_NAME, STATE_NAME) or _VOLUME_RE.match(name)
+                or name.endswith(".tmp")):
+            own.append(path)
+    return own
+
+
+def delete_plume_files(folder, frames_above=None):
+    """Deletes the bake's files (or only volume frames > frames_above); removes the folder when it
+    ends up empty. Never touches files it does not own. Returns the number of files deleted."""
+    count = 0
+    for path in plume_files(folder):
+        if frames_above is not None:
+            m = _VOLUME_RE.match(os.path.basename(path))
+            if not m or int(m.group(1)) <= frames_above:
+                continue
+        try:
+            os.remove(path)
+            count += 1
+        except FileNotFoundError:
+            pass
+    if frames_above is None:
+        try:
+            os.rmdir(folder)
+        except OSError:
+            pass  # not empty (artist files) or already gone
+    return count
+
+
+def check_writable(folder):
+    """Creates `folder` if needed and writes/deletes a probe file. Returns None when writable,
+    else the OS error text. Only creates directories when the whole path can be made."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+        probe = os.path.join(folder, f".plume_probe_{uuid.uuid4().hex[:8]}.tmp")
+        with open(probe, "wb") as f:
+            f.write(b"plume")
+        os.remove(probe)
+    except OSError as e:
+        return e.strerror or str(e)
+    return None
+

@@ -1,0 +1,43 @@
+"""plume.role_set: make the active object (and the other selected meshes) a domain, source,
+obstacle or flame source."""
+
+import bpy
+from bpy.props import EnumProperty
+
+from ..properties import ROLE_ITEMS
+
+
+class PLUME_OT_role_set(bpy.types.Operator):
+    """Set the Plume role of the active object (and of the other selected meshes, except for
+    Domain, which applies to the active object only)"""
+
+    bl_idname = "plume.role_set"
+    bl_label = "Set Plume Role"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    role: EnumProperty(name="Role", items=ROLE_ITEMS, default='DOMAIN')
+
+    def execute(self, context):
+        active = context.active_object
+        if active is None:
+            self.report({'ERROR'}, "Plume: no active object to set the role of")
+            return {'CANCELLED'}
+        targets = [active]
+        if self.role != 'DOMAIN':
+            targets += [o for o in context.selected_objects
+                        if o is not active and o.type == 'MESH']
+        if self.role != 'NONE' and active.type != 'MESH':
+            self.report({'ERROR'}, f"Plume: '{active.name}' is a {active.type.lower()}; "
+                                   f"the {self.role.lower()} role needs a mesh object")
+            return {'CANCELLED'}
+        for ob in targets:
+            previous = ob.plume.role
+            ob.plume.role = self.role
+            if previous == 'DOMAIN' and self.role != 'DOMAIN':
+                # Leaving the domain role: show the object again like before baking.
+                ob.display_type = 'TEXTURED'
+                ob.hide_render = False
+        return {'FINISHED'}
+
+
+classes = (PLUME_OT_role_set,)

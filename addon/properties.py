@@ -1,0 +1,178 @@
+"""Object properties: ``obj.plume`` with ``role``, ``domain``, ``source`` and ``obstacle``.
+
+Numbers carry soft limits only: a script may set any value, and the bake validates it with a
+message naming the setting (ADDON.md) instead of Blender clamping it silently."""
+
+import bpy
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
+                       IntProperty, PointerProperty, StringProperty)
+
+ROLE_ITEMS = (
+    ('NONE', "None", "Not part of a Plume simulation", 'X', 0),
+    ('DOMAIN', "Domain", "Box holding the smoke simulation grid", 'MESH_CUBE', 1),
+    ('SOURCE', "Source", "Emits smoke (density, heat, fuel) into the domain", 'OUTLINER_OB_FORCE_FIELD', 2),
+    ('OBSTACLE', "Obstacle", "Closed mesh the smoke flows around", 'MOD_PHYSICS', 3),
+    ('FLAME_SOURCE', "Flame Source", "Emits structural flames (flames_bake)", 'LIGHT_SUN', 4),
+)
+
+BOUNDARY_ITEMS = (
+    ('OPEN', "Open", "Air: smoke and air flow out freely (p = 0)"),
+    ('CLOSED', "Closed", "Wall: no flow through this side"),
+)
+
+
+def _boundary(side, default='OPEN'):
+    return EnumProperty(name=side, items=BOUNDARY_ITEMS, default=default,
+                        description=f"Boundary condition of the domain's {side} side")
+
+
+class PlumeDomainSettings(bpy.types.PropertyGroup):
+    # --- Settings ---
+    resolution: IntProperty(
+        name="Resolution", default=32, soft_min=8, soft_max=512,
+        description="Cells along the longest axis of the domain (Δx = longest side / resolution); "
+                    "validated at bake time to [2, 1024]")
+    frame_start: IntProperty(name="Start", default=1, description="First frame of the bake")
+    frame_end: IntProperty(name="End", default=50, description="Last frame of the bake")
+    time_scale: FloatProperty(
+        name="Time Scale", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="Simulated seconds per real second: Δt_frame = time scale / scene fps")
+    substeps: IntProperty(name="Substeps", default=1, soft_min=1, soft_max=20,
+                          description="Minimum fractional steps (Stam 1999) per frame")
+    use_cfl: BoolProperty(name="Adaptive Steps", default=True,
+                          description="Add steps so that no cell moves more than the CFL number per step")
+    cfl: FloatProperty(name="CFL", default=4.0, soft_min=0.5, soft_max=10.0,
+                       description="CFL number: cells the fastest flow may cross in one step")
+    seed: IntProperty(name="Seed", default=0, soft_min=0,
+                      description="Seed of every random choice: same seed, same bake")
+    threads: IntProperty(name="Threads", default=0, soft_min=0, soft_max=64,
+                         description="Worker threads (0 = all cores); results do not depend on it")
+    # --- Forces (Fedkiw, Stam & Jensen 2001) ---
+    alpha: FloatProperty(
+        name="Density Buoyancy (α)", default=1.0, soft_min=-10.0, soft_max=10.0,
+        description="α: buoyancy from density, f = -g (α ρ + β (T - T_amb)) (Fedkiw 2001 eq. 8); "
+                    "> 0 makes dense smoke rise, as in Blender")
+    beta: FloatProperty(
+        name="Heat Buoyancy (β)", default=1.0, soft_min=-10.0, soft_max=10.0,
+        description="β: buoyancy from temperature, f = -g (α ρ + β (T - T_amb)) (Fedkiw 2001 eq. 8)")
+    ambient_temperature: FloatProperty(
+        name="Ambient Temperature", default=0.0, soft_min=-10.0, soft_max=10.0,
+        description="T_amb: temperature of the surrounding air (T_0 of the fire paper)")
+    gravity: FloatVectorProperty(
+        name="Gravity", size=3, default=(0.0, 0.0, -9.81), subtype='ACCELERATION', unit='ACCELERATION',
+        description="g: gravity; buoyancy acts against it (Fedkiw 2001 eq. 8)")
+    vorticity: FloatProperty(
+        name="Vorticity (ε)", default=0.2, soft_min=0.0, soft_max=2.0,
+        description="ε: vorticity confinement strength (Fedkiw 2001 eq. 11)")
+    wind: FloatVectorProperty(
+        name="Wind", size=3, default=(0.0, 0.0, 0.0), subtype='VELOCITY', unit='VELOCITY',
+        description="u_wind: velocity the air is pulled towards, m/s")
+    wind_strength: FloatProperty(
+        name="Wind Strength", default=0.0, soft_min=0.0, soft_max=10.0,
+        description="k_w: f_wind = k_w (u_wind - u), 1/s")
+    density_dissipation: FloatProperty(
+        name="Dissipation", default=0.0, soft_min=0.0, soft_max=1.0,
+        description="Fraction of the smoke density lost per second")
+    # --- Advection ---
+    advection: EnumProperty(
+        name="Advection", default='BFECC',
+        items=(('SEMI_LAGRANGIAN', "Semi-Lagrangian", "Stable first-order backtrace (Stam 1999)"),
+               ('BFECC', "BFECC", "Back and forth error compensation (Kim et al. 2005; "
+                                  "smoke_surfaces.txt §3.1): sharper detail")))
+    interpolation: EnumProperty(
+        name="Interpolation", default='MONOTONIC_CUBIC',
+        items=(('LINEAR', "Linear", "Trilinear sampling"),
+               ('MONOTONIC_CUBIC', "Monotonic Cubic", "Monotonic cubic sampling (Fedkiw 2001 eq. 12-13): "
+                                                      "keeps small rolling features, no new extrema")))
+    # --- Pressure ---
+    pressure_tolerance: FloatProperty(
+        name="Tolerance", default=1e-4, soft_min=1e-8, soft_max=0.1, precision=6,
+        description="Relative residual |r|/|b| at which the pressure solve (MGPCG) stops")
+    max_pressure_iterations: IntProperty(
+        name="Max Iterations", default=200, soft_min=1, soft_max=2000,
+        description="Most conjugate gradient iterations per pressure solve")
+    # --- Boundaries: sides -x, +x, -y, +y, -z, +z ---
+    boundary_neg_x: _boundary("-X")
+    boundary_pos_x: _boundary("+X")
+    boundary_neg_y: _boundary("-Y")
+    boundary_pos_y: _boundary("+Y")
+    boundary_neg_z: _boundary("-Z (floor)", default='CLOSED')
+    boundary_pos_z: _boundary("+Z")
+    # --- Combustion (graph_fire_synthesis.txt eqs. 1-5) ---
+    combustion: BoolProperty(name="Combustion", default=False,
+                             description="Burn fuel into heat and soot: the domain becomes a fire simulation")
+    burn_rate: FloatProperty(name="Burn Rate (r)", default=4.0, soft_min=0.0, soft_max=20.0,
+                             description="r: fuel burnt per second, dF/dt = -r F (eq. 3)")
+    soot_yield: FloatProperty(name="Soot Yield (k_S)", default=0.5, soft_min=0.0, soft_max=5.0,
+                              description="k_S: soot made per unit of fuel burnt (eq. 4)")
+    heat_yield: FloatProperty(name="Heat Yield (k_T)", default=4.0, soft_min=0.0, soft_max=20.0,
+                              description="k_T: heat made per unit of fuel burnt (eq. 5)")
+    conductivity: FloatProperty(name="Conductivity (κ)", default=0.0, soft_min=0.0, soft_max=1.0,
+                                description="κ: thermal conductivity (heat diffusion), m²/s (eq. 5)")
+    cooling_rate: FloatProperty(
+        name="Cooling (c)", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="c: cooling c ((T - T_0)/(T_max - T_0))^4 per second (eq. 5)")
+    max_temperature: FloatProperty(name="Max Temperature (T_max)", default=4.0, soft_min=0.0,
+                                   soft_max=20.0, description="T_max: temperature of the hottest flame (eq. 5)")
+    expansion: FloatProperty(
+        name="Expansion (φ)", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="φ: divergence per unit of fuel burnt per second in the reaction zone (eq. 1)")
+    # --- Cache ---
+    cache_directory: StringProperty(
+        name="Cache", subtype='DIR_PATH', default="//plume_cache/",
+        description="Folder of the bake; a sub-folder named after the domain holds its files "
+                    "('//' = next to the .blend, or the working directory when unsaved)")
+    volume_object: StringProperty(name="Volume Object", default="",
+                                  description="Name of the Volume object showing this domain's bake")
+    frames_baked: IntProperty(name="Frames Baked", default=0, min=0,
+                              description="Frames of the last bake available in the cache")
+
+
+class PlumeSourceSettings(bpy.types.PropertyGroup):
+    density: FloatProperty(name="Density", default=1.0, soft_min=0.0, soft_max=10.0,
+                           description="ρ set in the source's cells each step")
+    temperature: FloatProperty(name="Temperature", default=1.0, soft_min=-10.0, soft_max=10.0,
+                               description="T - T_amb set in the source's cells each step")
+    fuel: FloatProperty(name="Fuel", default=0.0, soft_min=0.0, soft_max=10.0,
+                        description="F set in the source's cells (combustion domains only)")
+    velocity: FloatVectorProperty(
+        name="Initial Velocity", size=3, default=(0.0, 0.0, 0.0), subtype='VELOCITY', unit='VELOCITY',
+        description="Velocity given to the air in the source's cells, m/s (smoke_surfaces.txt §3.2)")
+    motion_factor: FloatProperty(name="Motion Factor", default=1.0, soft_min=0.0, soft_max=2.0,
+                                 description="Share of the source object's own motion added to its velocity")
+    point_sources: IntProperty(
+        name="Point Sources", default=16, soft_min=1, soft_max=64,
+        description="Tracer point sources per source cell (10-20 in smoke_surfaces.txt §3.2)")
+    candidate_group: IntProperty(
+        name="Candidate Group", default=-1, soft_min=-1, soft_max=64,
+        description="Streaklines are clustered only inside a candidate group (-1: the source's own group)")
+
+
+class PlumeObstacleSettings(bpy.types.PropertyGroup):
+    slip: EnumProperty(
+        name="Slip", default='NO_SLIP',
+        items=(('NO_SLIP', "No Slip", "The air next to the obstacle moves with it"),
+               ('FREE_SLIP', "Free Slip", "Only the normal part of the flow is stopped")))
+
+
+class PlumeObjectSettings(bpy.types.PropertyGroup):
+    role: EnumProperty(name="Role", items=ROLE_ITEMS, default='NONE',
+                       description="What this object is in a Plume simulation")
+    domain: PointerProperty(type=PlumeDomainSettings)
+    source: PointerProperty(type=PlumeSourceSettings)
+    obstacle: PointerProperty(type=PlumeObstacleSettings)
+
+
+classes = (PlumeDomainSettings, PlumeSourceSettings, PlumeObstacleSettings, PlumeObjectSettings)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Object.plume = PointerProperty(type=PlumeObjectSettings, name="Plume")
+
+
+def unregister():
+    del bpy.types.Object.plume
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

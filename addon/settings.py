@@ -1,0 +1,243 @@
+"""Plain-Python bake settings: the snapshot dataclasses, their validation and their conversion to
+``plume._native.SmokeParams``.  No ``bpy`` here: the snapshot module fills these from the scene,
+the bake runner consumes them (possibly on a worker thread)."""
+
+import dataclasses
+import hashlib
+import math
+from dataclasses import dataclass, field
+from typing import List, Optional, Tuple
+
+import numpy as np
+
+#: Accepted range of the domain's resolution (cells along the longest axis); the native
+#: SmokeParams.validate() applies the same bound per axis.
+RESOLUTION_RANGE = (2, 1024)
+
+#: Order of the six boundary sides, as in SmokeParams.boundaries.
+BOUNDARY_SIDES = ("neg_x", "pos_x", "neg_y", "pos_y", "neg_z", "pos_z")
+
+#: Settings that change nothing in the result (bit-identical at any thread count), so a bake may
+#: resume across them.
+RESULT_NEUTRAL_FIELDS = ("threads",)
+
+
+class BakeError(Exception):
+    """Bad input found before anything was written; the message names the setting or object."""
+
+
+@dataclass
+class SolverSettings:
+    """Mirror of ``_native.SmokeParams`` (same snake_case names); enums stored by name."""
+
+    resolution: Tuple[int, int, int] = (32, 32, 32)
+    cell_size: float = 1.0 / 32.0
+    origin: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    boundaries: Tuple[str, ...] = ("OPEN", "OPEN", "OPEN", "OPEN", "CLOSED", "OPEN")
+    frame_dt: float = 1.0 / 24.0
+    substeps: int = 1
+    use_cfl: bool = True
+    cfl: float = 4.0
+    advection: str = "BFECC"
+    interpolation: str = "MONOTONIC_CUBIC"
+    gravity: Tuple[float, float, float] = (0.0, 0.0, -9.81)
+    alpha: float = 1.0
+    beta: float = 1.0
+    ambient_temperature: float = 0.0
+    wind: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    wind_strength: float = 0.0
+    vorticity: float = 0.2
+    density_dissipation: float = 0.0
+    pressure_tolerance: float = 1e-4
+    max_pressure_iterations: int = 200
+    combustion: bool = False
+    burn_rate: float = 4.0
+    soot_yield: float = 0.5
+    heat_yield: float = 4.0
+    conductivity: float = 0.0
+    cooling_rate: float = 1.0
+    max_temperature: float = 4.0
+    expansion: float = 1.0
+    seed: int = 0
+    threads: int = 0
+
+
+@dataclass
+class SourceParams:
+    """Mirror of ``_native.SourceSettings``."""
+
+    density: float = 1.0
+    temperature: float = 1.0
+    fuel: float = 0.0
+    velocity: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    motion_factor: float = 1.0
+
+
+@dataclass
+class EmitterSnapshot:
+    """One source or obstacle: object-local triangles and its world matrix per frame."""
+
+    name: str
+    role: str  # 'SOURCE' or 'OBSTACLE'
+    vertices: np.ndarray  # float32 (N, 3)
+    triangles: np.ndarray  # int32 (M, 3)
+    #: 4x4 row-major matrices for frames frame_start .. frame_end + 1 (one entry when static).
+    matrices: List[np.ndarray]
+    source: Optional[SourceParams] = None
+    slip: str = "NO_SLIP"
+
+    @property
+    def animated(self):
+        return len(self.matrices) > 1
+
+    def matrix_at(self, index):
+        """Matrix at frame frame_start + index (static emitters have a single matrix)."""
+        return self.matrices[min(index, len(self.matrices) - 1)]
+
+    def mesh_hash(self):
+        """Hash of the geometry that ignores the order of the triangles (Blender's primitives do
+        not list their faces in the same order from one session to the next)."""
+        tris = np.asarray(self.triangles, dtype=np.int32).reshape(-1, 3)
+        if len(tris):
+            # Rotate each triangle to start at its smallest index (keeps its winding), then sort.
+            first = np.argmin(tris, axis=1)
+            rows = np.arange(len(tris))[:, None]
+            tris = tris[rows, (first[:, None] + np.arange(3)) % 3]
+            tris = tris[np.lexsort(tris.T[::-1])]
+        h = hashlib.sha1()
+        h.update(np.ascontiguousarray(self.vertices, dtype=np.float32).tobytes())
+        h.update(np.ascontiguousarray(tris, dtype=np.int32).tobytes())
+        return h.hexdigest()
+
+    def fingerprint(self):
+        """Everything but the motion, as JSON-friendly data (the manifest compares it)."""
+        data = {"name": self.name, "role": self.role, "mesh": self.mesh_hash()}
+        if self.role == "SOURCE":
+            data["source"] = dataclasses.asdict(self.source)
+        else:
+            data["slip"] = self.slip
+        return data
+
+
+@dataclass
+class BakeSnapshot:
+    """Everything a bake needs, taken on the main thread before the worker starts."""
+
+    domain_name: str
+    resolution: int  # cells along the longest axis (the artist's setting)
+    frame_start: int
+    frame_end: int
+    cache_directory: str  # as typed by the artist (for messages)
+    cache_folder: str  # absolute: <cache_directory>/<domain name>
+    solver: SolverSettings = field(default_factory=SolverSettings)
+    emitters: List[EmitterSnapshot] = field(default_factory=list)
+    addon_version: str = "0.1.0"
+
+    @property
+    def frame_count(self):
+        return self.frame_end - self.frame_start + 1
+
+    def settings_dict(self):
+        """Result-relevant settings, as stored in manifest.json and compared on resume."""
+        solver = dataclasses.asdict(self.solver)
+        for name in RESULT_NEUTRAL_FIELDS:
+            solver.pop(name, None)
+        solver["resolution"] = list(solver["resolution"])
+        solver["origin"] = list(solver["origin"])
+        solver["boundaries"] = list(solver["boundaries"])
+        for key in ("gravity", "wind"):
+            solver[key] = list(solver[key])
+        return {
+            "domain_resolution": self.resolution,
+            "frame_start": self.frame_start,
+            "solver": solver,
+            "emitters": [e.fingerprint() for e in self.emitters],
+        }
+
+    def frame_input_hash(self, frame):
+        """Hash of the emitter matrices that drive frame `frame` (matrices at frame and frame+1)."""
+        index = frame - self.frame_start
+        h = hashlib.sha1()
+        for emitter in self.emitters:
+            for m in (emitter.matrix_at(index), emitter.matrix_at(index + 1)):
+                h.update(np.ascontiguousarray(m, dtype=np.float64).tobytes())
+        return h.hexdigest()
+
+
+def domain_grid(bbox_min, bbox_max, resolution):
+    """Cells per axis, cell size and origin of a domain box (ADDON.md "Domain geometry"): the
+    longest axis gets `resolution` cells, the others round(dim / cell_size), at least 2."""
+    dims = [float(b) - float(a) for a, b in zip(bbox_min, bbox_max)]
+    longest = max(dims)
+    if not (longest > 0.0) or not math.isfinite(longest):
+        raise BakeError("Plume: the domain has no volume (its bounding box is flat)")
+    cell_size = longest / resolution
+    cells = tuple(max(2, int(round(d / cell_size))) for d in dims)
+    return cells, cell_size, tuple(float(a) for a in bbox_min)
+
+
+def validate_python_side(domain_name, resolution, frame_start, frame_end, solver):
+    """Rules the native validate() cannot see (it would fail later or less clearly)."""
+    lo, hi = RESOLUTION_RANGE
+    if not (lo <= resolution <= hi):
+        raise BakeError(
+            f"Plume: domain '{domain_name}': resolution must be in [{lo}, {hi}] cells along the "
+            f"longest axis (got {resolution})")
+    if frame_end < frame_start:
+        raise BakeError(
+            f"Plume: domain '{domain_name}': frame_end ({frame_end}) must not be before "
+            f"frame_start ({frame_start})")
+    for name, value in dataclasses.asdict(solver).items():
+        values = value if isinstance(value, (tuple, list)) else (value,)
+        for v in values:
+            if isinstance(v, float) and not math.isfinite(v):
+                raise BakeError(
+                    f"Plume: domain '{domain_name}': {name} must be a finite number (got {v})")
+    if solver.substeps < 1:
+        raise BakeError(
+            f"Plume: domain '{domain_name}': substeps must be at least 1 (got {solver.substeps})")
+
+
+def validate_source(emitter):
+    """Finite, non-negative amounts on a source."""
+    s = emitter.source
+    for name in ("density", "temperature", "fuel", "motion_factor"):
+        v = getattr(s, name)
+        if not math.isfinite(v):
+            raise BakeError(
+                f"Plume: source '{emitter.name}': {name} must be a finite number (got {v})")
+    for name in ("density", "fuel"):
+        v = getattr(s, name)
+        if v < 0.0:
+            raise BakeError(f"Plume: source '{emitter.name}': {name} must be >= 0 (got {v})")
+    if not all(math.isfinite(v) for v in s.velocity):
+        raise BakeError(
+            f"Plume: source '{emitter.name}': velocity must be finite (got {tuple(s.velocity)})")
+
+
+def to_native_params(solver, native):
+    """SolverSettings -> validated ``native.SmokeParams``; ValueError (naming the setting) if bad."""
+    p = native.SmokeParams()
+    for f in dataclasses.fields(solver):
+        value = getattr(solver, f.name)
+        if f.name == "boundaries":
+            value = [getattr(native.Boundary, b) for b in value]
+        elif f.name == "advection":
+            value = getattr(native.Advection, value)
+        elif f.name == "interpolation":
+            value = getattr(native.Interpolation, value)
+        elif isinstance(value, list):
+            value = tuple(value)
+        setattr(p, f.name, value)
+    p.validate()
+    return p
+
+
+def to_native_source(source, native):
+    s = native.SourceSettings()
+    s.density = source.density
+    s.temperature = source.temperature
+    s.fuel = source.fuel
+    s.velocity = tuple(source.velocity)
+    s.motion_factor = source.motion_factor
+    return s

@@ -1,0 +1,154 @@
+"""Scene -> BakeSnapshot (bpy side). Runs on the main thread before a bake starts."""
+
+import os
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+from . import cache
+from .settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, EmitterSnapshot, SolverSettings,
+                       SourceParams, domain_grid)
+
+NOT_A_DOMAIN = ("Plume: the active object is not a Plume domain "
+                "(set one with plume.role_set(role='DOMAIN'))")
+
+#: Roles that take part in a grid bake (Flame Sources belong to flames_bake).
+EMITTER_ROLES = {'SOURCE', 'OBSTACLE'}
+
+
+def active_domain(context):
+    """The active object if it is a Plume domain, else raises BakeError."""
+    obj = getattr(context, "active_object", None)
+    if obj is None or getattr(obj, "plume", None) is None or obj.plume.role != 'DOMAIN':
+        raise BakeError(NOT_A_DOMAIN)
+    if obj.type != 'MESH':
+        raise BakeError(f"Plume: domain '{obj.name}' must be a mesh object (got {obj.type})")
+    return obj
+
+
+def cache_folder_of(domain):
+    """Absolute cache folder of a domain: abspath(cache_directory)/<domain name>/."""
+    base = bpy.path.abspath(domain.plume.domain.cache_directory or "//plume_cache/")
+    if base.startswith("//"):  # unsaved file: relative to the working directory
+        base = base[2:]
+    return cache.cache_folder(os.path.abspath(base or "."), domain.name)
+
+
+def domain_bbox(domain, depsgraph):
+    """World-space bounding box of the evaluated domain mesh."""
+    ob = domain.evaluated_get(depsgraph)
+    corners = [ob.matrix_world @ Vector(c) for c in ob.bound_box]
+    lo = tuple(min(c[a] for c in corners) for a in range(3))
+    hi = tuple(max(c[a] for c in corners) for a in range(3))
+    return lo, hi
+
+
+def solver_settings(domain, scene, cells, cell_size, origin):
+    d = domain.plume.domain
+    fps = scene.render.fps / scene.render.fps_base
+    return SolverSettings(
+        resolution=tuple(cells), cell_size=float(cell_size), origin=tuple(origin),
+        boundaries=tuple(getattr(d, "boundary_" + side) for side in BOUNDARY_SIDES),
+        frame_dt=float(d.time_scale) / fps, substeps=int(d.substeps), use_cfl=bool(d.use_cfl),
+        cfl=float(d.cfl), advection=d.advection, interpolation=d.interpolation,
+        gravity=tuple(float(v) for v in d.gravity), alpha=float(d.alpha), beta=float(d.beta),
+        ambient_temperature=float(d.ambient_temperature), wind=tuple(float(v) for v in d.wind),
+        wind_strength=float(d.wind_strength), vorticity=float(d.vorticity),
+        density_dissipation=float(d.density_dissipation),
+        pressure_tolerance=float(d.pressure_tolerance),
+        max_pressure_iterations=int(d.max_pressure_iterations), combustion=bool(d.combustion),
+        burn_rate=float(d.burn_rate), soot_yield=float(d.soot_yield),
+        heat_yield=float(d.heat_yield), conductivity=float(d.conductivity),
+        cooling_rate=float(d.cooling_rate), max_temperature=float(d.max_temperature),
+        expansion=float(d.expansion), seed=int(d.seed), threads=int(d.threads))
+
+
+def _is_animated(obj):
+    """True when the object or a parent has animation, drivers or constraints."""
+    while obj is not None:
+        ad = obj.animation_data
+        if ad is not None and (ad.action is not None or len(ad.drivers) or len(ad.nla_tracks)):
+            return True
+        if len(obj.constraints):
+            return True
+        obj = obj.parent
+    return False
+
+
+def mesh_arrays(obj, depsgraph):
+    """Object-local vertices (float32 (N,3)) and triangles (int32 (M,3)) of the evaluated mesh."""
+    ob = obj.evaluated_get(depsgraph)
+    mesh = ob.to_mesh()
+    try:
+        mesh.calc_loop_triangles()
+        verts = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", verts)
+        tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+        mesh.loop_triangles.foreach_get("vertices", tris)
+    finally:
+        ob.to_mesh_clear()
+    return verts.reshape(-1, 3), tris.reshape(-1, 3)
+
+
+def scene_emitters(scene, domain):
+    return [o for o in scene.objects
+            if o is not domain and o.type == 'MESH' and o.plume.role in EMITTER_ROLES]
+
+
+def emitter_snapshots(context, domain, frame_start, frame_end):
+    """Meshes at the current frame, matrices at frame_start .. frame_end + 1 (evaluated per frame
+    only when something is animated; the current frame is restored)."""
+    scene = context.scene
+    depsgraph = context.evaluated_depsgraph_get()
+    objs = scene_emitters(scene, domain)
+    snaps = []
+    for o in objs:
+        verts, tris = mesh_arrays(o, depsgraph)
+        s = o.plume.source
+        snaps.append(EmitterSnapshot(
+            name=o.name, role=o.plume.role, vertices=verts, triangles=tris,
+            matrices=[np.array(o.matrix_world, dtype=np.float64)],
+            source=SourceParams(density=float(s.density), temperature=float(s.temperature),
+                                fuel=float(s.fuel), velocity=tuple(float(v) for v in s.velocity),
+                                motion_factor=float(s.motion_factor))
+            if o.plume.role == 'SOURCE' else None,
+            slip=o.plume.obstacle.slip))
+    animated = [i for i, o in enumerate(objs) if _is_animated(o)]
+    if animated:
+        current, subframe = scene.frame_current, scene.frame_subframe
+        for i in animated:
+            snaps[i].matrices = []
+        try:
+            for f in range(frame_start, frame_end + 2):
+                scene.frame_set(f)
+                for i in animated:
+                    snaps[i].matrices.append(np.array(objs[i].matrix_world, dtype=np.float64))
+        finally:
+            scene.frame_set(current, subframe=subframe)
+    return snaps
+
+
+def take_snapshot(context, addon_version="0.1.0"):
+    """Everything the bake needs from the scene; BakeError for problems visible from here."""
+    domain = active_domain(context)
+    d = domain.plume.domain
+    scene = context.scene
+    from .settings import validate_python_side
+    resolution = int(d.resolution)
+    frame_start, frame_end = int(d.frame_start), int(d.frame_end)
+    # Cheap checks first, before the grid size is derived from the resolution.
+    validate_python_side(domain.name, resolution, frame_start, frame_end, SolverSettings())
+    lo, hi = domain_bbox(domain, context.evaluated_depsgraph_get())
+    try:
+        cells, cell_size, origin = domain_grid(lo, hi, resolution)
+    except BakeError as e:
+        raise BakeError(f"{e} (domain '{domain.name}')") from None
+    solver = solver_settings(domain, scene, cells, cell_size, origin)
+    validate_python_side(domain.name, resolution, frame_start, frame_end, solver)
+    return BakeSnapshot(
+        domain_name=domain.name, resolution=resolution, frame_start=frame_start,
+        frame_end=frame_end, cache_directory=d.cache_directory,
+        cache_folder=cache_folder_of(domain), solver=solver,
+        emitters=emitter_snapshots(context, domain, frame_start, frame_end),
+        addon_version=addon_version)

@@ -1,0 +1,3 @@
+"""Panels of the Physics tab."""
+
+from .panels import classes  # noqa: F401

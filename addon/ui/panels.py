@@ -1,0 +1,214 @@
+"""Properties editor > Physics tab: the "Plume" panel and its sub-panels (laid out like
+Mantaflow's): role buttons, then the settings of the object's role."""
+
+import bpy
+
+from ..operators.bake import cache_status, is_baking
+from ..properties import ROLE_ITEMS
+
+
+class PlumePanel:
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "physics"
+
+    @staticmethod
+    def plume(context):
+        ob = context.object
+        return None if ob is None else ob.plume
+
+
+class PlumeDomainPanel(PlumePanel):
+    bl_parent_id = "PHYSICS_PT_plume"
+
+    @classmethod
+    def poll(cls, context):
+        p = cls.plume(context)
+        return p is not None and p.role == 'DOMAIN'
+
+
+class PHYSICS_PT_plume(PlumePanel, bpy.types.Panel):
+    bl_label = "Plume"
+
+    @classmethod
+    def poll(cls, context):
+        return context.object is not None and context.object.type == 'MESH'
+
+    def draw(self, context):
+        layout = self.layout
+        p = context.object.plume
+        grid = layout.grid_flow(row_major=True, columns=3, even_columns=True, align=True)
+        for ident, name, _desc, icon, _num in ROLE_ITEMS:
+            op = grid.operator("plume.role_set", text=name, icon=icon, depress=(p.role == ident))
+            op.role = ident
+        if p.role == 'DOMAIN':
+            row = layout.row(align=True)
+            row.enabled = not is_baking(context.object)
+            row.operator("plume.bake", icon='PHYSICS')
+            row.operator("plume.cache_free", icon='TRASH')
+
+
+class PHYSICS_PT_plume_settings(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Settings"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        d = context.object.plume.domain
+        layout.prop(d, "resolution")
+        col = layout.column(align=True)
+        col.prop(d, "frame_start", text="Frame Start")
+        col.prop(d, "frame_end", text="End")
+        layout.prop(d, "time_scale")
+        col = layout.column(align=True)
+        col.prop(d, "substeps")
+        col.prop(d, "use_cfl")
+        sub = col.row()
+        sub.active = d.use_cfl
+        sub.prop(d, "cfl")
+        layout.prop(d, "seed")
+        layout.prop(d, "threads")
+
+
+class PHYSICS_PT_plume_forces(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Forces"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        d = context.object.plume.domain
+        col = layout.column(align=True)
+        col.prop(d, "alpha")
+        col.prop(d, "beta")
+        col.prop(d, "ambient_temperature")
+        layout.prop(d, "gravity")
+        layout.prop(d, "vorticity")
+        layout.prop(d, "wind")
+        layout.prop(d, "wind_strength")
+        layout.prop(d, "density_dissipation")
+
+
+class PHYSICS_PT_plume_advection(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Advection"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        d = context.object.plume.domain
+        layout.prop(d, "advection")
+        layout.prop(d, "interpolation")
+
+
+class PHYSICS_PT_plume_pressure(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Pressure"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        d = context.object.plume.domain
+        layout.prop(d, "pressure_tolerance")
+        layout.prop(d, "max_pressure_iterations")
+
+
+class PHYSICS_PT_plume_boundaries(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Boundaries"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        d = context.object.plume.domain
+        for side in ("neg_x", "pos_x", "neg_y", "pos_y", "neg_z", "pos_z"):
+            layout.prop(d, "boundary_" + side)
+
+
+class PHYSICS_PT_plume_combustion(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Combustion"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw_header(self, context):
+        self.layout.prop(context.object.plume.domain, "combustion", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        d = context.object.plume.domain
+        layout.active = d.combustion
+        for name in ("burn_rate", "soot_yield", "heat_yield", "conductivity", "cooling_rate",
+                     "max_temperature", "expansion"):
+            layout.prop(d, name)
+
+
+class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Cache"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        ob = context.object
+        d = ob.plume.domain
+        layout.prop(d, "cache_directory", text="Directory")
+        baking = is_baking(ob)
+        row = layout.row(align=True)
+        row.enabled = not baking
+        row.operator("plume.bake", icon='PHYSICS')
+        row.operator("plume.cache_free", icon='TRASH')
+        done, total = cache_status(ob)
+        state = "baking" if baking else ("complete" if total and done >= total else "")
+        layout.label(text=f"Frames: {done} / {total} {state}".rstrip(), icon='INFO')
+        if d.volume_object:
+            layout.label(text=f"Volume: {d.volume_object}", icon='OUTLINER_OB_VOLUME')
+
+
+class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
+    bl_label = "Source"
+    bl_parent_id = "PHYSICS_PT_plume"
+
+    @classmethod
+    def poll(cls, context):
+        p = cls.plume(context)
+        return p is not None and p.role in {'SOURCE', 'FLAME_SOURCE'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        s = context.object.plume.source
+        layout.prop(s, "density")
+        layout.prop(s, "temperature")
+        layout.prop(s, "fuel")
+        layout.prop(s, "velocity")
+        layout.prop(s, "motion_factor")
+        col = layout.column(heading="Streak Surfaces")
+        col.prop(s, "point_sources")
+        col.prop(s, "candidate_group")
+
+
+class PHYSICS_PT_plume_obstacle(PlumePanel, bpy.types.Panel):
+    bl_label = "Obstacle"
+    bl_parent_id = "PHYSICS_PT_plume"
+
+    @classmethod
+    def poll(cls, context):
+        p = cls.plume(context)
+        return p is not None and p.role == 'OBSTACLE'
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(context.object.plume.obstacle, "slip")
+
+
+classes = (
+    PHYSICS_PT_plume,
+    PHYSICS_PT_plume_settings,
+    PHYSICS_PT_plume_forces,
+    PHYSICS_PT_plume_advection,
+    PHYSICS_PT_plume_pressure,
+    PHYSICS_PT_plume_boundaries,
+    PHYSICS_PT_plume_combustion,
+    PHYSICS_PT_plume_cache,
+    PHYSICS_PT_plume_source,
+    PHYSICS_PT_plume_obstacle,
+)

@@ -1,0 +1,115 @@
+"""Bad input to plume.bake: a RuntimeError naming the setting or object, no file written, no
+object or datablock created, and Blender keeps running (the next test runs).
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_bad_input.py
+"""
+
+import os
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+
+from helpers import (add_domain, add_sphere_source, reset_scene, rmtree, run,  # noqa: E402
+                     select_only, temp_dir, tree_listing)
+
+
+class BadInputTest(unittest.TestCase):
+    def setUp(self):
+        reset_scene()
+        self.tmp = temp_dir("plume_bad_")
+        self.cache = os.path.join(self.tmp, "cache")
+        os.makedirs(self.cache)
+        self.source = add_sphere_source()
+        self.domain = add_domain(resolution=16, frame_end=3, cache_directory=self.cache + "/")
+        select_only(self.domain)
+
+    def tearDown(self):
+        rmtree(self.tmp)
+
+    def counts(self):
+        d = bpy.data
+        return dict(objects=len(d.objects), volumes=len(d.volumes), meshes=len(d.meshes),
+                    materials=len(d.materials), collections=len(d.collections),
+                    frame=bpy.context.scene.frame_current)
+
+    def assert_bake_fails(self, *words):
+        """bake() raises RuntimeError whose message holds every word; nothing changed."""
+        before = self.counts()
+        files_before = tree_listing(self.tmp)
+        with self.assertRaises(RuntimeError) as cm:
+            bpy.ops.plume.bake()
+        msg = str(cm.exception)
+        for w in words:
+            self.assertIn(w, msg, f"message should name {w!r}: {msg}")
+        self.assertEqual(self.counts(), before, "objects/datablocks changed")
+        self.assertEqual(tree_listing(self.tmp), files_before, "files were written")
+        self.assertEqual(self.domain.display_type, 'TEXTURED')
+        self.assertFalse(self.domain.hide_render)
+        return msg
+
+    def test_no_active_object(self):
+        select_only(None)
+        self.assert_bake_fails("not a Plume domain", "role_set")
+
+    def test_active_object_not_a_domain(self):
+        select_only(self.source)
+        self.assert_bake_fails("not a Plume domain")
+
+    def test_resolution_zero(self):
+        self.domain.plume.domain.resolution = 0
+        self.assertEqual(self.domain.plume.domain.resolution, 0, "resolution must not be clamped")
+        self.assert_bake_fails("resolution", "[2, 1024]", "Domain")
+
+    def test_resolution_5000(self):
+        self.domain.plume.domain.resolution = 5000
+        self.assert_bake_fails("resolution", "5000")
+
+    def test_resolution_above_memory(self):
+        # 1000^3 cells is inside the per-axis range but far above the memory bound (512^3).
+        self.domain.plume.domain.resolution = 1000
+        self.assert_bake_fails("resolution", "cells")
+
+    def test_negative_vorticity(self):
+        self.domain.plume.domain.vorticity = -1.0
+        self.assert_bake_fails("vorticity", "-1")
+
+    def test_nan_alpha(self):
+        self.domain.plume.domain.alpha = float("nan")
+        self.assert_bake_fails("alpha", "finite")
+
+    def test_frame_end_before_start(self):
+        d = self.domain.plume.domain
+        d.frame_start, d.frame_end = 10, 5
+        self.assert_bake_fails("frame_end", "frame_start")
+
+    def test_cache_folder_not_writable(self):
+        # Tests run as root, so chmod would not stop them: put the cache under a regular file.
+        blocker = os.path.join(self.tmp, "not_a_folder")
+        with open(blocker, "w") as f:
+            f.write("x")
+        self.domain.plume.domain.cache_directory = os.path.join(blocker, "cache") + "/"
+        msg = self.assert_bake_fails("cache_directory", "not_a_folder")
+        self.assertFalse(os.path.exists(os.path.join(blocker, "cache")), msg)
+
+    def test_non_manifold_obstacle(self):
+        bpy.ops.mesh.primitive_plane_add(size=0.5, location=(0.0, 0.0, 1.0))
+        plane = bpy.context.active_object
+        plane.name = "FlatWall"
+        bpy.ops.plume.role_set(role='OBSTACLE')
+        select_only(self.domain)
+        self.assert_bake_fails("FlatWall")
+
+    def test_good_input_still_bakes(self):
+        # The same scene without the bad setting bakes (so the failures above are the settings').
+        bpy.ops.plume.bake()
+        self.assertIsNotNone(bpy.data.objects.get("Domain_smoke"))
+        self.assertEqual(len([n for n in os.listdir(os.path.join(self.cache, "Domain"))
+                              if n.endswith(".vdb")]), 3)
+
+
+if __name__ == "__main__":
+    run(BadInputTest)
