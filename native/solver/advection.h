@@ -2,11 +2,17 @@
 /// \file advection.h
 /// Semi-Lagrangian advection (Stam 1999) and BFECC (Kim, Liu, Llamas & Rossignac 2005) with a
 /// clamp limiter, for cell-centred scalars and the staggered velocity components.
+///
+/// Speed: back-traces are computed once per grid layout and shared by every field on it (density,
+/// temperature, fuel and soot share one trace), and scalar fields skip the blocks of cells that
+/// are far from any smoke (their value stays the background value exactly).
 
 #include "core/grid3.h"
 #include "core/mac_grid3.h"
 #include "core/sampling.h"
 #include "solver/smoke_params.h"
+
+#include <vector>
 
 namespace plume {
 
@@ -20,21 +26,55 @@ constexpr glm::vec3 kFaceOffsetW{0.f, 0.f, -0.5f};
 /// the velocity field: explicit midpoint rule (RK2), second order in time.
 glm::vec3 traceBack(const MacGrid3& velocity, glm::vec3 p, float cells);
 
-/// Carries grids through a velocity field. Owns the scratch grids BFECC needs, sized once.
+/// Blocks of 8³ samples that may hold something other than a field's background value after
+/// advection: blocks holding such a value, dilated by two blocks (16 cells).
+class BlockMask {
+ public:
+  static constexpr int kBlock = 8;
+  static constexpr int kDilation = 2;  ///< blocks; covers 2 × (trace + stencil) of BFECC
+
+  /// Marks the blocks of `field` with a value != background, then dilates.
+  void build(const ScalarGrid& field, float background);
+  /// Union with another mask of the same grid.
+  void merge(const BlockMask& other);
+  /// Marks everything active.
+  void setAll(glm::ivec3 size);
+  bool active(int bi, int bj, int bk) const {
+    return mActive[std::size_t(bi) + std::size_t(mBlocks.x) * (std::size_t(bj) + std::size_t(mBlocks.y) * std::size_t(bk))] != 0;
+  }
+  glm::ivec3 blocks() const { return mBlocks; }
+  /// Share of active blocks, in [0, 1].
+  float fill() const;
+
+ private:
+  glm::ivec3 mBlocks{0};
+  std::vector<std::uint8_t> mActive, mRaw;
+};
+
+/// Carries grids through a velocity field. Owns the traces and scratch BFECC needs, sized once.
+///
+/// Use: trace() for a layout, then advect() every field of that layout.
 class Advector {
  public:
-  /// Reserves scratch for grids of up to `count` samples (no allocation afterwards).
+  /// Reserves traces and scratch for grids of up to `count` samples (no allocation afterwards).
   void reserve(std::size_t count);
 
-  /// dst = src advected for dt along `velocity`. `offset` says where src's samples sit
-  /// (kCellOffset, kFaceOffsetU...). With BFECC: φ̂ = A(φ), φ̄ = A⁻¹(φ̂),
+  /// Traces every sample of a grid of `size` whose sample (0,0,0) sits at `offset`: back by Δt
+  /// (and forth by Δt for BFECC) through `velocity`, only in the active blocks of `mask`
+  /// (nullptr = everywhere).
+  void trace(const MacGrid3& velocity, glm::ivec3 size, glm::vec3 offset, float dt, float cellSize,
+             Advection scheme, const BlockMask* mask);
+
+  /// dst = src advected with the last trace(). With BFECC: φ̂ = A(φ), φ̄ = A⁻¹(φ̂),
   /// result = A(φ + ½(φ - φ̄)) clamped to the range of φ around the back-traced point.
-  /// dst must not alias src or velocity.
-  void advect(const ScalarGrid& src, ScalarGrid& dst, glm::vec3 offset, const MacGrid3& velocity,
-              float dt, float cellSize, Advection scheme, Interpolation interpolation);
+  /// Outside the active blocks of `mask` dst is `background`. dst must not alias src.
+  void advect(const ScalarGrid& src, ScalarGrid& dst, Interpolation interpolation,
+              const BlockMask* mask, float background);
 
  private:
   ScalarGrid mForward, mBackward;
+  std::vector<glm::vec3> mBack, mFore;  ///< traced positions in the grid's index space
+  Advection mScheme = Advection::SemiLagrangian;
 };
 
 }  // namespace plume

@@ -194,25 +194,47 @@ void SmokeSolver::advect(float dt) {
   const Advection scheme = mParams.advection;
   const Interpolation interp = mParams.interpolation;
   const float h = mParams.cellSize;
-  // Scalars first: every field is carried by the same (pre-advection) velocity.
-  std::vector<ScalarGrid*> scalars{&mDensity, &mTemperature};
+  // Scalars first, all carried by the same (pre-advection) velocity along one shared trace.
+  struct Field {
+    ScalarGrid* grid;
+    float background;  ///< value of clean air
+    bool conserve;     ///< density-like: keep Σq, less outflow
+  };
+  std::vector<Field> scalars{{&mDensity, 0.f, mParams.conserveMass},
+                             {&mTemperature, mParams.ambientTemperature, false}};
   if (mParams.combustion) {
-    scalars.push_back(&mFuel);
-    scalars.push_back(&mSoot);
+    scalars.push_back({&mFuel, 0.f, mParams.conserveMass});
+    scalars.push_back({&mSoot, 0.f, mParams.conserveMass});
   }
-  for (ScalarGrid* g : scalars) {
-    // Density-like fields (not temperature) keep their mass, less what leaves the domain.
-    const bool conserve = mParams.conserveMass && g != &mTemperature;
+  // Blocks far from any smoke stay clean air exactly, as long as nothing travels further than
+  // the mask's dilation in one step (BFECC reaches twice the trace plus two stencils).
+  const float reach = maxSpeed() * dt / h;
+  const float dilation = float(BlockMask::kBlock * BlockMask::kDilation);
+  const BlockMask* mask = nullptr;
+  if (2.f * reach + 4.f < dilation) {
+    mMask.build(*scalars[0].grid, scalars[0].background);
+    for (std::size_t f = 1; f < scalars.size(); ++f) {
+      mMaskTmp.build(*scalars[f].grid, scalars[f].background);
+      mMask.merge(mMaskTmp);
+    }
+    mask = &mMask;
+  }
+  mAdvector.trace(mVelocity, mParams.resolution, kCellOffset, dt, h, scheme, mask);
+  for (const Field& f : scalars) {
     const double target =
-        conserve ? totalMass(*g) - outflowMass(*g, mVelocity, mParams.boundaries, dt, h) : 0.0;
-    mAdvector.advect(*g, mScalarTmp, kCellOffset, mVelocity, dt, h, scheme, interp);
-    std::swap(g->values(), mScalarTmp.values());
-    if (conserve) restoreMass(*g, target);
+        f.conserve ? totalMass(*f.grid) - outflowMass(*f.grid, mVelocity, mParams.boundaries, dt, h)
+                   : 0.0;
+    mAdvector.advect(*f.grid, mScalarTmp, interp, mask, f.background);
+    std::swap(f.grid->values(), mScalarTmp.values());
+    if (f.conserve) restoreMass(*f.grid, target);
   }
+  // Then each velocity component along the trace of its own faces.
   static const glm::vec3 kOffsets[3] = {kFaceOffsetU, kFaceOffsetV, kFaceOffsetW};
-  for (int a = 0; a < 3; ++a)
-    mAdvector.advect(mVelocity.component(a), mVelocityTmp.component(a), kOffsets[a], mVelocity,
-                     dt, h, scheme, interp);
+  for (int a = 0; a < 3; ++a) {
+    const ScalarGrid& comp = mVelocity.component(a);
+    mAdvector.trace(mVelocity, comp.size(), kOffsets[a], dt, h, scheme, nullptr);
+    mAdvector.advect(comp, mVelocityTmp.component(a), interp, nullptr, 0.f);
+  }
   std::swap(mVelocity, mVelocityTmp);
   if (!mObstacles.empty()) zeroSolidScalars();
 }

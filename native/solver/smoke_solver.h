@@ -119,6 +119,7 @@ class SmokeSolver {
   ScalarGrid mPressure, mRhs, mDivergenceTarget;
   VectorGrid mVorticity, mForce, mWindField;
   Advector mAdvector;
+  BlockMask mMask, mMaskTmp;  ///< blocks of cells near smoke (advection skips the rest)
   FlagGrid mCellTypes, mCellTypesNext;
   VectorGrid mSolidVelocity;  ///< velocity of the obstacle in each solid cell
   FlagGrid mNoSlip;           ///< 1 where a solid cell belongs to a no-slip obstacle
