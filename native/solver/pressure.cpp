@@ -18,9 +18,14 @@
 #include <utility>
 
 #include "core/parallel.h"
+#include "solver/band_solver.h"
+#include "solver/multigrid_level.h"
 
 namespace plume {
 namespace {
+
+using detail::BandSolver;
+using detail::Level;
 
 /// Jacobi damping ω. The smoother S = ω D⁻¹ is convergent in the A-norm (which makes the V-cycle
 /// SPD) iff 2 D/ω - A is SPD; Gershgorin gives λ_max(D⁻¹A) <= 2, so any ω < 1 is safe. 6/7, the
@@ -46,21 +51,6 @@ constexpr double kRoundOffFloor = 3e-7;
 /// 4 × (average of the 8 children) = ½ × (sum of the children). With piecewise constant
 /// prolongation P this restriction is R = ½ Pᵀ, which keeps the V-cycle symmetric.
 constexpr float kRestrict = 0.5f;
-
-/// One level of the hierarchy (padded storage, see the file comment).
-struct Level {
-  glm::ivec3 n{0};
-  std::ptrdiff_t sy = 0, sz = 0;  ///< padded strides
-  std::vector<float> diag;        ///< fluid neighbours + air neighbours; 0 on solid and ghosts
-  std::vector<float> wInv;        ///< ω / diag on fluid cells, else 0
-  std::vector<float> b, x, t;     ///< rhs, solution, scratch (level 0: CG's r, z and q)
-  std::vector<float> rows;        ///< residual rows for the restriction, one per coarse slice
-
-  std::size_t at(int i, int j, int k) const {
-    return std::size_t((i + 1) + sy * (j + 1) + sz * (k + 1));
-  }
-  std::size_t padded() const { return std::size_t(n.x + 2) * (n.y + 2) * (n.z + 2); }
-};
 
 template <typename RowFn>
 void forRows(glm::ivec3 n, const RowFn& fn) {
@@ -179,82 +169,6 @@ void prolongAdd(Level& F, const Level& C) {
     prolongPairs(F.n.x, C.x.data() + C.at(0, j >> 1, k >> 1), F.diag.data() + o, F.x.data() + o);
   });
 }
-
-/// Direct solve on the coarsest level: banded Cholesky of the fluid cells ordered with the
-/// longest axis slowest (bandwidth = product of the two shorter axes). A pivot that vanishes
-/// (the last cell of a component with no air, e.g. the all-closed singular case) is dropped,
-/// which pins that cell to 0: x = L⁺ᵀ L⁺ b stays symmetric positive semi-definite and solves
-/// A x = b for any consistent b.
-struct BandSolver {
-  int n = 0, w = 0;
-  std::vector<std::size_t> cells;  ///< padded index of each unknown
-  std::vector<double> l;           ///< row i holds L(i, i-w .. i)
-  std::vector<double> y;
-
-  double& at(int i, int j) { return l[std::size_t(i) * (w + 1) + (w - (i - j))]; }
-
-  static double cost(glm::ivec3 s) {
-    int a[3] = {s.x, s.y, s.z};
-    std::sort(a, a + 3);
-    const double bw = double(a[0]) * a[1];
-    return bw * bw * a[0] * a[1] * a[2];
-  }
-
-  void build(const Level& L) {
-    int ax[3] = {0, 1, 2};  // fastest, middle, slowest = the longest axis
-    std::sort(ax, ax + 3, [&](int a, int b) { return L.n[a] < L.n[b]; });
-    std::vector<int> number(L.padded(), -1);
-    cells.clear();
-    glm::ivec3 c;
-    for (c[ax[2]] = 0; c[ax[2]] < L.n[ax[2]]; ++c[ax[2]])
-      for (c[ax[1]] = 0; c[ax[1]] < L.n[ax[1]]; ++c[ax[1]])
-        for (c[ax[0]] = 0; c[ax[0]] < L.n[ax[0]]; ++c[ax[0]]) {
-          const std::size_t o = L.at(c.x, c.y, c.z);
-          if (L.diag[o] > 0.f) {
-            number[o] = int(cells.size());
-            cells.push_back(o);
-          }
-        }
-    n = int(cells.size());
-    const std::ptrdiff_t off[3] = {1, L.sy, L.sz};
-    w = 0;
-    for (int i = 0; i < n; ++i)
-      for (std::ptrdiff_t s : off)
-        if (number[cells[i] + s] >= 0) w = std::max(w, number[cells[i] + s] - i);
-    l.assign(std::size_t(n) * (w + 1), 0.0);
-    y.assign(std::size_t(n), 0.0);
-    for (int i = 0; i < n; ++i) {
-      at(i, i) = L.diag[cells[i]];
-      for (std::ptrdiff_t s : off)
-        if (number[cells[i] - s] >= 0) at(i, number[cells[i] - s]) = -1.0;
-    }
-    for (int i = 0; i < n; ++i) {
-      const int j0 = std::max(0, i - w);
-      for (int j = j0; j <= i; ++j) {
-        double s = at(i, j);
-        for (int k = j0; k < j; ++k) s -= at(i, k) * at(j, k);
-        if (j < i)
-          at(i, j) = at(j, j) > 0.0 ? s / at(j, j) : 0.0;
-        else
-          at(i, i) = s > 1e-10 * L.diag[cells[i]] ? std::sqrt(s) : 0.0;
-      }
-    }
-  }
-
-  void solve(Level& L) {
-    for (int i = 0; i < n; ++i) {
-      double s = L.b[cells[i]];
-      for (int k = std::max(0, i - w); k < i; ++k) s -= at(i, k) * y[k];
-      y[i] = at(i, i) > 0.0 ? s / at(i, i) : 0.0;
-    }
-    for (int i = n - 1; i >= 0; --i) {
-      double s = y[i];
-      for (int k = i + 1; k <= std::min(n - 1, i + w); ++k) s -= at(k, i) * y[k];
-      y[i] = at(i, i) > 0.0 ? s / at(i, i) : 0.0;
-    }
-    for (int i = 0; i < n; ++i) L.x[cells[i]] = float(y[i]);
-  }
-};
 
 }  // namespace
 
