@@ -84,6 +84,10 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         items=(('LINEAR', "Linear", "Trilinear sampling"),
                ('MONOTONIC_CUBIC', "Monotonic Cubic", "Monotonic cubic sampling (Fedkiw 2001 eq. 12-13): "
                                                       "keeps small rolling features, no new extrema")))
+    conserve_mass: BoolProperty(
+        name="Conserve Mass", default=True,
+        description="Restore the total smoke after each advection, less what left through open "
+                    "sides (advection alone drifts 5-50% in 100 steps)")
     # --- Pressure ---
     pressure_tolerance: FloatProperty(
         name="Tolerance", default=1e-4, soft_min=1e-8, soft_max=0.1, precision=6,

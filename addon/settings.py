@@ -40,6 +40,7 @@ class SolverSettings:
     cfl: float = 4.0
     advection: str = "BFECC"
     interpolation: str = "MONOTONIC_CUBIC"
+    conserve_mass: bool = True
     gravity: Tuple[float, float, float] = (0.0, 0.0, -9.81)
     alpha: float = 1.0
     beta: float = 1.0

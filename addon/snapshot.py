@@ -52,6 +52,7 @@ def solver_settings(domain, scene, cells, cell_size, origin):
         boundaries=tuple(getattr(d, "boundary_" + side) for side in BOUNDARY_SIDES),
         frame_dt=float(d.time_scale) / fps, substeps=int(d.substeps), use_cfl=bool(d.use_cfl),
         cfl=float(d.cfl), advection=d.advection, interpolation=d.interpolation,
+        conserve_mass=bool(d.conserve_mass),
         gravity=tuple(float(v) for v in d.gravity), alpha=float(d.alpha), beta=float(d.beta),
         ambient_temperature=float(d.ambient_temperature), wind=tuple(float(v) for v in d.wind),
         wind_strength=float(d.wind_strength), vorticity=float(d.vorticity),

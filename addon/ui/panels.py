@@ -98,6 +98,7 @@ class PHYSICS_PT_plume_advection(PlumeDomainPanel, bpy.types.Panel):
         d = context.object.plume.domain
         layout.prop(d, "advection")
         layout.prop(d, "interpolation")
+        layout.prop(d, "conserve_mass")
 
 
 class PHYSICS_PT_plume_pressure(PlumeDomainPanel, bpy.types.Panel):
