@@ -16,6 +16,11 @@ from dataclasses import dataclass, field
 from typing import List, Optional
 
 from . import cache
+
+#: A checkpoint of the solver state is written when the time since the last one is at least this
+#: many times what writing the last one took (and after the last frame): about every frame on
+#: small grids, every few seconds at 128³ (75 MB), never more than ~10% of the bake time.
+CHECKPOINT_COST_RATIO = 10.0
 from .settings import (BakeError, to_native_params, to_native_source, validate_python_side,
                        validate_source)
 
@@ -61,6 +66,7 @@ class BakeRunner:
         self._cancel = threading.Event()
         self._mode = None  # 'fresh', 'resume' or 'complete'
         self._resume_last = None
+        self._resume_state = None
         self._manifest = None
         self._emitter_index = None  # frame index whose emitters are loaded in the solver
 
@@ -142,9 +148,15 @@ class BakeRunner:
         self._manifest = m
         if last >= snap.frame_end:
             self._mode = "complete"
-        elif m.get("state_frame") == last and os.path.isfile(cache.state_path(snap.cache_folder)):
-            self._mode = "resume"
-            self._resume_last = last
+        else:
+            # Checkpoints are written every few seconds, so the state may be some frames behind
+            # the last complete frame: resume from it and recompute (bit for bit) what follows.
+            state = m.get("state_frame")
+            if (isinstance(state, int) and snap.frame_start <= state <= last
+                    and os.path.isfile(cache.state_path(snap.cache_folder))):
+                self._mode = "resume"
+                self._resume_last = last
+                self._resume_state = state
 
     # ---------------------------------------------------------------- the loop
     def cancel(self):
@@ -184,10 +196,10 @@ class BakeRunner:
             except RuntimeError:
                 self._mode = "fresh"  # corrupt checkpoint: load_state left the solver untouched
         if self._mode == "resume":
-            first = self._resume_last + 1
+            first = self._resume_state + 1
             result.resumed_from = first
             result.last_complete_frame = self._resume_last
-            manifest.update(last_complete_frame=self._resume_last, state_frame=self._resume_last,
+            manifest.update(last_complete_frame=self._resume_last, state_frame=self._resume_state,
                             frame_inputs=self._manifest.get("frame_inputs", [])[
                                 :self._resume_last - snap.frame_start + 1],
                             frames_computed_total=self._manifest.get("frames_computed_total", 0))
@@ -198,6 +210,7 @@ class BakeRunner:
                                 "cancelled": False}
         cache.write_manifest(folder, manifest)
 
+        last_checkpoint, checkpoint_cost = time.perf_counter(), 0.0
         try:
             for frame in range(first, snap.frame_end + 1):
                 if self._cancel.is_set():
@@ -208,12 +221,19 @@ class BakeRunner:
                     result.cancelled = True
                     break
                 self._solver.write_vdb(cache.volume_path(folder, frame))
-                self._solver.save_state(cache.state_path(folder))
-                result.last_complete_frame = frame
+                # The checkpoint holds every grid (75 MB at 128³), so it is not written every frame.
+                now = time.perf_counter()
+                if (frame == snap.frame_end
+                        or now - last_checkpoint >= CHECKPOINT_COST_RATIO * checkpoint_cost):
+                    self._solver.save_state(cache.state_path(folder))
+                    manifest["state_frame"] = frame
+                    last_checkpoint = time.perf_counter()
+                    checkpoint_cost = last_checkpoint - now
+                result.last_complete_frame = max(result.last_complete_frame, frame)
                 result.computed_frames.append(frame)
-                manifest["last_complete_frame"] = frame
-                manifest["state_frame"] = frame
-                manifest["frame_inputs"].append(snap.frame_input_hash(frame))
+                manifest["last_complete_frame"] = result.last_complete_frame
+                if frame - snap.frame_start >= len(manifest["frame_inputs"]):
+                    manifest["frame_inputs"].append(snap.frame_input_hash(frame))
                 manifest["frames_computed_total"] += 1
                 manifest["last_run"]["computed_frames"].append(frame)
                 cache.write_manifest(folder, manifest)

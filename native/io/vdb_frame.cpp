@@ -66,9 +66,9 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
   const std::size_t slab = std::size_t(n.x) * std::size_t(n.y);
 
   openvdb::GridPtrVec grids;
+  // Blender's Principled Volume reads `density`: what it shows is smoke plus soot.
+  std::vector<float> density(solver.density().count());
   {
-    // Blender's Principled Volume reads `density`: what it shows is smoke plus soot.
-    std::vector<float> density(solver.density().count());
     const float* d = solver.density().data();
     const float* s = solver.soot().data();
     parallelFor(0, slabs, [&](int k) {
@@ -79,15 +79,20 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
   grids.push_back(floatGrid("temperature", solver.temperature().data(), n, xform));
   if (p.combustion) grids.push_back(floatGrid("flame", solver.flame().data(), n, xform));
   {
-    // Cell-centred velocity: the mean of each cell's two faces per axis.
+    // Cell-centred velocity (the mean of each cell's two faces per axis), stored only where
+    // there is smoke or flame: the projection leaves tiny velocities in the whole domain, which
+    // would make every frame a dense grid (270 MB for ten frames at 128³) for motion blur only.
     std::vector<openvdb::Vec3s> velocity(solver.density().count());
     const MacGrid3& mac = solver.velocity();
+    const float* flame = solver.flame().data();
+    const bool burning = p.combustion;
     parallelFor(0, slabs, [&](int k) {
       for (int j = 0; j < n.y; ++j)
         for (int i = 0; i < n.x; ++i) {
-          const glm::vec3 c = mac.cellCenter(i, j, k);
-          velocity[std::size_t(i) + std::size_t(n.x) * (std::size_t(j) + std::size_t(n.y) * k)] =
-              openvdb::Vec3s(c.x, c.y, c.z);
+          const std::size_t m = std::size_t(i) + std::size_t(n.x) * (std::size_t(j) + std::size_t(n.y) * k);
+          const bool visible = density[m] != 0.f || (burning && flame[m] != 0.f);
+          const glm::vec3 c = visible ? mac.cellCenter(i, j, k) : glm::vec3(0.f);
+          velocity[m] = openvdb::Vec3s(c.x, c.y, c.z);
         }
     });
     auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
