@@ -1,0 +1,413 @@
+"""Bake time of Mantaflow vs Plume on the same smoke scene, in one Blender process.
+
+    blender -b --factory-startup --python examples/compare_mantaflow.py -- RES FRAMES
+
+Scene (built twice): a 2 m cube domain standing on the floor (z 0..2), a UV sphere of radius
+0.16 m at (0, 0, 0.3) emitting smoke (density 1, temperature 1), RES cells along every axis,
+frames 1..FRAMES at the factory 24 fps, one solver step per frame, vorticity, alpha and beta equal
+in both, closed floor and open sides/top in both.
+
+1. Mantaflow: Quick Smoke on the sphere, then the domain is moved/scaled onto the cube above;
+   resolution_max RES, adaptive time steps off, timesteps_min = timesteps_max = 1, cache_type
+   'MODULAR', cache_data_format 'OPENVDB' with full 32-bit floats (Plume writes float32), noise,
+   mesh and particles off, default advection (MacCormack), baked with bpy.ops.fluid.bake_data()
+   into a temp folder.
+2. Plume: a cube domain and the same sphere as SOURCE, BFECC + monotonic cubic, pressure
+   tolerance 1e-3, substeps 1 and no CFL sub-stepping, baked with bpy.ops.plume.bake() into a temp
+   folder.
+
+Each bake is timed with time.perf_counter() around the bake operator only (wall clock, VDB
+writing included). Both caches are checked (one VDB per frame, smoke in the last frame) and the
+script fails (exit code 1) otherwise. Peak memory: ru_maxrss is the peak of the whole process and
+cannot be split between two bakes in one process; on Linux the peak RSS (VmHWM) is reset through
+/proc/self/clear_refs before each bake instead, and the cache sizes are printed too. The last line
+printed is exactly ``ratio: X`` with X = Mantaflow s/frame / Plume s/frame (2 decimals).
+
+Needs the Plume add-on installed (BLENDER_USER_SCRIPTS/addons/plume or
+~/.config/blender/3.4/scripts/addons/plume). Set PLUME_COMPARE_KEEP=1 to keep the cache folders.
+"""
+
+import gzip
+import os
+import re
+import shutil
+import struct
+import sys
+import tempfile
+import time
+import traceback
+
+import addon_utils
+import bpy
+
+USAGE = ("usage: blender -b --factory-startup --python examples/compare_mantaflow.py -- RES FRAMES\n"
+         "  RES     cells along each axis of the 2 m cube domain, integer in [8, 1024]\n"
+         "  FRAMES  frames to bake (1..FRAMES), integer >= 1")
+
+# Shared scene and physics settings (same value in both solvers).
+DOMAIN_SIZE = 2.0                  # m, cube standing on the floor
+DOMAIN_CENTER = (0.0, 0.0, 1.0)
+SOURCE_RADIUS = 0.16
+SOURCE_CENTER = (0.0, 0.0, 0.3)
+SOURCE_DENSITY = 1.0
+SOURCE_TEMPERATURE = 1.0           # temperature difference to the ambient air
+VORTICITY = 0.2                    # Plume's default ε
+ALPHA = 1.0                        # density buoyancy (both: > 0 makes dense smoke rise)
+BETA = 1.0                         # heat buoyancy
+PRESSURE_TOLERANCE = 1e-3          # Plume; Mantaflow's fixed gas cgAccuracy is also 1e-3
+
+MANTA_DOMAIN = "MantaDomain"
+PLUME_DOMAIN = "PlumeDomain"
+MIB = 1024.0 * 1024.0
+
+
+class CompareError(Exception):
+    """A bake failed or produced no usable data."""
+
+
+def parse_args():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    if len(argv) != 2:
+        sys.exit(f"{USAGE}\nerror: expected 2 arguments after '--', got {len(argv)}: {argv}")
+    values = []
+    for name, text in zip(("RES", "FRAMES"), argv):
+        try:
+            values.append(int(text))
+        except ValueError:
+            sys.exit(f"{USAGE}\nerror: {name} must be an integer (got {text!r})")
+    res, frames = values
+    if not 8 <= res <= 1024:
+        sys.exit(f"{USAGE}\nerror: RES must be in [8, 1024] (got {res})")
+    if frames < 1:
+        sys.exit(f"{USAGE}\nerror: FRAMES must be at least 1 (got {frames})")
+    return res, frames
+
+
+# --- memory -------------------------------------------------------------------------------------
+
+def _status_kib(field):
+    try:
+        with open("/proc/self/status") as f:
+            m = re.search(rf"^{field}:\s+(\d+)\s+kB", f.read(), re.M)
+        return int(m.group(1)) if m else None
+    except OSError:
+        return None
+
+
+def reset_peak_rss():
+    """Resets VmHWM (Linux >= 4.0); returns the current RSS in KiB, or None if unsupported."""
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+    except OSError:
+        return None
+    rss, hwm = _status_kib("VmRSS"), _status_kib("VmHWM")
+    if rss is None or hwm is None or hwm > rss + 1024:  # the reset did not take
+        return None
+    return rss
+
+
+def peak_rss_since_reset():
+    return _status_kib("VmHWM")
+
+
+# --- helpers ------------------------------------------------------------------------------------
+
+def clear_scene():
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob, do_unlink=True)
+
+
+def select_only(obj):
+    vl = bpy.context.view_layer
+    for o in vl.objects:
+        o.select_set(False)
+    obj.select_set(True)
+    vl.objects.active = obj
+
+
+def folder_bytes(folder, pattern=None):
+    total = 0
+    for root, _dirs, files in os.walk(folder):
+        for name in files:
+            if pattern is None or re.fullmatch(pattern, name):
+                total += os.path.getsize(os.path.join(root, name))
+    return total
+
+
+def check_vdb_frames(kind, paths, native):
+    """Every frame's VDB exists, is non-empty and has a density grid; smoke in the last one."""
+    missing = [p for p in paths if not os.path.isfile(p) or os.path.getsize(p) == 0]
+    if missing:
+        raise CompareError(f"{kind} bake produced no data for {len(missing)} of {len(paths)} "
+                           f"frames, e.g. {missing[0]}")
+    for p in (paths[0], paths[-1]):
+        names = native.vdb_grid_names(p)
+        if "density" not in names:
+            raise CompareError(f"{kind}: {p} has no 'density' grid (grids: {names})")
+    grid = native.read_vdb_grid(paths[-1], "density")
+    values = grid["values"]
+    peak = float(values.max()) if values.size else 0.0
+    if not peak > 0.0:
+        raise CompareError(f"{kind}: the density of the last frame ({paths[-1]}) is empty")
+    return peak
+
+
+# --- Mantaflow ----------------------------------------------------------------------------------
+
+def build_mantaflow(res, frames, cache_dir):
+    """Quick Smoke on a small sphere, domain moved onto the shared 2 m cube. Returns (domain, sphere)."""
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=SOURCE_RADIUS, location=SOURCE_CENTER)
+    sphere = bpy.context.active_object
+    sphere.name = "SmokeSource"
+    select_only(sphere)
+    if bpy.ops.object.quick_smoke(style='SMOKE') != {'FINISHED'}:
+        raise CompareError("bpy.ops.object.quick_smoke() failed")
+    dom = bpy.context.active_object
+    dom.name = MANTA_DOMAIN
+    # Quick Smoke sizes the domain around the sphere (+1 m, +2 m up): put it on the shared cube.
+    # The default cube has size 2, so scale 1 = the 2 m cube.
+    dom.location = DOMAIN_CENTER
+    dom.scale = (DOMAIN_SIZE / 2.0,) * 3
+
+    ds = next(m for m in dom.modifiers if m.type == 'FLUID').domain_settings
+    ds.domain_type = 'GAS'
+    ds.resolution_max = res
+    ds.use_adaptive_timesteps = False
+    ds.timesteps_min = 1
+    ds.timesteps_max = 1
+    ds.time_scale = 1.0
+    ds.use_adaptive_domain = False
+    ds.use_noise = False
+    ds.use_dissolve_smoke = False
+    ds.use_guide = False
+    ds.vorticity = VORTICITY
+    ds.alpha = ALPHA
+    ds.beta = BETA
+    ds.gravity = (0.0, 0.0, -9.81)  # used when the scene has no gravity; the scene's is the same
+    # Plume's default boundaries: closed floor, open elsewhere.
+    ds.use_collision_border_bottom = True
+    for side in ("top", "front", "back", "left", "right"):
+        setattr(ds, "use_collision_border_" + side, False)
+    ds.cache_type = 'MODULAR'
+    ds.cache_data_format = 'OPENVDB'
+    ds.openvdb_data_depth = '32'            # full floats, like Plume's float32 grids
+    ds.openvdb_cache_compress_type = 'BLOSC'  # Plume writes Blosc too
+    ds.cache_resumable = False
+    ds.cache_directory = cache_dir
+    ds.cache_frame_start = 1
+    ds.cache_frame_end = frames
+    # (Mesh, particles and noise are liquid/upres options and stay off for a gas domain.)
+
+    fs = next(m for m in sphere.modifiers if m.type == 'FLUID').flow_settings
+    fs.flow_type = 'SMOKE'
+    fs.flow_behavior = 'INFLOW'
+    fs.flow_source = 'MESH'
+    fs.density = SOURCE_DENSITY
+    fs.temperature = SOURCE_TEMPERATURE
+    fs.volume_density = 1.0   # fill the sphere like Plume's voxelized source (Quick Smoke: 0, shell only)
+    fs.use_initial_velocity = False
+    fs.subframes = 0
+    return dom, sphere
+
+
+def bake_mantaflow(dom):
+    select_only(dom)
+    with bpy.context.temp_override(object=dom, active_object=dom, selected_objects=[dom]):
+        t0 = time.perf_counter()
+        result = bpy.ops.fluid.bake_data()
+        seconds = time.perf_counter() - t0
+    if result != {'FINISHED'}:
+        raise CompareError(f"bpy.ops.fluid.bake_data() returned {result}")
+    return seconds
+
+
+def read_manta_config(path):
+    """(res, dt, time_total) from Mantaflow's config_####.uni (fluid.c manta_write_config, cache
+    version C01), or None if the layout is not the expected one."""
+    try:
+        with gzip.open(path, "rb") as f:
+            b = f.read()
+    except OSError:
+        return None
+    if len(b) < 32 or b[-4:] != b"C01\x00":
+        return None
+    res = struct.unpack_from("<3i", b, 4)
+    dt = struct.unpack_from("<f", b, 20)[0]
+    time_total = struct.unpack_from("<f", b, len(b) - 8)[0]
+    return res, dt, time_total
+
+
+def check_mantaflow(cache_dir, res, frames, native):
+    data = [os.path.join(cache_dir, "data", f"fluid_data_{f:04d}.vdb") for f in range(1, frames + 1)]
+    peak = check_vdb_frames("Mantaflow", data, native)
+    # One step per frame: dt must be the whole frame and the simulated time frames * dt.
+    fps = bpy.context.scene.render.fps / bpy.context.scene.render.fps_base
+    frame_length = 0.1 * (25.0 / fps)  # fluid.c: DT_DEFAULT * (25 / fps) * time_scale
+    cfg = read_manta_config(os.path.join(cache_dir, "config", f"config_{frames:04d}.uni"))
+    if cfg is None:
+        print("compare_mantaflow: warning: cannot read Mantaflow's config file; "
+              "one step per frame not verified", flush=True)
+        return peak, None
+    grid_res, dt, time_total = cfg
+    if tuple(grid_res) != (res, res, res):
+        raise CompareError(f"Mantaflow grid is {grid_res}, expected {(res, res, res)}")
+    if abs(dt - frame_length) > 1e-5 * frame_length or \
+            abs(time_total - frames * frame_length) > 1e-3 * frames * frame_length:
+        raise CompareError(f"Mantaflow did not take one step per frame: dt {dt:.6g}, simulated "
+                           f"time {time_total:.6g}, frame length {frame_length:.6g}")
+    return peak, grid_res
+
+
+def remove_mantaflow(dom, sphere):
+    """Frees the Mantaflow domain (and its solver memory) and the sphere's flow modifier."""
+    for m in [m for m in sphere.modifiers if m.type == 'FLUID']:
+        sphere.modifiers.remove(m)
+    mesh = dom.data
+    bpy.data.objects.remove(dom, do_unlink=True)
+    if mesh.users == 0:
+        bpy.data.meshes.remove(mesh)
+
+
+# --- Plume --------------------------------------------------------------------------------------
+
+def build_plume(res, frames, cache_dir, sphere):
+    bpy.ops.mesh.primitive_cube_add(size=DOMAIN_SIZE, location=DOMAIN_CENTER)
+    dom = bpy.context.active_object
+    dom.name = PLUME_DOMAIN
+    select_only(dom)
+    bpy.ops.plume.role_set(role='DOMAIN')
+    d = dom.plume.domain
+    d.resolution = res
+    d.frame_start, d.frame_end = 1, frames
+    d.time_scale = 1.0
+    d.cache_directory = cache_dir
+    d.advection = 'BFECC'
+    d.interpolation = 'MONOTONIC_CUBIC'
+    d.vorticity = VORTICITY
+    d.alpha = ALPHA
+    d.beta = BETA
+    d.gravity = (0.0, 0.0, -9.81)
+    d.pressure_tolerance = PRESSURE_TOLERANCE
+    d.substeps = 1
+    d.use_cfl = False
+    d.threads = 0
+    d.combustion = False
+    d.density_dissipation = 0.0
+    d.wind_strength = 0.0
+    for side in ("neg_x", "pos_x", "neg_y", "pos_y", "pos_z"):
+        setattr(d, "boundary_" + side, 'OPEN')
+    d.boundary_neg_z = 'CLOSED'
+
+    select_only(sphere)
+    bpy.ops.plume.role_set(role='SOURCE')
+    s = sphere.plume.source
+    s.density = SOURCE_DENSITY
+    s.temperature = SOURCE_TEMPERATURE
+    s.velocity = (0.0, 0.0, 0.0)
+    if dom.plume.role != 'DOMAIN' or sphere.plume.role != 'SOURCE':
+        raise CompareError("plume.role_set did not set the domain/source roles")
+    return dom
+
+
+def bake_plume(dom):
+    select_only(dom)
+    t0 = time.perf_counter()
+    result = bpy.ops.plume.bake()  # RuntimeError with Plume's message on failure
+    seconds = time.perf_counter() - t0
+    if result != {'FINISHED'}:
+        raise CompareError(f"bpy.ops.plume.bake() returned {result}")
+    return seconds
+
+
+def check_plume(folder, frames, native):
+    vdbs = [os.path.join(folder, f"volume_{f:04d}.vdb") for f in range(1, frames + 1)]
+    return check_vdb_frames("Plume", vdbs, native)
+
+
+# --- main ---------------------------------------------------------------------------------------
+
+def report(name, seconds, frames, cache_bytes, vdb_bytes, rss0, peak, extra=""):
+    mem = "n/a (cannot reset the peak RSS on this system)"
+    if rss0 is not None and peak is not None:
+        mem = f"{peak / 1024.0:.0f} MiB (+{max(0, peak - rss0) / 1024.0:.0f} MiB over the start)"
+    print(f"{name}: {seconds:.2f} s for {frames} frames = {seconds / frames:.3f} s/frame; "
+          f"cache {cache_bytes / MIB:.1f} MiB ({vdb_bytes / MIB:.1f} MiB VDB){extra}; "
+          f"peak RSS during bake {mem}", flush=True)
+
+
+def run(res, frames, work):
+    mod = addon_utils.enable("plume", default_set=True)
+    if mod is None or not hasattr(bpy.ops.plume, "bake"):
+        raise CompareError("the plume add-on is not installed (see README: install_addon)")
+    from plume import _native  # the add-on's native module (VDB reading for the checks)
+
+    if not bpy.app.build_options.fluid or not bpy.app.build_options.openvdb:
+        raise CompareError("this Blender is built without Mantaflow (fluid) or OpenVDB")
+
+    scene = bpy.context.scene
+    clear_scene()
+    scene.frame_start, scene.frame_end = 1, frames
+    scene.frame_set(1)
+    manta_dir = os.path.join(work, "mantaflow")
+    plume_dir = os.path.join(work, "plume")
+    os.makedirs(manta_dir)
+    os.makedirs(plume_dir)
+    print(f"compare_mantaflow: {res}^3 cells, {frames} frames at {scene.render.fps} fps, "
+          f"caches in {work}", flush=True)
+
+    # 1. Mantaflow
+    manta_dom, sphere = build_mantaflow(res, frames, manta_dir)
+    rss0 = reset_peak_rss()
+    manta_s = bake_mantaflow(manta_dom)
+    manta_peak = peak_rss_since_reset() if rss0 is not None else None
+    manta_rss0 = rss0
+    manta_density, _ = check_mantaflow(manta_dir, res, frames, _native)
+    manta_cache = folder_bytes(manta_dir)
+    manta_vdb = folder_bytes(os.path.join(manta_dir, "data"), r"fluid_data_\d+\.vdb")
+    remove_mantaflow(manta_dom, sphere)
+    scene.frame_set(1)
+
+    # 2. Plume
+    plume_dom = build_plume(res, frames, plume_dir + os.sep, sphere)
+    rss0 = reset_peak_rss()
+    plume_s = bake_plume(plume_dom)
+    plume_peak = peak_rss_since_reset() if rss0 is not None else None
+    plume_folder = os.path.join(plume_dir, plume_dom.name)
+    plume_density = check_plume(plume_folder, frames, _native)
+    plume_cache = folder_bytes(plume_folder)
+    plume_vdb = folder_bytes(plume_folder, r"volume_\d+\.vdb")
+
+    report("mantaflow", manta_s, frames, manta_cache, manta_vdb, manta_rss0, manta_peak,
+           f", max density {manta_density:.3g}")
+    state_bytes = folder_bytes(plume_folder, r"state\.bin")
+    report("plume", plume_s, frames, plume_cache, plume_vdb, rss0, plume_peak,
+           f", max density {plume_density:.3g}, incl. state.bin checkpoint "
+           f"{state_bytes / MIB:.1f} MiB")
+    if rss0 is None:
+        print("note: ru_maxrss is the peak of the whole process and cannot be split between "
+              "the two bakes; compare the cache sizes instead", flush=True)
+    return (manta_s / frames) / (plume_s / frames)
+
+
+def main():
+    res, frames = parse_args()
+    work = tempfile.mkdtemp(prefix="plume_vs_mantaflow_")
+    keep = os.environ.get("PLUME_COMPARE_KEEP", "") not in ("", "0")
+    try:
+        ratio = run(res, frames, work)
+    except Exception as e:  # noqa: BLE001 - any failure must end the run with exit code 1
+        traceback.print_exc()
+        print(f"compare_mantaflow: FAILED: {e}", file=sys.stderr, flush=True)
+        sys.exit(1)
+    finally:
+        if keep:
+            print(f"compare_mantaflow: caches kept in {work}", flush=True)
+        else:
+            shutil.rmtree(work, ignore_errors=True)
+    print(f"ratio: {ratio:.2f}", flush=True)
+    sys.exit(0)  # skip Blender's own "Blender quit" line: "ratio" stays the last line
+
+
+if __name__ == "__main__":
+    main()
