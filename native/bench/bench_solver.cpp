@@ -2,6 +2,11 @@
 /// Google Benchmark of the smoke solver: whole steps, each stage of step(), and VDB output, on a
 /// warmed-up plume (BFECC + monotonic cubic, vorticity confinement, buoyancy, spherical source on
 /// a closed floor, open sides). Not a test: run build/native/plume_bench by hand.
+///
+/// Memory: peak_rss_MB is the peak of the whole process so far, so it includes every solver an
+/// earlier benchmark of the same run built (they are cached). For the peak of one solver, run one
+/// size per process, e.g. plume_bench --benchmark_filter='BM_Step/128'; rss_MB is the resident
+/// set when the benchmark ends.
 
 #include "io/vdb_frame.h"
 #include "solver/emitters.h"
@@ -9,11 +14,13 @@
 
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <tuple>
 #include <memory>
 #include <utility>
 
@@ -27,6 +34,16 @@ double peakRssMb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return double(usage.ru_maxrss) / 1024.0;
+}
+
+/// Resident set of the process now, MB (second field of /proc/self/statm, in pages).
+double rssMb() {
+  long pages = 0, resident = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+    std::fclose(f);
+  }
+  return double(resident) * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
 
 /// UV sphere of radius r around c: the source mesh.
@@ -56,11 +73,11 @@ EmitterMesh sphere(glm::vec3 c, float r, int rings = 16, int segments = 32) {
   return m;
 }
 
-SmokeParams benchParams(int n, bool fire) {
+SmokeParams benchParams(int n, bool fire, Advection scheme) {
   SmokeParams p;
   p.resolution = glm::ivec3(n);
   p.cellSize = 1.f / float(n);
-  p.advection = Advection::Bfecc;
+  p.advection = scheme;
   p.interpolation = Interpolation::MonotonicCubic;
   p.vorticity = 0.3f;
   p.alpha = 1.f;
@@ -73,11 +90,11 @@ SmokeParams benchParams(int n, bool fire) {
 
 /// One warmed-up solver per (resolution, fire), built once: Google Benchmark calls each
 /// benchmark function several times while it sizes the iteration count.
-SmokeSolver& warmSolver(int n, bool fire) {
-  static std::map<std::pair<int, bool>, std::unique_ptr<SmokeSolver>> cache;
-  auto& slot = cache[{n, fire}];
+SmokeSolver& warmSolver(int n, bool fire, Advection scheme = Advection::Bfecc) {
+  static std::map<std::tuple<int, bool, Advection>, std::unique_ptr<SmokeSolver>> cache;
+  auto& slot = cache[{n, fire, scheme}];
   if (!slot) {
-    slot = std::make_unique<SmokeSolver>(benchParams(n, fire));
+    slot = std::make_unique<SmokeSolver>(benchParams(n, fire, scheme));
     SourceSettings settings;
     settings.density = 1.f;
     settings.temperature = 2.f;
@@ -108,8 +125,8 @@ struct Snapshot {
   }
 };
 
-void BM_Step(benchmark::State& state) {
-  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false);
+void stepBenchmark(benchmark::State& state, Advection scheme) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false, scheme);
   const float dt = solver.params().frameDt;
   double iterations = 0.0;
   for (auto _ : state) {
@@ -120,13 +137,20 @@ void BM_Step(benchmark::State& state) {
                                                      benchmark::Counter::kIsRate);
   state.counters["pressure_iters"] = iterations / double(state.iterations());
   state.counters["peak_rss_MB"] = peakRssMb();
+  state.counters["rss_MB"] = rssMb();
 }
+
+void BM_Step(benchmark::State& state) { stepBenchmark(state, Advection::Bfecc); }
+/// The same step with MacCormack advection (Selle et al. 2008): two interpolation passes a field.
+void BM_StepMacCormack(benchmark::State& state) { stepBenchmark(state, Advection::MacCormack); }
 BENCHMARK(BM_Step)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_StepMacCormack)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// Times `stage` alone, each iteration from the state the previous stages of a step leave.
 template <typename Stage>
-void stageBenchmark(benchmark::State& state, bool fire, int before, Stage stage) {
-  SmokeSolver& solver = warmSolver(int(state.range(0)), fire);
+void stageBenchmark(benchmark::State& state, bool fire, int before, Stage stage,
+                    Advection scheme = Advection::Bfecc) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), fire, scheme);
   const float dt = solver.params().frameDt;
   using Member = void (SmokeSolver::*)(float);
   const Member order[] = {&SmokeSolver::applySources, &SmokeSolver::addForces,
@@ -144,6 +168,7 @@ void stageBenchmark(benchmark::State& state, bool fire, int before, Stage stage)
   state.counters["cells_per_s"] = benchmark::Counter(
       double(state.iterations()) * double(solver.density().count()), benchmark::Counter::kIsRate);
   state.counters["peak_rss_MB"] = peakRssMb();
+  state.counters["rss_MB"] = rssMb();
 }
 
 void BM_Stage_applySources(benchmark::State& state) {
@@ -154,6 +179,10 @@ void BM_Stage_addForces(benchmark::State& state) {
 }
 void BM_Stage_advect(benchmark::State& state) {
   stageBenchmark(state, false, 2, [](SmokeSolver& s, float dt) { s.advect(dt); });
+}
+void BM_Stage_advectMacCormack(benchmark::State& state) {
+  stageBenchmark(
+      state, false, 2, [](SmokeSolver& s, float dt) { s.advect(dt); }, Advection::MacCormack);
 }
 void BM_Stage_burn(benchmark::State& state) {
   stageBenchmark(state, /*fire=*/true, 3, [](SmokeSolver& s, float dt) { s.burn(dt); });
@@ -169,6 +198,7 @@ void BM_Stage_project(benchmark::State& state) {
 BENCHMARK(BM_Stage_applySources)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_addForces)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_advect)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stage_advectMacCormack)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_burn)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_project)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -178,7 +178,8 @@ void bindParams(py::module_& m) {
   field(c, "substeps", &SmokeParams::substeps, "Minimum steps per frame.");
   field(c, "use_cfl", &SmokeParams::useCfl, "Add steps so no cell moves more than `cfl` cells.");
   field(c, "cfl", &SmokeParams::cfl, "CFL number of the adaptive steps.");
-  field(c, "advection", &SmokeParams::advection, "Advection.SEMI_LAGRANGIAN or Advection.BFECC.");
+  field(c, "advection", &SmokeParams::advection,
+        "Advection.SEMI_LAGRANGIAN, Advection.BFECC or Advection.MACCORMACK.");
   field(c, "interpolation", &SmokeParams::interpolation,
         "Interpolation.LINEAR or Interpolation.MONOTONIC_CUBIC (Fedkiw 2001 eq. 12-13).");
   field(c, "conserve_mass", &SmokeParams::conserveMass,
@@ -328,7 +329,7 @@ void bindSmokeSolver(py::module_& m) {
       "Per-cell wind velocity u_wind, shape (nx, ny, nz, 3), replacing the constant `wind`; "
       "None restores the constant.");
 
-  c.def("advance_frame", &SmokeSolver::advanceFrame, py::call_guard<py::gil_scoped_release>(),
+  c.def("advance_frame", [](SmokeSolver& s) { return s.advanceFrame(); }, py::call_guard<py::gil_scoped_release>(),
         "Advances one frame (substeps, more if the CFL condition needs them). Releases the GIL. "
         "Returns False when cancel() was called; the state is then mid-frame and must be "
         "discarded.");
@@ -342,7 +343,7 @@ void bindSmokeSolver(py::module_& m) {
         py::call_guard<py::gil_scoped_release>(),
         "Stage: buoyancy (Fedkiw 2001 eq. 8), wind, vorticity confinement (eq. 11).");
   c.def("advect", &SmokeSolver::advect, py::arg("dt"), py::call_guard<py::gil_scoped_release>(),
-        "Stage: semi-Lagrangian or BFECC advection of velocity and scalars.");
+        "Stage: semi-Lagrangian, BFECC or MacCormack advection of velocity and scalars.");
   c.def("burn", &SmokeSolver::burn, py::arg("dt"), py::call_guard<py::gil_scoped_release>(),
         "Stage: combustion (graph_fire_synthesis eqs. 3-5) and divergence φ (eq. 1).");
   c.def("dissipate", &SmokeSolver::dissipate, py::arg("dt"),

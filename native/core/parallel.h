@@ -22,12 +22,36 @@ void parallelFor(int begin, int end, const Body& body) {
                     });
 }
 
+namespace detail {
+
+/// One partial result per index of a reduction: on the stack for up to kStack indices (every
+/// grid axis in practice), so that a solver step never allocates; on the heap beyond.
+class Partials {
+ public:
+  static constexpr std::size_t kStack = 2048;
+  explicit Partials(std::size_t count) : mCount(count) {
+    if (count > kStack) mHeap.resize(count);
+    mData = count > kStack ? mHeap.data() : mStack;
+  }
+  double& operator[](std::size_t n) { return mData[n]; }
+  const double* begin() const { return mData; }
+  const double* end() const { return mData + mCount; }
+
+ private:
+  std::size_t mCount;
+  double mStack[kStack];
+  std::vector<double> mHeap;
+  double* mData;
+};
+
+}  // namespace detail
+
 /// Sum of term(n) over [begin, end) as double. Partial sums are formed per n and added in
 /// index order, so the result is bit-identical for any thread count.
 template <typename Term>
 double parallelSum(int begin, int end, const Term& term) {
   if (end <= begin) return 0.0;
-  std::vector<double> partial(std::size_t(end - begin), 0.0);
+  detail::Partials partial(std::size_t(end - begin));
   parallelFor(begin, end, [&](int n) { partial[std::size_t(n - begin)] = term(n); });
   double sum = 0.0;
   for (double p : partial) sum += p;
@@ -38,9 +62,9 @@ double parallelSum(int begin, int end, const Term& term) {
 template <typename Term>
 double parallelMax(int begin, int end, const Term& term) {
   if (end <= begin) return 0.0;
-  std::vector<double> partial(std::size_t(end - begin), 0.0);
+  detail::Partials partial(std::size_t(end - begin));
   parallelFor(begin, end, [&](int n) { partial[std::size_t(n - begin)] = term(n); });
-  double m = partial[0];
+  double m = *partial.begin();
   for (double p : partial) m = p > m ? p : m;
   return m;
 }

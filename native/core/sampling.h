@@ -20,6 +20,10 @@ float sampleLinear(const ScalarGrid& grid, glm::vec3 p);
 /// (Fritsch & Carlson) so that no new extrema appear. Applied per axis (x, then y, then z).
 float sampleMonotonicCubic(const ScalarGrid& grid, glm::vec3 p);
 
+/// sampleMonotonicCubic() at four points p[0..3] into out[0..3]: the same values, with the last
+/// (z) cubic of the four samples computed together. Advection samples runs of points this way.
+void sampleMonotonicCubic4(const ScalarGrid& grid, const glm::vec3* p, float* out);
+
 /// Dispatches on the interpolation scheme.
 inline float sample(const ScalarGrid& grid, glm::vec3 p, Interpolation scheme) {
   return scheme == Interpolation::Linear ? sampleLinear(grid, p) : sampleMonotonicCubic(grid, p);

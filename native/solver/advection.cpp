@@ -20,39 +20,66 @@ void forEachRun(glm::ivec3 n, const BlockMask* mask, const Run& run, const Idle&
   });
 }
 
-/// One semi-Lagrangian pass over traced positions: dst(x) = src(trace(x)). With `clampTo`, the
-/// result is limited to the range of *clampTo around the traced point (BFECC's limiter).
+/// One semi-Lagrangian pass over traced positions: dst(x) = finish(c, src(trace(x))), c the
+/// linear index of x. `finish` applies the corrections and limiters of BFECC and MacCormack.
+template <typename Finish>
 void pass(const ScalarGrid& src, ScalarGrid& dst, const std::vector<glm::vec3>& traced,
-          Interpolation interpolation, const ScalarGrid* clampTo, const BlockMask* mask,
-          float background) {
-  forEachRun(
-      src.size(), mask,
-      [&](int i0, int i1, int j, int k) {
-        std::size_t c = src.index(i0, j, k);
-        for (int i = i0; i < i1; ++i, ++c) {
-          const glm::vec3 q = traced[c];
-          float value = sample(src, q, interpolation);
-          if (clampTo) {
-            float lo, hi;
-            sampleRange(*clampTo, q, lo, hi);
-            value = value < lo ? lo : (value > hi ? hi : value);
+          Interpolation interpolation, const BlockMask* mask, float background,
+          const Finish& finish) {
+  // sampler(c, count, values) samples src at the `count` <= 4 traced points from index c on.
+  auto runs = [&](const auto& sampler) {
+    forEachRun(
+        src.size(), mask,
+        [&](int i0, int i1, int j, int k) {
+          std::size_t c = src.index(i0, j, k);
+          for (int i = i0; i < i1; i += 4, c += 4) {
+            const int count = std::min(4, i1 - i);
+            float values[4];
+            sampler(c, count, values);
+            for (int m = 0; m < count; ++m) dst[c + m] = finish(c + m, values[m]);
           }
-          dst[c] = value;
-        }
-      },
-      [&](int i0, int i1, int j, int k) {
-        std::size_t c = src.index(i0, j, k);
-        for (int i = i0; i < i1; ++i, ++c) dst[c] = background;
-      });
+        },
+        [&](int i0, int i1, int j, int k) {
+          std::size_t c = src.index(i0, j, k);
+          for (int i = i0; i < i1; ++i, ++c) dst[c] = background;
+        });
+  };
+  // The scheme is chosen once per pass, not per sample; cubic samples go four at a time.
+  if (interpolation == Interpolation::Linear) {
+    runs([&](std::size_t c, int count, float* values) {
+      for (int m = 0; m < count; ++m) values[m] = sampleLinear(src, traced[c + m]);
+    });
+  } else {
+    runs([&](std::size_t c, int count, float* values) {
+      if (count == 4) sampleMonotonicCubic4(src, &traced[c], values);
+      else
+        for (int m = 0; m < count; ++m) values[m] = sampleMonotonicCubic(src, traced[c + m]);
+    });
+  }
+}
+
+/// The plain semi-Lagrangian value.
+constexpr auto kAsIs = [](std::size_t, float value) { return value; };
+
+/// value clamped to the range of φ around the back-traced point q (the limiter of BFECC and
+/// MacCormack: no new extrema).
+inline float clampToRange(const ScalarGrid& phi, glm::vec3 q, float value) {
+  float lo, hi;
+  sampleRange(phi, q, lo, hi);
+  return value < lo ? lo : (value > hi ? hi : value);
+}
+
+/// traceBack() with the velocity v1 at p already known (BFECC's back and forth traces share it).
+inline glm::vec3 traceBackFrom(const MacGrid3& velocity, glm::vec3 p, glm::vec3 v1, float cells) {
+  const glm::vec3 mid = p - 0.5f * cells * v1;
+  const glm::vec3 v2 = sampleVelocity(velocity, mid);
+  return p - cells * v2;
 }
 
 }  // namespace
 
 glm::vec3 traceBack(const MacGrid3& velocity, glm::vec3 p, float cells) {
-  const glm::vec3 v1 = sampleVelocity(velocity, p);
-  const glm::vec3 mid = p - 0.5f * cells * v1;
-  const glm::vec3 v2 = sampleVelocity(velocity, mid);
-  return p - cells * v2;
+  return traceBackFrom(velocity, p, sampleVelocity(velocity, p), cells);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -126,9 +153,10 @@ void Advector::trace(const MacGrid3& velocity, glm::ivec3 size, glm::vec3 offset
   mScheme = scheme;
   const std::size_t count = std::size_t(size.x) * size.y * size.z;
   mBack.resize(count);
-  if (scheme == Advection::Bfecc) mFore.resize(count);
+  // BFECC and MacCormack also need the forward traces (their reverse step A⁻¹).
+  const bool both = scheme != Advection::SemiLagrangian;
+  if (both) mFore.resize(count);
   const float cells = dt / cellSize;
-  const bool both = scheme == Advection::Bfecc;
   forEachRun(
       size, mask,
       [&](int i0, int i1, int j, int k) {
@@ -136,8 +164,9 @@ void Advector::trace(const MacGrid3& velocity, glm::ivec3 size, glm::vec3 offset
         for (int i = i0; i < i1; ++i, ++c) {
           const glm::vec3 p = glm::vec3(i, j, k) + offset;
           // Positions are stored in the grid's own index space (cell coordinates - offset).
-          mBack[c] = traceBack(velocity, p, cells) - offset;
-          if (both) mFore[c] = traceBack(velocity, p, -cells) - offset;
+          const glm::vec3 v1 = sampleVelocity(velocity, p);
+          mBack[c] = traceBackFrom(velocity, p, v1, cells) - offset;
+          if (both) mFore[c] = traceBackFrom(velocity, p, v1, -cells) - offset;
         }
       },
       [](int, int, int, int) {});
@@ -147,22 +176,27 @@ void Advector::advect(const ScalarGrid& src, ScalarGrid& dst, Interpolation inte
                       const BlockMask* mask, float background) {
   dst.reshape(src.size());
   if (mScheme == Advection::SemiLagrangian) {
-    pass(src, dst, mBack, interpolation, nullptr, mask, background);
+    pass(src, dst, mBack, interpolation, mask, background, kAsIs);
     return;
   }
-  // BFECC (Kim et al. 2005): forward, backward, then forward again from the corrected field.
+  // φ̂ = A(φ): the semi-Lagrangian step along the back-traces.
   mForward.reshape(src.size());
+  pass(src, mForward, mBack, interpolation, mask, background, kAsIs);
+  if (mScheme == Advection::MacCormack) {
+    // Selle et al. 2008 eq. 7: φ = φ̂ + ½(φⁿ - φ̄) with φ̄ = A⁻¹(φ̂), fused with the reverse step,
+    // then clamped to the range of φⁿ around the back-traced point (§4, first limiter).
+    pass(mForward, dst, mFore, interpolation, mask, background, [&](std::size_t c, float bar) {
+      return clampToRange(src, mBack[c], mForward[c] + 0.5f * (src[c] - bar));
+    });
+    return;
+  }
+  // BFECC (Kim et al. 2005): φ̄ = A⁻¹(φ̂) and the corrected field φ + ½(φ - φ̄) in one pass...
   mBackward.reshape(src.size());
-  pass(src, mForward, mBack, interpolation, nullptr, mask, background);        // φ̂
-  pass(mForward, mBackward, mFore, interpolation, nullptr, mask, background);  // φ̄
-  const std::size_t slice = std::size_t(src.size().x) * src.size().y;
-  parallelFor(0, src.size().z, [&](int k) {
-    // The error estimate ½(φ - φ̄) is added to φ before the final pass.
-    for (std::size_t n = std::size_t(k) * slice, e = n + slice; n < e; ++n)
-      mBackward[n] = src[n] + 0.5f * (src[n] - mBackward[n]);
-  });
-  // The limiter clamps to the range of the original φ so no new extrema appear.
-  pass(mBackward, dst, mBack, interpolation, &src, mask, background);
+  pass(mForward, mBackward, mFore, interpolation, mask, background,
+       [&](std::size_t c, float bar) { return src[c] + 0.5f * (src[c] - bar); });
+  // ...then forward again from it, clamped to the range of the original φ (no new extrema).
+  pass(mBackward, dst, mBack, interpolation, mask, background,
+       [&](std::size_t c, float value) { return clampToRange(src, mBack[c], value); });
 }
 
 }  // namespace plume

@@ -1,7 +1,8 @@
 #pragma once
 /// \file advection.h
-/// Semi-Lagrangian advection (Stam 1999) and BFECC (Kim, Liu, Llamas & Rossignac 2005) with a
-/// clamp limiter, for cell-centred scalars and the staggered velocity components.
+/// Semi-Lagrangian advection (Stam 1999), BFECC (Kim, Liu, Llamas & Rossignac 2005) and
+/// MacCormack (Selle, Fedkiw, Kim, Liu & Rossignac 2008), the last two with a clamp limiter, for
+/// cell-centred scalars and the staggered velocity components.
 ///
 /// Speed: back-traces are computed once per grid layout and shared by every field on it (density,
 /// temperature, fuel and soot share one trace), and scalar fields skip the blocks of cells that
@@ -67,6 +68,7 @@ class Advector {
 
   /// dst = src advected with the last trace(). With BFECC: φ̂ = A(φ), φ̄ = A⁻¹(φ̂),
   /// result = A(φ + ½(φ - φ̄)) clamped to the range of φ around the back-traced point.
+  /// With MacCormack: result = φ̂ + ½(φ - φ̄), clamped the same way (two passes, not three).
   /// Outside the active blocks of `mask` dst is `background`. dst must not alias src.
   void advect(const ScalarGrid& src, ScalarGrid& dst, Interpolation interpolation,
               const BlockMask* mask, float background);

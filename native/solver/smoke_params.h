@@ -12,8 +12,9 @@
 
 namespace plume {
 
-/// Semi-Lagrangian (Stam 1999) or BFECC (Kim et al. 2005, smoke_surfaces.txt §3.1) advection.
-enum class Advection { SemiLagrangian, Bfecc };
+/// Semi-Lagrangian (Stam 1999), BFECC (Kim et al. 2005, smoke_surfaces.txt §3.1) or MacCormack
+/// (Selle et al. 2008: BFECC's accuracy with two interpolation passes instead of three).
+enum class Advection { SemiLagrangian, Bfecc, MacCormack };
 
 /// A side of the domain is open (air: p = 0, outflow; smoke_surfaces.txt's default) or a wall.
 enum class Boundary { Open, Closed };

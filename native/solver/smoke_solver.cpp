@@ -117,7 +117,7 @@ void SmokeSolver::rebuildCellTypes() {
 // ---------------------------------------------------------------------------------------------
 // Time stepping
 
-bool SmokeSolver::advanceFrame() {
+bool SmokeSolver::advanceFrame(StepObserver* observer) {
   ThreadLimit limit(mParams.threads);
   const float h = mParams.cellSize;
   int steps = mParams.substeps;
@@ -130,8 +130,11 @@ bool SmokeSolver::advanceFrame() {
   const float dt = mParams.frameDt / float(steps);
   StepStats stats;
   for (int s = 0; s < steps; ++s) {
-    if (mCancel.exchange(false)) return false;
+    const bool stop = observer && observer->cancelRequested();
+    if (mCancel.exchange(false) || stop) return false;
+    if (observer) observer->beforeStep(*this);
     step(dt);
+    if (observer) observer->afterStep(*this, dt);
     stats.pressureIterations += mStats.pressureIterations;
     stats.pressureResidual = std::max(stats.pressureResidual, mStats.pressureResidual);
   }
@@ -200,12 +203,12 @@ void SmokeSolver::advect(float dt) {
     float background;  ///< value of clean air
     bool conserve;     ///< density-like: keep Σq, less outflow
   };
-  std::vector<Field> scalars{{&mDensity, 0.f, mParams.conserveMass},
-                             {&mTemperature, mParams.ambientTemperature, false}};
-  if (mParams.combustion) {
-    scalars.push_back({&mFuel, 0.f, mParams.conserveMass});
-    scalars.push_back({&mSoot, 0.f, mParams.conserveMass});
-  }
+  // A fixed array, not a vector: step() never allocates.
+  const Field scalars[] = {{&mDensity, 0.f, mParams.conserveMass},
+                           {&mTemperature, mParams.ambientTemperature, false},
+                           {&mFuel, 0.f, mParams.conserveMass},
+                           {&mSoot, 0.f, mParams.conserveMass}};
+  const std::size_t fieldCount = mParams.combustion ? 4 : 2;  // fuel and soot only burn
   // Blocks far from any smoke stay clean air exactly, as long as nothing travels further than
   // the mask's dilation in one step (BFECC reaches twice the trace plus two stencils).
   const float reach = maxSpeed() * dt / h;
@@ -213,14 +216,15 @@ void SmokeSolver::advect(float dt) {
   const BlockMask* mask = nullptr;
   if (2.f * reach + 4.f < dilation) {
     mMask.build(*scalars[0].grid, scalars[0].background);
-    for (std::size_t f = 1; f < scalars.size(); ++f) {
+    for (std::size_t f = 1; f < fieldCount; ++f) {
       mMaskTmp.build(*scalars[f].grid, scalars[f].background);
       mMask.merge(mMaskTmp);
     }
     mask = &mMask;
   }
   mAdvector.trace(mVelocity, mParams.resolution, kCellOffset, dt, h, scheme, mask);
-  for (const Field& f : scalars) {
+  for (std::size_t m = 0; m < fieldCount; ++m) {
+    const Field& f = scalars[m];
     const double target =
         f.conserve ? totalMass(*f.grid) - outflowMass(*f.grid, mVelocity, mParams.boundaries, dt, h)
                    : 0.0;

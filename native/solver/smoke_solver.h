@@ -37,6 +37,21 @@ struct StepStats {
   float maxSpeed = 0.f;           ///< m/s, at the end of the frame
 };
 
+class SmokeSolver;
+
+/// Follows a simulation step by step, e.g. the streakline tracers of smoke_surfaces.txt §3.2,
+/// whose particles move with the velocity of every step, not only of every frame.
+class StepObserver {
+ public:
+  virtual ~StepObserver() = default;
+  /// Before each step: the solver still holds the previous step's state.
+  virtual void beforeStep(const SmokeSolver& solver) = 0;
+  /// After each step of length dt.
+  virtual void afterStep(const SmokeSolver& solver, float dt) = 0;
+  /// Checked before each step, like SmokeSolver::cancel(): true stops the frame.
+  virtual bool cancelRequested() { return false; }
+};
+
 /// One smoke/fire simulation. Holds all grids; allocation happens in the constructor and when
 /// obstacles change, never inside step().
 class SmokeSolver {
@@ -56,7 +71,8 @@ class SmokeSolver {
 
   /// Advances one frame in one or more steps (params().substeps, more if CFL needs them).
   /// Returns false when cancel() was called; the state is then mid-frame and must be discarded.
-  bool advanceFrame();
+  /// `observer`, when given, is called around every step.
+  bool advanceFrame(StepObserver* observer = nullptr);
   /// One fractional step of length dt: the stages below, in order.
   void step(float dt);
   /// Thread-safe: makes a running advanceFrame() return false after the current step.
