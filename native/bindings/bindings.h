@@ -13,6 +13,11 @@ namespace plume::bindings {
 void bindSolver(pybind11::module_& m);
 /// vdb_grid_names, read_vdb_grid (bind_io.cpp).
 void bindIo(pybind11::module_& m);
+/// Streak-surface NURBS: interpolation, evaluation, tessellation, density map, OpenSubdiv export
+/// (bind_nurbs.cpp).
+void bindNurbs(pybind11::module_& m);
+/// Point sources, StreakTracer, streak files, distances/clusters/order (bind_streak.cpp).
+void bindStreak(pybind11::module_& m);
 
 /// A path argument given as str or os.PathLike, as a std::string (needs the GIL).
 inline std::string pathArg(const pybind11::object& path) {

@@ -18,10 +18,11 @@ PYBIND11_MODULE(_native, m) {
   m.attr("__version__") = "0.1.0";
 
   py::enum_<plume::Advection>(m, "Advection",
-                              "Advection scheme: semi-Lagrangian (Stam 1999) or BFECC (Kim et al. "
-                              "2005, smoke_surfaces §3.1).")
+                              "Advection scheme: semi-Lagrangian (Stam 1999), BFECC (Kim et al. "
+                              "2005, smoke_surfaces §3.1) or MacCormack (Selle et al. 2008).")
       .value("SEMI_LAGRANGIAN", plume::Advection::SemiLagrangian)
-      .value("BFECC", plume::Advection::Bfecc);
+      .value("BFECC", plume::Advection::Bfecc)
+      .value("MACCORMACK", plume::Advection::MacCormack);
   py::enum_<plume::Interpolation>(
       m, "Interpolation",
       "How grids are sampled between samples: trilinear or monotonic cubic (Fedkiw 2001 §5).")
@@ -39,4 +40,6 @@ PYBIND11_MODULE(_native, m) {
 
   plume::bindings::bindSolver(m);
   plume::bindings::bindIo(m);
+  plume::bindings::bindNurbs(m);
+  plume::bindings::bindStreak(m);
 }

@@ -1,0 +1,103 @@
+#include "io/byte_buffer.h"
+
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace plume {
+namespace {
+
+bool hostIsLittleEndian() {
+  const std::uint32_t one = 1;
+  unsigned char b;
+  std::memcpy(&b, &one, 1);
+  return b == 1;
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(const unsigned char* data, std::size_t size, std::uint64_t hash) {
+  for (std::size_t n = 0; n < size; ++n) {
+    hash ^= data[n];
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+void ByteWriter::floats(const float* p, std::size_t n) {
+  const std::size_t start = mBuf.size();
+  mBuf.resize(start + 4 * n);
+  if (hostIsLittleEndian()) {
+    if (n) std::memcpy(mBuf.data() + start, p, 4 * n);
+    return;
+  }
+  for (std::size_t m = 0; m < n; ++m) {
+    std::uint32_t u;
+    std::memcpy(&u, p + m, 4);
+    for (int b = 0; b < 4; ++b) mBuf[start + 4 * m + std::size_t(b)] = (u >> (8 * b)) & 0xff;
+  }
+}
+
+void ByteReader::need(std::size_t n) const {
+  if (n > mSize - mPos) throw std::runtime_error(mKind + " '" + mPath + "' is truncated");
+}
+
+void ByteReader::floats(float* out, std::size_t n) {
+  if (n > (mSize - mPos) / 4) throw std::runtime_error(mKind + " '" + mPath + "' is truncated");
+  if (hostIsLittleEndian()) {
+    if (n) std::memcpy(out, mData + mPos, 4 * n);
+  } else {
+    for (std::size_t m = 0; m < n; ++m) {
+      std::uint32_t u = 0;
+      for (int b = 0; b < 4; ++b) u |= std::uint32_t(mData[mPos + 4 * m + std::size_t(b)]) << (8 * b);
+      std::memcpy(out + m, &u, 4);
+    }
+  }
+  mPos += 4 * n;
+}
+
+void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,
+                     const std::string& kind) {
+  const std::string tmp = path + ".tmp";
+  bool ok = false;
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (out) {
+      out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+      out.flush();
+      ok = bool(out);
+      out.close();
+      ok = ok && !out.fail();
+    }
+  }
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(kind + " '" + path +
+                             "' cannot be written (missing directory, no permission or disk full?)");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(kind + " '" + path + "' cannot be written: renaming the temporary file '" +
+                             tmp + "' failed");
+  }
+}
+
+std::vector<unsigned char> readFileChecked(const std::string& path, std::size_t minSize,
+                                           std::size_t maxSize, const std::string& kind) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw std::runtime_error(kind + " '" + path + "' cannot be opened");
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw std::runtime_error(kind + " '" + path + "' cannot be read");
+  if (std::size_t(size) < minSize)
+    throw std::runtime_error(kind + " '" + path + "' is truncated (shorter than its header)");
+  if (std::size_t(size) > maxSize)
+    throw std::runtime_error(kind + " '" + path + "' is too large (" + std::to_string(size) +
+                             " bytes)");
+  std::vector<unsigned char> buf(static_cast<std::size_t>(size));
+  in.seekg(0);
+  if (size > 0 && !in.read(reinterpret_cast<char*>(buf.data()), size))
+    throw std::runtime_error(kind + " '" + path + "' cannot be read");
+  return buf;
+}
+
+}  // namespace plume

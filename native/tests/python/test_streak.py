@@ -1,0 +1,308 @@
+"""Streaklines and streak surfaces from Python (smoke_surfaces §3.2-3.3): point sources, the
+tracer driven by the solver, streak files, distances h, threshold h0, clusters and ordering."""
+import itertools
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import _native
+
+
+def box_mesh(lo, hi):
+    """Axis-aligned box [lo, hi] as (vertices (8, 3), triangles (12, 3)), closed and manifold."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    vertices = np.array([[hi[0] if n & 1 else lo[0], hi[1] if n & 2 else lo[1],
+                          hi[2] if n & 4 else lo[2]] for n in range(8)], dtype=np.float32)
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    triangles = []
+    for a, b, c, d in quads:
+        triangles += [(a, b, c), (a, c, d)]
+    return vertices, np.array(triangles, dtype=np.int32)
+
+
+def small_params(**overrides):
+    p = _native.SmokeParams(resolution=(16, 16, 20), cell_size=1.0 / 16)
+    for key, value in overrides.items():
+        setattr(p, key, value)
+    return p
+
+
+def streaking_solver(params, points_per_cell=3, emission_period=1):
+    """Solver with a box source and a tracer whose point sources fill the source cells."""
+    solver = _native.SmokeSolver(params)
+    vertices, triangles = box_mesh((0.4, 0.4, 0.05), (0.6, 0.6, 0.2))
+    settings = _native.SourceSettings()
+    settings.velocity = (0.0, 0.0, 0.5)
+    cells, motion = _native.source_cells(vertices, triangles, np.eye(4), np.eye(4), params, "src")
+    assert solver.add_source(vertices, triangles, np.eye(4), np.eye(4), settings, "src") == len(cells)
+    points = _native.random_points_in_cells(cells, params.resolution, params.cell_size,
+                                            params.origin, points_per_cell, params.seed)
+    velocities = np.repeat(motion, points_per_cell, axis=0) + np.asarray(settings.velocity)
+    tracer = _native.StreakTracer(params, emission_period=emission_period)
+    assert tracer.add_point_sources(points, np.zeros(len(points), int), velocities) == 0
+    return solver, tracer, points
+
+
+# --- point sources ---------------------------------------------------------------------------
+
+def test_random_points_lie_in_their_cells_and_are_deterministic():
+    res, h, origin = (6, 5, 4), 0.2, (-1.0, 0.5, 2.0)
+    cells = np.array([0, 13, 119], dtype=np.uint32)
+    p = _native.random_points_in_cells(cells, res, h, origin, 12, seed=5, stream=2)
+    assert p.shape == (36, 3) and p.dtype == np.float32
+    c = np.repeat(cells, 12)
+    corner = np.stack([c % 6, (c // 6) % 5, c // 30], axis=1) * h + np.asarray(origin)
+    local = (p - corner) / h
+    assert local.min() >= -1e-5 and local.max() <= 1 + 1e-5
+    np.testing.assert_array_equal(p, _native.random_points_in_cells(cells, res, h, origin, 12, 5, 2))
+    assert not np.array_equal(p, _native.random_points_in_cells(cells, res, h, origin, 12, 5, 3))
+    with pytest.raises(ValueError, match="point_sources"):
+        _native.random_points_in_cells(cells, res, h, origin, 0, 5)
+    with pytest.raises(ValueError, match="outside the grid"):
+        _native.random_points_in_cells([120], res, h, origin, 3, 5)
+
+
+# --- tracer ----------------------------------------------------------------------------------
+
+def uniform_velocity(n, v):
+    nx, ny, nz = n
+    return (np.full((nx + 1, ny, nz), v[0], np.float32), np.full((nx, ny + 1, nz), v[1], np.float32),
+            np.full((nx, ny, nz + 1), v[2], np.float32))
+
+
+def test_tracer_step_moves_particles_exactly_in_a_uniform_field():
+    p = small_params(interpolation=_native.Interpolation.LINEAR)
+    tracer = _native.StreakTracer(p, emission_period=2)
+    assert tracer.interpolation == _native.Interpolation.LINEAR
+    assert tracer.emission_period == 2
+    source = np.array([[0.3, 0.5, 0.2], [0.6, 0.4, 0.3]], np.float32)
+    tracer.add_point_sources(source, [0, 1])
+    v = (0.2, -0.1, 0.4)
+    vel = uniform_velocity(p.resolution, v)
+    density = np.full(p.resolution, 0.25, np.float32)
+    dt = 0.05
+    for _ in range(5):
+        tracer.step(vel, vel, density, dt)
+    snap = tracer.snapshot()
+    assert tracer.steps == 5 and tracer.particles_per_source == 5 // 2 + 1
+    np.testing.assert_array_equal(snap["counts"], [3, 3])
+    np.testing.assert_array_equal(snap["groups"], [0, 1])
+    assert snap["positions"].shape == (6, 3) and snap["density"].shape == (6,)
+    # Emitted at steps 0, 2, 4: travelled 5, 3, 1 steps.
+    for s in range(2):
+        for e, travelled in enumerate([5, 3, 1]):
+            expected = source[s] + np.asarray(v) * dt * travelled
+            np.testing.assert_allclose(snap["positions"][3 * s + e], expected, atol=1e-5)
+    np.testing.assert_allclose(snap["density"], 0.25)
+    assert not snap["outside"].any()
+
+
+def test_tracer_rejects_bad_input():
+    p = small_params()
+    with pytest.raises(ValueError, match="emission_period"):
+        _native.StreakTracer(p, emission_period=0)
+    tracer = _native.StreakTracer(p)
+    with pytest.raises(ValueError, match="outside the domain"):
+        tracer.add_point_sources([[5.0, 0.5, 0.5]], [0])
+    with pytest.raises(ValueError):
+        tracer.add_point_sources([[0.5, 0.5, 0.5]], [0, 1])
+    tracer.add_point_sources([[0.5, 0.5, 0.5]], [0])
+    vel = uniform_velocity(p.resolution, (0, 0, 0))
+    with pytest.raises(ValueError, match="density must have shape"):
+        tracer.step(vel, vel, np.zeros((3, 3, 3), np.float32), 0.1)
+    tracer.step(vel, vel, np.zeros(p.resolution, np.float32), 0.1)
+    with pytest.raises(ValueError, match="before the first step"):
+        tracer.add_point_sources([[0.5, 0.5, 0.5]], [0])
+
+
+def test_advance_frame_with_tracers_matches_advance_frame():
+    p = small_params()
+    plain, _, _ = streaking_solver(p)
+    solver, tracer, points = streaking_solver(p)
+    for frame in range(3):
+        assert plain.advance_frame() is True
+        assert _native.advance_frame_with_tracers(solver, tracer) is True
+    assert solver.frame == 3
+    np.testing.assert_array_equal(plain.get_density(), solver.get_density())
+    snap = tracer.snapshot()
+    n = len(points)
+    assert snap["counts"].tolist() == [tracer.steps + 1] * n
+    assert snap["positions"].shape == (n * (tracer.steps + 1), 3)
+    # Youngest particle of each streakline sits at its source; the oldest has risen.
+    per = tracer.steps + 1
+    np.testing.assert_array_equal(snap["positions"][per - 1::per], points)
+    assert (snap["positions"][0::per, 2] - points[:, 2]).mean() > 0.03
+    assert snap["density"].max() > 0
+
+
+def test_tracer_cancel_and_gil_release():
+    p = small_params(resolution=(32, 32, 32), cell_size=1.0 / 32, substeps=400)
+    solver, tracer, _ = streaking_solver(p)
+    tracer.cancel()
+    assert _native.advance_frame_with_tracers(solver, tracer) is False
+    assert solver.frame == 0
+    result = {}
+    worker = threading.Thread(
+        target=lambda: result.setdefault("ok", _native.advance_frame_with_tracers(solver, tracer)))
+    start = time.monotonic()
+    worker.start()
+    ticks = 0
+    # The GIL is released: this thread keeps running and cancels through the tracer.
+    while worker.is_alive():
+        ticks += 1
+        tracer.cancel()
+        worker.join(0.01)
+    assert result["ok"] is False
+    assert time.monotonic() - start < 30.0
+    solver.cancel()  # the solver's own cancel stops a traced frame too
+    assert _native.advance_frame_with_tracers(solver, tracer) is False
+
+
+# --- streak files ----------------------------------------------------------------------------
+
+def test_streak_file_round_trip_and_errors(tmp_path):
+    p = small_params()
+    solver, tracer, _ = streaking_solver(p, points_per_cell=1)
+    assert _native.advance_frame_with_tracers(solver, tracer)
+    snap = tracer.snapshot()
+    path = tmp_path / _native.streak_file_name(1)
+    assert path.name == "streaks_0001.bin"
+    _native.write_streak_file(path, snap)
+    back = _native.read_streak_file(path)
+    for key in ("counts", "positions", "density", "groups", "outside"):
+        np.testing.assert_array_equal(back[key], snap[key])
+    # Truncated and corrupt files raise RuntimeError naming the path.
+    data = path.read_bytes()
+    bad = tmp_path / "streaks_0002.bin"
+    bad.write_bytes(data[:-3])
+    with pytest.raises(RuntimeError, match="streaks_0002.bin"):
+        _native.read_streak_file(bad)
+    flipped = bytearray(data)
+    flipped[len(data) // 2] ^= 1
+    bad.write_bytes(bytes(flipped))
+    with pytest.raises(RuntimeError, match="corrupt"):
+        _native.read_streak_file(bad)
+    with pytest.raises(RuntimeError, match="cannot be written"):
+        _native.write_streak_file(tmp_path / "missing" / "s.bin", snap)
+    with pytest.raises(ValueError):
+        _native.write_streak_file(path, {"counts": [2], "positions": np.zeros((3, 3)),
+                                         "density": np.zeros(3)})
+    with pytest.raises(ValueError, match="density"):
+        _native.write_streak_file(path, {"counts": [1], "positions": np.zeros((1, 3))})
+
+
+# --- distances, clusters, order --------------------------------------------------------------
+
+def random_snapshots(sources, counts, seed):
+    rng = np.random.default_rng(seed)
+    # float32, as the core stores positions, so that the brute force sees the same numbers.
+    return [{"counts": np.full(sources, n),
+             "positions": (rng.normal(size=(sources * n, 3)) +
+                           np.repeat(np.arange(sources), n)[:, None] * [0.3, 0, 0]).astype(np.float32)}
+            for n in counts]
+
+
+def brute_h(snaps, a, b):
+    total = 0.0
+    for s in snaps:
+        n = int(s["counts"][a])
+        if n == 0:
+            continue
+        pa = np.asarray(s["positions"], np.float64)[a * n:(a + 1) * n]
+        pb = np.asarray(s["positions"], np.float64)[b * n:(b + 1) * n]
+        total += ((pa - pb) ** 2).sum() / n
+    return total
+
+
+def brute_clusters(h, h0):
+    n = len(h)
+    parent = list(range(n))
+
+    def find(x):
+        while parent[x] != x:
+            x = parent[x]
+        return x
+
+    for a, b in itertools.combinations(range(n), 2):
+        if h[a, b] < h0:
+            ra, rb = find(a), find(b)
+            parent[max(ra, rb)] = min(ra, rb)
+    groups = {}
+    for a in range(n):
+        groups.setdefault(find(a), []).append(a)
+    return sorted((g for g in groups.values() if len(g) >= 2), key=lambda g: g[0])
+
+
+@pytest.mark.parametrize("sources,counts", [(2, [1]), (4, [0, 2, 5, 1]), (9, [3, 0, 7, 7, 12])])
+def test_distances_threshold_and_clusters_match_brute_force(sources, counts):
+    snaps = random_snapshots(sources, counts, seed=sources)
+    ids = list(range(sources))[::-1]
+    h = _native.streak_distances(snaps, ids)
+    assert h.shape == (sources, sources) and h.dtype == np.float64
+    expected = np.zeros((sources, sources))
+    for a, b in itertools.combinations(range(sources), 2):
+        expected[a, b] = expected[b, a] = brute_h(snaps, ids[a], ids[b])
+    np.testing.assert_allclose(h, expected, rtol=1e-12, atol=1e-12)
+    upper = h[np.triu_indices(sources, 1)]
+    assert _native.default_threshold(h) == pytest.approx(upper.mean(), rel=1e-12)
+    for h0 in [0.0, *np.quantile(upper, [0.2, 0.5, 0.8]), _native.default_threshold(h), 2 * upper.max()]:
+        clusters = _native.cluster_sources(h, h0)
+        assert clusters == brute_clusters(h, h0)
+        assert _native.cluster_summary(h, h0) == (len(clusters), sum(map(len, clusters)))
+
+
+def test_order_greedy_recovers_shuffled_parallel_streaklines():
+    rng = np.random.default_rng(3)
+    n, frames = 11, 8
+    slot = rng.permutation(n)
+    snaps = []
+    for t in range(frames):
+        k = t + 1
+        heights = 0.1 * np.arange(k, 0, -1)
+        pos = [[slot[s] * 0.05, 0.0, z] for s in range(n) for z in heights]
+        snaps.append({"counts": np.full(n, k), "positions": np.array(pos, np.float32)})
+    h = _native.streak_distances(snaps, np.arange(n))
+    order = _native.order_greedy(h, list(range(n)))
+    slots = [int(slot[m]) for m in order]
+    assert slots in (list(range(n)), list(range(n))[::-1])
+    surfaces = _native.build_surfaces(snaps, np.zeros(n, int), 1e9)
+    assert len(surfaces) == 1 and surfaces[0]["group"] == 0
+    assert [int(slot[s]) for s in surfaces[0]["sources"]] in (list(range(n)), list(range(n))[::-1])
+
+
+def test_clustering_errors():
+    h = np.array([[0, 1.0], [1.0, 0]])
+    with pytest.raises(ValueError, match="h0"):
+        _native.cluster_sources(h, -1.0)
+    with pytest.raises(ValueError, match="square"):
+        _native.cluster_summary(np.zeros((2, 3)), 1.0)
+    with pytest.raises(ValueError, match="at least 2"):
+        _native.default_threshold(np.zeros((1, 1)))
+    with pytest.raises(ValueError, match="repeats"):
+        _native.order_greedy(h, [1, 1])
+    snaps = random_snapshots(3, [2, 3], seed=1)
+    with pytest.raises(ValueError, match="candidate group 5"):
+        _native.build_surfaces(snaps, [0, 0, 5])
+    snaps[1]["counts"] = np.array([3, 2, 4])
+    with pytest.raises(ValueError, match="equal counts"):
+        _native.streak_distances(snaps, [0, 1])
+
+
+def test_surfaces_from_a_baked_plume(tmp_path):
+    """End to end: bake with tracers, write and read the streak files, cluster the sources."""
+    p = small_params()
+    solver, tracer, points = streaking_solver(p, points_per_cell=2)
+    paths = []
+    for frame in range(1, 5):
+        assert _native.advance_frame_with_tracers(solver, tracer)
+        paths.append(tmp_path / _native.streak_file_name(frame))
+        _native.write_streak_file(paths[-1], tracer.snapshot())
+    snaps = [_native.read_streak_file(path) for path in paths]
+    surfaces = _native.build_surfaces(snaps)
+    used = [s for surface in surfaces for s in surface["sources"]]
+    assert len(used) == len(set(used)) and all(len(s["sources"]) >= 2 for s in surfaces)
+    h = _native.streak_distances(snaps, np.arange(len(points)))
+    assert _native.cluster_summary(h, _native.default_threshold(h)) == (
+        len(surfaces), len(used))

@@ -1,0 +1,187 @@
+#include "tracers/streak_tracer.h"
+
+#include "core/parallel.h"
+#include "solver/smoke_solver.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace plume {
+namespace {
+
+/// Particles per parallel task: enough work to pay for the task, small enough to balance.
+constexpr int kChunk = 256;
+
+bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string sizeText(glm::ivec3 s) {
+  return std::to_string(s.x) + "x" + std::to_string(s.y) + "x" + std::to_string(s.z);
+}
+
+}  // namespace
+
+void StreakParams::validate() const {
+  if (emissionPeriod < 1 || emissionPeriod > kMaxEmissionPeriod)
+    throw std::invalid_argument("emission_period must be in [1, " +
+                                std::to_string(kMaxEmissionPeriod) + "] steps (got " +
+                                std::to_string(emissionPeriod) + ")");
+  if (interpolation != Interpolation::Linear && interpolation != Interpolation::MonotonicCubic)
+    throw std::invalid_argument("interpolation must be LINEAR or MONOTONIC_CUBIC");
+}
+
+StreakTracer::StreakTracer(const StreakParams& params, const GridFrame& grid,
+                           const std::array<Boundary, 6>& boundaries)
+    : mParams(params), mGrid(grid), mBoundaries(boundaries) {
+  mParams.validate();
+  if (grid.resolution.x < 1 || grid.resolution.y < 1 || grid.resolution.z < 1)
+    throw std::invalid_argument("resolution must be >= 1 cell per axis (got " +
+                                sizeText(grid.resolution) + ")");
+  if (!(grid.cellSize > 0.f) || !std::isfinite(grid.cellSize))
+    throw std::invalid_argument("cell_size must be a finite number > 0 (got " +
+                                std::to_string(grid.cellSize) + ")");
+  if (!finite(grid.origin)) throw std::invalid_argument("origin must be finite");
+  mInvCellSize = 1.f / grid.cellSize;
+  mLo = grid.origin;
+  mHi = grid.origin + glm::vec3(grid.resolution) * grid.cellSize;
+}
+
+StreakTracer::StreakTracer(const StreakParams& params, const SmokeParams& smoke)
+    : StreakTracer(params,
+                   GridFrame{smoke.resolution, smoke.cellSize, smoke.origin, smoke.frameDt},
+                   smoke.boundaries) {}
+
+int StreakTracer::addPointSources(const std::vector<glm::vec3>& positions,
+                                  const std::vector<int>& groups,
+                                  const std::vector<glm::vec3>& velocities) {
+  if (mSteps != 0)
+    throw std::invalid_argument(
+        "point sources must be added before the first step (every streakline needs the same "
+        "particle count)");
+  if (groups.size() != positions.size())
+    throw std::invalid_argument("point sources: " + std::to_string(groups.size()) + " groups for " +
+                                std::to_string(positions.size()) + " positions");
+  if (!velocities.empty() && velocities.size() != positions.size())
+    throw std::invalid_argument("point sources: " + std::to_string(velocities.size()) +
+                                " velocities for " + std::to_string(positions.size()) + " positions");
+  for (std::size_t n = 0; n < positions.size(); ++n) {
+    const glm::vec3 p = positions[n];
+    if (!finite(p) || (!velocities.empty() && !finite(velocities[n])))
+      throw std::invalid_argument("point source " + std::to_string(n) +
+                                  ": position and velocity must be finite");
+    if (glm::any(glm::lessThan(p, mLo)) || glm::any(glm::greaterThan(p, mHi)))
+      throw std::invalid_argument("point source " + std::to_string(n) + " at (" +
+                                  std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
+                                  std::to_string(p.z) + ") lies outside the domain");
+  }
+  const int first = int(mSources.size());
+  for (std::size_t n = 0; n < positions.size(); ++n) {
+    mSources.push_back({positions[n], groups[n], velocities.empty() ? glm::vec3(0.f) : velocities[n]});
+    // Emission 0 (instant t = 0). Before the first step the storage holds only emission 0, so
+    // appending keeps the emission-major layout. Density is unknown until the first step.
+    mPositions.push_back(positions[n]);
+    mDensity.push_back(0.f);
+    mOutside.push_back(0);
+  }
+  return first;
+}
+
+void StreakTracer::checkGrid(glm::ivec3 size, glm::ivec3 expected, const char* what) const {
+  if (size != expected)
+    throw std::invalid_argument(std::string("streak tracer: ") + what + " grid is " +
+                                sizeText(size) + "; expected " + sizeText(expected));
+}
+
+void StreakTracer::emit() {
+  for (const PointSource& s : mSources) {
+    mPositions.push_back(s.position);
+    mDensity.push_back(0.f);
+    mOutside.push_back(0);
+  }
+  ++mEmissions;
+}
+
+void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const ScalarGrid& density,
+                        float dt) {
+  if (!(dt > 0.f) || !std::isfinite(dt))
+    throw std::invalid_argument("dt must be a finite number > 0 (got " + std::to_string(dt) + ")");
+  checkGrid(before.cells(), mGrid.resolution, "start-of-step velocity");
+  checkGrid(after.cells(), mGrid.resolution, "end-of-step velocity");
+  checkGrid(density.size(), mGrid.resolution, "density");
+  const Interpolation scheme = mParams.interpolation;
+  const int sources = sourceCount();
+  // Particles of the emission made at this step's start (instant mSteps) are newborn.
+  const std::size_t newborn = mSteps % mParams.emissionPeriod == 0
+                                  ? std::size_t(mEmissions - 1) * std::size_t(sources)
+                                  : mPositions.size();
+  const int count = int(mPositions.size());
+  const float half = 0.5f * dt;
+  parallelFor(0, (count + kChunk - 1) / kChunk, [&](int chunk) {
+    const int end = std::min(count, (chunk + 1) * kChunk);
+    for (int n = chunk * kChunk; n < end; ++n) {
+      if (mOutside[std::size_t(n)]) continue;  // frozen on an open side
+      const glm::vec3 x = mPositions[std::size_t(n)];
+      glm::vec3 k1(0.f);
+      if (std::size_t(n) >= newborn) k1 = mSources[std::size_t(n) % std::size_t(sources)].velocity;
+      if (k1 == glm::vec3(0.f)) k1 = sampleVelocity(before, toCell(x), scheme);
+      const glm::vec3 xm = x + half * k1;
+      const glm::vec3 cm = toCell(xm);
+      // The field at t + ½Δt: mean of the fields at t and t + Δt (second order in time).
+      const glm::vec3 um = 0.5f * (sampleVelocity(before, cm, scheme) + sampleVelocity(after, cm, scheme));
+      glm::vec3 xn = x + dt * um;
+      if (!finite(xn)) xn = x;  // a broken field must not poison the cache
+      bool left = false;
+      for (int a = 0; a < 3; ++a) {
+        if (xn[a] < mLo[a]) {
+          xn[a] = mLo[a];
+          left = left || mBoundaries[std::size_t(2 * a)] == Boundary::Open;
+        } else if (xn[a] > mHi[a]) {
+          xn[a] = mHi[a];
+          left = left || mBoundaries[std::size_t(2 * a + 1)] == Boundary::Open;
+        }
+      }
+      mPositions[std::size_t(n)] = xn;
+      if (left) mOutside[std::size_t(n)] = 1;
+    }
+  });
+  ++mSteps;
+  if (mSteps % mParams.emissionPeriod == 0) emit();
+  // Density at every particle still inside, at the end of the step (§3.2: stored every step).
+  const int total = int(mPositions.size());
+  parallelFor(0, (total + kChunk - 1) / kChunk, [&](int chunk) {
+    const int end = std::min(total, (chunk + 1) * kChunk);
+    for (int n = chunk * kChunk; n < end; ++n)
+      if (!mOutside[std::size_t(n)])
+        mDensity[std::size_t(n)] = sample(density, toCell(mPositions[std::size_t(n)]), scheme);
+  });
+}
+
+void StreakTracer::observeStep(const SmokeSolver& solver, const MacGrid3& velocityBefore,
+                               float dt) {
+  const GridFrame g = solver.gridFrame();
+  if (g.resolution != mGrid.resolution || g.cellSize != mGrid.cellSize || g.origin != mGrid.origin)
+    throw std::invalid_argument("streak tracer: the solver's domain differs from the tracer's");
+  step(velocityBefore, solver.velocity(), solver.density(), dt);
+}
+
+StreakFrame StreakTracer::snapshot() const {
+  StreakFrame f;
+  const std::size_t sources = mSources.size(), emissions = std::size_t(mEmissions);
+  f.counts.assign(sources, mEmissions);
+  f.groups.reserve(sources);
+  for (const PointSource& s : mSources) f.groups.push_back(s.group);
+  f.positions.resize(mPositions.size());
+  f.density.resize(mPositions.size());
+  f.outside.resize(mPositions.size());
+  // Emission-major storage to source-major snapshot, oldest particle first.
+  for (std::size_t s = 0; s < sources; ++s)
+    for (std::size_t e = 0; e < emissions; ++e) {
+      const std::size_t from = e * sources + s, to = s * emissions + e;
+      f.positions[to] = mPositions[from];
+      f.density[to] = mDensity[from];
+      f.outside[to] = mOutside[from];
+    }
+  return f;
+}
+
+}  // namespace plume

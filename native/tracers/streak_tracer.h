@@ -1,0 +1,128 @@
+#pragma once
+/// \file streak_tracer.h
+/// Streaklines (smoke_surfaces.txt §3.2): massless particles emitted from point sources every
+/// emission period and carried by the solver's time-varying velocity, second order in time.
+///
+/// Timeline. Emission happens at the instants t = s·Δt with s = 0, P, 2P, … (P = emission
+/// period, s counts the steps this tracer has seen): the particle of instant 0 is emitted when the
+/// point sources are added, the others at the end of the step that reaches their instant. After S
+/// steps every source therefore holds floor(S / P) + 1 particles, the youngest at the source.
+///
+/// Boundaries. Particles never leave the domain box: a particle pushed through a closed side is
+/// clamped onto it and keeps moving; one carried through an open side is clamped onto that side,
+/// marked `outside` and frozen there (position and density no longer change). It is kept so that
+/// every streakline of a bake has the same particle count, which the distance h(α,β) of §3.3 and
+/// the fixed control nets of the surfaces need.
+
+#include "core/grid3.h"
+#include "core/mac_grid3.h"
+#include "core/sampling.h"
+#include "solver/emitters.h"
+#include "solver/smoke_params.h"
+#include "tracers/streak_frame.h"
+
+#include <array>
+#include <atomic>
+#include <vector>
+
+namespace plume {
+
+class SmokeSolver;
+
+/// Settings of the streakline tracer (§3.2).
+struct StreakParams {
+  int emissionPeriod = 1;  ///< steps between two emissions; §3.2 shoots one every step
+  /// How velocity and density are read between grid samples (§3.2: "the same interpolation").
+  Interpolation interpolation = Interpolation::MonotonicCubic;
+  /// Throws std::invalid_argument naming the setting and its accepted range.
+  void validate() const;
+};
+
+/// Largest accepted emission period, in steps.
+constexpr int kMaxEmissionPeriod = 100000;
+
+/// A point source (§3.2): where its particles are born, its candidate group (§3.3) and the
+/// velocity its particles leave it with (the source's velocity, zero for a still source).
+struct PointSource {
+  glm::vec3 position{0.f};
+  int group = 0;
+  glm::vec3 velocity{0.f};
+};
+
+/// Emits and advects the particles of streaklines (§3.2). Independent of SmokeSolver: step()
+/// takes the velocity at the start and end of a step and the density at the end; observeStep()
+/// and advanceFrameWithTracers() (tracer_driver.h) feed it from a solver.
+class StreakTracer {
+ public:
+  /// `grid` fixes the domain box and the index space of the fields; `boundaries` (-x,+x,-y,+y,-z,+z)
+  /// say through which sides particles leave. Validates params (std::invalid_argument).
+  StreakTracer(const StreakParams& params, const GridFrame& grid,
+               const std::array<Boundary, 6>& boundaries);
+  /// Same, on the domain and boundaries of a solver's settings.
+  StreakTracer(const StreakParams& params, const SmokeParams& smoke);
+
+  const StreakParams& params() const { return mParams; }
+  const GridFrame& gridFrame() const { return mGrid; }
+
+  /// Adds point sources (source ID = index, in the order added) and emits their first particle.
+  /// All arrays have one entry per source; `velocities` may be empty (still sources). Only
+  /// allowed before the first step, so that every streakline keeps the same particle count.
+  /// Throws std::invalid_argument on size mismatches, non-finite values or positions outside
+  /// the domain. Returns the ID of the first added source.
+  int addPointSources(const std::vector<glm::vec3>& positions, const std::vector<int>& groups,
+                      const std::vector<glm::vec3>& velocities);
+  const std::vector<PointSource>& pointSources() const { return mSources; }
+
+  /// Advances every particle over one step of length dt (seconds) with the explicit midpoint
+  /// rule, second order in time: k1 = u(x, t), x½ = x + ½Δt k1, u(x½, t + ½Δt) taken as the mean
+  /// of the start- and end-of-step fields at x½, x' = x + Δt u(x½, t + ½Δt). A particle born at
+  /// this step's start uses its source's velocity as k1 when that is non-zero (the velocity the
+  /// solver writes into source cells). Then emits if due and samples density at every particle.
+  /// `before`/`after` are the face velocities at the start/end of the step and `density` the
+  /// density at the end, all on the grid given at construction.
+  void step(const MacGrid3& before, const MacGrid3& after, const ScalarGrid& density, float dt);
+  /// step() with the solver's current velocity and density as the end-of-step fields; call it
+  /// right after solver.step(dt), with `velocityBefore` copied just before that call.
+  void observeStep(const SmokeSolver& solver, const MacGrid3& velocityBefore, float dt);
+
+  /// Storage for the start-of-step velocity used by advanceFrameWithTracers (allocated once).
+  MacGrid3& previousVelocity() { return mPrevious; }
+
+  /// The streaklines now: per source, its particles in birth order (§3.2, Figure 2).
+  StreakFrame snapshot() const;
+
+  int sourceCount() const { return int(mSources.size()); }
+  /// Particles per source (equal for all sources).
+  int particlesPerSource() const { return mEmissions; }
+  /// Steps seen so far.
+  long long steps() const { return mSteps; }
+
+  /// Thread-safe: a running advanceFrameWithTracers() returns false before its next step.
+  void cancel() { mCancel.store(true); }
+  /// Returns whether cancel() was called since the last call, and clears the request.
+  bool consumeCancel() { return mCancel.exchange(false); }
+
+ private:
+  void emit();
+  glm::vec3 toCell(glm::vec3 world) const {
+    return (world - mGrid.origin) * mInvCellSize - glm::vec3(0.5f);
+  }
+  void checkGrid(glm::ivec3 size, glm::ivec3 expected, const char* what) const;
+
+  StreakParams mParams;
+  GridFrame mGrid;
+  std::array<Boundary, 6> mBoundaries;
+  float mInvCellSize;
+  glm::vec3 mLo, mHi;  ///< domain box, world space
+  std::vector<PointSource> mSources;
+  // Particles, emission-major: particle e of source s at e * sourceCount() + s.
+  std::vector<glm::vec3> mPositions;
+  std::vector<float> mDensity;
+  std::vector<std::uint8_t> mOutside;
+  int mEmissions = 1;  ///< emission instants reached: floor(steps / P) + 1
+  long long mSteps = 0;
+  MacGrid3 mPrevious;
+  std::atomic<bool> mCancel{false};
+};
+
+}  // namespace plume
