@@ -39,6 +39,7 @@ except ImportError as e:
 import bpy  # noqa: E402  (after the checks above)
 
 from . import operators, properties, ui  # noqa: E402
+from .build import surfaces as _surfaces  # noqa: E402
 
 _classes = operators.classes + ui.classes
 
@@ -47,9 +48,11 @@ def register():
     properties.register()
     for cls in _classes:
         bpy.utils.register_class(cls)
+    _surfaces.register()  # persistent frame_change_pre handler of the streak surfaces
 
 
 def unregister():
+    _surfaces.unregister()
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)
     properties.unregister()

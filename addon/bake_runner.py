@@ -15,14 +15,16 @@ import time
 from dataclasses import dataclass, field
 from typing import List, Optional
 
+import numpy as np
+
 from . import cache
 
 #: A checkpoint of the solver state is written when the time since the last one is at least this
 #: many times what writing the last one took (and after the last frame): about every frame on
 #: small grids, every few seconds at 128³ (75 MB), never more than ~10% of the bake time.
 CHECKPOINT_COST_RATIO = 10.0
-from .settings import (BakeError, to_native_params, to_native_source, validate_python_side,
-                       validate_source)
+from .settings import (BakeError, candidate_groups, to_native_params, to_native_source,
+                       validate_python_side, validate_source, validate_streaks)
 
 
 @dataclass
@@ -69,6 +71,7 @@ class BakeRunner:
         self._resume_state = None
         self._manifest = None
         self._emitter_index = None  # frame index whose emitters are loaded in the solver
+        self._tracer = None  # StreakTracer when streak surfaces are on
 
     # ---------------------------------------------------------------- validation
     def prepare(self):
@@ -84,6 +87,7 @@ class BakeRunner:
         for emitter in snap.emitters:
             if emitter.role == "SOURCE":
                 validate_source(emitter)
+        validate_streaks(snap.domain_name, snap.streaks, snap.emitters)
         try:
             self._solver = self._native.SmokeSolver(params)
         except ValueError as e:
@@ -94,6 +98,8 @@ class BakeRunner:
         # Voxelize every emitter of the first frame now, so a bad obstacle is reported before
         # any file is written.
         self._load_emitters(0)
+        if snap.streaks.enabled:
+            self._tracer = self._make_tracer(params)
         error = cache.check_writable(snap.cache_folder)
         if error is not None:
             raise BakeError(f"Plume: cache_directory '{snap.cache_directory}' is not writable "
@@ -123,6 +129,46 @@ class BakeRunner:
                 raise BakeError(f"Plume: {text}") from None
         self._emitter_index = index
 
+    def _make_tracer(self, params):
+        """StreakTracer with `point_sources` random points per source cell of every Source
+        (smoke_surfaces.txt §3.2), seeded by the domain seed and the source's index; candidate
+        group = the source's candidate_group (-1: a group of its own)."""
+        snap, native = self.snapshot, self._native
+        try:
+            tracer = native.StreakTracer(params, emission_period=snap.streaks.emission_period)
+        except ValueError as e:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
+        sources = [e for e in snap.emitters if e.role == "SOURCE"]
+        groups = candidate_groups(snap.emitters)
+        all_points, all_groups, all_vel = [], [], []
+        for index, (e, group) in enumerate(zip(sources, groups)):
+            try:
+                cells, motion = native.source_cells(e.vertices, e.triangles, e.matrix_at(0),
+                                                    e.matrix_at(1), params, e.name)
+                if len(cells) == 0:
+                    continue
+                points = native.random_points_in_cells(
+                    cells, params.resolution, params.cell_size, params.origin, e.point_sources,
+                    seed=snap.solver.seed, stream=index)
+            except ValueError as err:
+                raise BakeError(f"Plume: source '{e.name}': {err}") from None
+            # The source's velocity plus its own motion, as the solver writes into its cells.
+            vel = (np.repeat(np.asarray(motion, np.float32), e.point_sources, axis=0)
+                   * np.float32(e.source.motion_factor)
+                   + np.asarray(e.source.velocity, np.float32))
+            all_points.append(points)
+            all_vel.append(vel)
+            all_groups.append(np.full(len(points), group, dtype=np.int64))
+        if not all_points:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': streak surfaces need point "
+                            "sources, but no Source object has a cell inside the domain")
+        try:
+            tracer.add_point_sources(np.concatenate(all_points), np.concatenate(all_groups),
+                                     np.concatenate(all_vel))
+        except ValueError as e:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': point sources: {e}") from None
+        return tracer
+
     def _plan(self):
         """Fresh bake, resume from the checkpoint, or nothing to compute (already complete)."""
         snap = self.snapshot
@@ -145,9 +191,17 @@ class BakeRunner:
         present = set(cache.volume_frames(snap.cache_folder))
         if any(f not in present for f in range(snap.frame_start, upto + 1)):
             return
+        if snap.streaks.enabled:
+            streaks = set(cache.streak_frames(snap.cache_folder))
+            if any(f not in streaks for f in range(snap.frame_start, upto + 1)):
+                return
         self._manifest = m
         if last >= snap.frame_end:
             self._mode = "complete"
+        elif snap.streaks.enabled:
+            # The tracer has no checkpoint in the native API (StreakTracer cannot be saved or
+            # restored), so a bake with streak surfaces on starts over instead of resuming.
+            return
         else:
             # Checkpoints are written every few seconds, so the state may be some frames behind
             # the last complete frame: resume from it and recompute (bit for bit) what follows.
@@ -164,6 +218,8 @@ class BakeRunner:
         self._cancel.set()
         if self._solver is not None:
             self._solver.cancel()
+        if self._tracer is not None:
+            self._tracer.cancel()
 
     @property
     def cancelled(self):
@@ -217,13 +273,22 @@ class BakeRunner:
                     result.cancelled = True
                     break
                 self._load_emitters(frame - snap.frame_start)
-                if not self._solver.advance_frame():
+                tracer = self._tracer
+                if tracer is None:
+                    ok = self._solver.advance_frame()
+                else:
+                    ok = self._native.advance_frame_with_tracers(self._solver, tracer)
+                if not ok:
                     result.cancelled = True
                     break
                 self._solver.write_vdb(cache.volume_path(folder, frame))
+                if tracer is not None:  # atomic (tmp + rename) like the VDB
+                    self._native.write_streak_file(cache.streak_path(folder, frame),
+                                                   tracer.snapshot())
                 # The checkpoint holds every grid (75 MB at 128³), so it is not written every frame.
+                # With streaks it is useless (the tracer cannot be restored): never written.
                 now = time.perf_counter()
-                if (frame == snap.frame_end
+                if tracer is None and (frame == snap.frame_end
                         or now - last_checkpoint >= CHECKPOINT_COST_RATIO * checkpoint_cost):
                     self._solver.save_state(cache.state_path(folder))
                     manifest["state_frame"] = frame
@@ -263,6 +328,8 @@ class BakeRunner:
             "cell_size": s.cell_size,
             "origin": list(s.origin),
             "combustion": s.combustion,
+            "streaks": snap.streaks.enabled,
+            "emission_period": snap.streaks.emission_period,
             "last_complete_frame": snap.frame_start - 1,
             "state_frame": None,
             "frame_inputs": [],

@@ -3,6 +3,8 @@
     <cache_directory>/<domain name>/manifest.json
                                     volume_<frame:04d>.vdb
                                     state.bin            (checkpoint of the last complete frame)
+                                    streaks_<frame:04d>.bin   (streak surfaces on: tracers, §3.2)
+                                    surface_<n>.npz, sheet_<n>_<frame:04d>.exr  (plume.surfaces_build)
 """
 
 import json
@@ -16,6 +18,15 @@ FORMAT_VERSION = 1
 KIND = "smoke"
 
 _VOLUME_RE = re.compile(r"^volume_(-?\d+)\.vdb$")
+_STREAK_RE = re.compile(r"^streaks_(-?\d+)\.bin$")
+#: Files of plume.surfaces_build (per-surface control points and density map images).
+_SURFACE_RE = re.compile(r"^(surface_\d+\.npz|sheet_\d+_-?\d+\.exr)$")
+
+
+def _frame_of(name):
+    """Frame number of a per-frame file (volume or streaks), else None."""
+    m = _VOLUME_RE.match(name) or _STREAK_RE.match(name)
+    return int(m.group(1)) if m else None
 
 
 def folder_name(domain_name):
@@ -30,6 +41,36 @@ def cache_folder(base_directory, domain_name):
 
 def volume_path(folder, frame):
     return os.path.join(folder, f"volume_{frame:04d}.vdb")
+
+
+def streak_path(folder, frame):
+    return os.path.join(folder, f"streaks_{frame:04d}.bin")
+
+
+def surface_path(folder, index):
+    return os.path.join(folder, f"surface_{index}.npz")
+
+
+def sheet_path(folder, index, frame):
+    return os.path.join(folder, f"sheet_{index}_{frame:04d}.exr")
+
+
+def surface_files(folder):
+    """Files of the last plume.surfaces_build in the folder."""
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return []
+    return [os.path.join(folder, n) for n in names if _SURFACE_RE.match(n)]
+
+
+def streak_frames(folder):
+    """Frame numbers of the streaks_*.bin files present, sorted."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(int(m.group(1)) for m in map(_STREAK_RE.match, names) if m)
 
 
 def manifest_path(folder):
@@ -80,7 +121,8 @@ def volume_frames(folder):
 
 
 def plume_files(folder):
-    """Files of the folder that a bake owns: manifest.json, volume_*.vdb, state.bin, *.tmp."""
+    """Files of the folder that a bake owns: manifest.json, volume_*.vdb, streaks_*.bin, state.bin,
+    the surfaces' files, *.tmp."""
     try:
         names = sorted(os.listdir(folder))
     except OSError:
@@ -90,8 +132,8 @@ def plume_files(folder):
         path = os.path.join(folder, name)
         if not os.path.isfile(path):
             continue
-        if (name in (MANIFEST_NAME, STATE_NAME) or _VOLUME_RE.match(name)
-                or name.endswith(".tmp")):
+        if (name in (MANIFEST_NAME, STATE_NAME) or _frame_of(name) is not None
+                or _SURFACE_RE.match(name) or name.endswith(".tmp")):
             own.append(path)
     return own
 
@@ -102,8 +144,8 @@ def delete_plume_files(folder, frames_above=None):
     count = 0
     for path in plume_files(folder):
         if frames_above is not None:
-            m = _VOLUME_RE.match(os.path.basename(path))
-            if not m or int(m.group(1)) <= frames_above:
+            frame = _frame_of(os.path.basename(path))
+            if frame is None or frame <= frames_above:
                 continue
         try:
             os.remove(path)

@@ -78,7 +78,9 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         name="Advection", default='BFECC',
         items=(('SEMI_LAGRANGIAN', "Semi-Lagrangian", "Stable first-order backtrace (Stam 1999)"),
                ('BFECC', "BFECC", "Back and forth error compensation (Kim et al. 2005; "
-                                  "smoke_surfaces.txt §3.1): sharper detail")))
+                                  "smoke_surfaces.txt §3.1): sharper detail"),
+               ('MACCORMACK', "MacCormack", "Selle et al. 2008: BFECC's accuracy with two passes "
+                                            "instead of three (faster)")))
     interpolation: EnumProperty(
         name="Interpolation", default='MONOTONIC_CUBIC',
         items=(('LINEAR', "Linear", "Trilinear sampling"),
@@ -121,6 +123,40 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     expansion: FloatProperty(
         name="Expansion (φ)", default=1.0, soft_min=0.0, soft_max=10.0,
         description="φ: divergence per unit of fuel burnt per second in the reaction zone (eq. 1)")
+    # --- Streak surfaces (smoke_surfaces.txt §3.2-3.4) ---
+    streaks: BoolProperty(
+        name="Streak Surfaces", default=False,
+        description="Streak Surfaces: trace particles from point sources (smoke_surfaces.txt §3.2) "
+                    "during the bake, for plume.surfaces_build")
+    emission_period: IntProperty(
+        name="Emission Period", default=1, soft_min=1, soft_max=20,
+        description="Steps between two particles of a point source (§3.2: one every step)")
+    streak_threshold: FloatProperty(
+        name="Threshold (h0)", default=0.0, soft_min=0.0, soft_max=100.0, precision=4,
+        description="h0: streaklines with h(α,β) < h0 share a surface (§3.3); 0 = the default, "
+                    "the mean of h in each candidate group")
+    density_k_u: IntProperty(
+        name="Sampling u (k_u)", default=4, soft_min=0, soft_max=16,
+        description="k_u: density samples between particles along a streakline (§3.4, Figure 8)")
+    density_k_v: IntProperty(
+        name="Sampling v (k_v)", default=2, soft_min=0, soft_max=16,
+        description="k_v: density samples between neighbouring streaklines (§3.4, Figure 8)")
+    sheet_falloff: EnumProperty(
+        name="Contour", default='EXP',
+        items=(('EXP', "e^(-|n·v|)", "p = d e^(-|n·v|), the paper's choice (§3.4)"),
+               ('LINEAR', "1 - |n·v|", "p = d (1 - |n·v|), the simple attenuation of §3.4")),
+        description="How the angle between normal n and view v shapes the opacity p (§3.4)")
+    sheet_color: FloatVectorProperty(
+        name="Sheet Color", size=4, subtype='COLOR', default=(0.85, 0.85, 0.9, 1.0), min=0.0,
+        max=1.0, description="Colour of the smoke sheets")
+    sheet_brightness: FloatProperty(
+        name="Brightness", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="Emission strength of the smoke sheets")
+    sheet_opacity: FloatProperty(
+        name="Opacity Scale", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="Multiplies the density d in p = d e^(-|n·v|)")
+    surfaces_collection: StringProperty(
+        name="Surfaces", default="", description="Collection holding this domain's streak surfaces")
     # --- Cache ---
     cache_directory: StringProperty(
         name="Cache", subtype='DIR_PATH', default="//plume_cache/",

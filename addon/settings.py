@@ -86,6 +86,8 @@ class EmitterSnapshot:
     matrices: List[np.ndarray]
     source: Optional[SourceParams] = None
     slip: str = "NO_SLIP"
+    point_sources: int = 16  # streak surfaces: tracer point sources per source cell (§3.2)
+    candidate_group: int = -1  # §3.3 candidate group, -1: the source's own group
 
     @property
     def animated(self):
@@ -120,6 +122,19 @@ class EmitterSnapshot:
         return data
 
 
+#: Accepted range of the streak settings (the native StreakParams / random_points_in_cells bounds).
+EMISSION_PERIOD_RANGE = (1, 100000)
+POINT_SOURCES_RANGE = (1, 10000)
+
+
+@dataclass
+class StreakSettings:
+    """Streak surfaces (smoke_surfaces.txt §3.2): tracers from point sources during the bake."""
+
+    enabled: bool = False
+    emission_period: int = 1  # steps between two emissions
+
+
 @dataclass
 class BakeSnapshot:
     """Everything a bake needs, taken on the main thread before the worker starts."""
@@ -133,6 +148,7 @@ class BakeSnapshot:
     solver: SolverSettings = field(default_factory=SolverSettings)
     emitters: List[EmitterSnapshot] = field(default_factory=list)
     addon_version: str = "0.1.0"
+    streaks: StreakSettings = field(default_factory=StreakSettings)
 
     @property
     def frame_count(self):
@@ -148,12 +164,18 @@ class BakeSnapshot:
         solver["boundaries"] = list(solver["boundaries"])
         for key in ("gravity", "wind"):
             solver[key] = list(solver[key])
-        return {
+        data = {
             "domain_resolution": self.resolution,
             "frame_start": self.frame_start,
             "solver": solver,
             "emitters": [e.fingerprint() for e in self.emitters],
         }
+        if self.streaks.enabled:  # absent when off, so older caches still resume
+            data["streaks"] = {
+                "emission_period": self.streaks.emission_period,
+                "sources": [[e.name, e.point_sources, e.candidate_group]
+                            for e in self.emitters if e.role == "SOURCE"]}
+        return data
 
     def frame_input_hash(self, frame):
         """Hash of the emitter matrices that drive frame `frame` (matrices at frame and frame+1)."""
@@ -214,6 +236,45 @@ def validate_source(emitter):
     if not all(math.isfinite(v) for v in s.velocity):
         raise BakeError(
             f"Plume: source '{emitter.name}': velocity must be finite (got {tuple(s.velocity)})")
+
+
+def validate_streaks(domain_name, streaks, emitters):
+    """Streak settings of a bake with streak surfaces on (smoke_surfaces.txt §3.2)."""
+    if not streaks.enabled:
+        return
+    lo, hi = EMISSION_PERIOD_RANGE
+    if not (lo <= streaks.emission_period <= hi):
+        raise BakeError(f"Plume: domain '{domain_name}': emission_period must be in [{lo}, {hi}] "
+                        f"steps (got {streaks.emission_period})")
+    sources = [e for e in emitters if e.role == "SOURCE"]
+    if not sources:
+        raise BakeError(f"Plume: domain '{domain_name}': streak surfaces need at least one Source "
+                        "object (its cells hold the point sources)")
+    lo, hi = POINT_SOURCES_RANGE
+    for e in sources:
+        if not (lo <= e.point_sources <= hi):
+            raise BakeError(f"Plume: source '{e.name}': point_sources must be in [{lo}, {hi}] "
+                            f"(got {e.point_sources})")
+        if e.candidate_group < -1:
+            raise BakeError(f"Plume: source '{e.name}': candidate_group must be >= -1 "
+                            f"(-1 = its own group; got {e.candidate_group})")
+
+
+def candidate_groups(emitters):
+    """Candidate group of each Source (§3.3), in source order: the explicit group, or for -1 a
+    number of its own that no explicit group uses."""
+    sources = [e for e in emitters if e.role == "SOURCE"]
+    used = {e.candidate_group for e in sources if e.candidate_group >= 0}
+    groups, next_free = [], 0
+    for e in sources:
+        if e.candidate_group >= 0:
+            groups.append(e.candidate_group)
+            continue
+        while next_free in used:
+            next_free += 1
+        used.add(next_free)
+        groups.append(next_free)
+    return groups
 
 
 def to_native_params(solver, native):

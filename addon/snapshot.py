@@ -8,7 +8,7 @@ from mathutils import Vector
 
 from . import cache
 from .settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, EmitterSnapshot, SolverSettings,
-                       SourceParams, domain_grid)
+                       SourceParams, StreakSettings, domain_grid)
 
 NOT_A_DOMAIN = ("Plume: the active object is not a Plume domain "
                 "(set one with plume.role_set(role='DOMAIN'))")
@@ -114,7 +114,8 @@ def emitter_snapshots(context, domain, frame_start, frame_end):
                                 fuel=float(s.fuel), velocity=tuple(float(v) for v in s.velocity),
                                 motion_factor=float(s.motion_factor))
             if o.plume.role == 'SOURCE' else None,
-            slip=o.plume.obstacle.slip))
+            slip=o.plume.obstacle.slip,
+            point_sources=int(s.point_sources), candidate_group=int(s.candidate_group)))
     animated = [i for i, o in enumerate(objs) if _is_animated(o)]
     if animated:
         current, subframe = scene.frame_current, scene.frame_subframe
@@ -152,4 +153,5 @@ def take_snapshot(context, addon_version="0.1.0"):
         frame_end=frame_end, cache_directory=d.cache_directory,
         cache_folder=cache_folder_of(domain), solver=solver,
         emitters=emitter_snapshots(context, domain, frame_start, frame_end),
-        addon_version=addon_version)
+        addon_version=addon_version,
+        streaks=StreakSettings(enabled=bool(d.streaks), emission_period=int(d.emission_period)))

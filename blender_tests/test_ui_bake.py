@@ -49,9 +49,10 @@ class UiBakeTest(unittest.TestCase):
 
     def test_invoke_runs_modal_on_a_worker_thread(self):
         self.assertEqual(self.result["invoke"], ["RUNNING_MODAL"])
-        # Blender kept handling timers while the bake ran: several polls saw it baking.
-        baking = [s for s in self.result["seen"] if s[2]]
-        self.assertGreaterEqual(len(baking), 2, self.result["seen"])
+        # Blender kept handling timers while the bake ran: a poll saw it mid-bake (invoke had
+        # returned, frames were done, more were to come).
+        baking = [s for s in self.result["seen"] if s[2] and 0 < s[1] < self.result["total"]]
+        self.assertGreaterEqual(len(baking), 1, self.result["seen"])
 
     def test_esc_cancels_within_one_step_and_keeps_finished_frames(self):
         r = self.result

@@ -1,5 +1,5 @@
-"""Operators: plume.role_set, plume.bake, plume.cache_free."""
+"""Operators: plume.role_set, plume.bake, plume.cache_free, plume.surfaces_build."""
 
-from . import bake, roles
+from . import bake, roles, surfaces
 
-classes = roles.classes + bake.classes
+classes = roles.classes + bake.classes + surfaces.classes

@@ -4,6 +4,7 @@ Mantaflow's): role buttons, then the settings of the object's role."""
 import bpy
 
 from ..operators.bake import cache_status, is_baking
+from ..operators.surfaces import live_summary
 from ..properties import ROLE_ITEMS
 
 
@@ -163,6 +164,40 @@ class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
             layout.label(text=f"Volume: {d.volume_object}", icon='OUTLINER_OB_VOLUME')
 
 
+class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Streak Surfaces"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw_header(self, context):
+        self.layout.prop(context.object.plume.domain, "streaks", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        ob = context.object
+        d = ob.plume.domain
+        col = layout.column()
+        col.active = d.streaks
+        col.prop(d, "emission_period")
+        col.prop(d, "streak_threshold")
+        # Live count from the h cached by the last build (never computed here, §3.3 Figure 4).
+        counts = live_summary(ob)
+        if counts is not None:
+            col.label(text=f"{counts[0]} surfaces from {counts[1]} streaklines", icon='INFO')
+        else:
+            col.label(text="Build once to see the surface count", icon='INFO')
+        sub = col.column(align=True)
+        sub.prop(d, "density_k_u")
+        sub.prop(d, "density_k_v")
+        col.prop(d, "sheet_falloff")
+        col.prop(d, "sheet_color")
+        col.prop(d, "sheet_brightness")
+        col.prop(d, "sheet_opacity")
+        row = col.row()
+        row.enabled = not is_baking(ob)
+        row.operator("plume.surfaces_build", icon='SURFACE_NSURFACE')
+
+
 class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
     bl_label = "Source"
     bl_parent_id = "PHYSICS_PT_plume"
@@ -210,6 +245,7 @@ classes = (
     PHYSICS_PT_plume_boundaries,
     PHYSICS_PT_plume_combustion,
     PHYSICS_PT_plume_cache,
+    PHYSICS_PT_plume_streaks,
     PHYSICS_PT_plume_source,
     PHYSICS_PT_plume_obstacle,
 )

@@ -1,0 +1,310 @@
+"""Streak surfaces end to end (smoke_surfaces.txt §3.2-3.4, the paper's Figure 1 setup): a 50³
+domain with one tiny source cell holding 20 point sources bakes with streaks on, then
+plume.surfaces_build makes >= 2 SURFACE objects whose points follow the cache on frame changes,
+and a Cycles render shows semi-transparent sheets. Bad input gives a clear error, changes nothing.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_streak_surfaces.py
+PNG renders go to $PLUME_TEST_OUT (default /tmp/plume_test_out).
+"""
+
+import os
+import sys
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (OUT_DIR, add_domain, image_pixels, reset_scene, rmtree, run,  # noqa: E402
+                     select_only, temp_dir)
+
+RESOLUTION = 50
+FRAMES = 40
+POINT_SOURCES = 20
+
+
+def build_scene(cache_dir, frame_end=FRAMES, point_sources=POINT_SOURCES, streaks=True):
+    """Figure 1: a single small source cell low in a 50³ domain, smoke rising from it."""
+    cell = 2.0 / RESOLUTION
+    # Cell centre near the bottom middle of the domain [-1, 1]² x [0, 2].
+    centre = (0.5 * cell, 0.5 * cell, 0.2 + 0.5 * cell)
+    bpy.ops.mesh.primitive_cube_add(size=cell * 0.9, location=centre)
+    src = bpy.context.active_object
+    src.name = "Incense"
+    bpy.ops.plume.role_set(role='SOURCE')
+    s = src.plume.source
+    s.point_sources = point_sources
+    s.velocity = (0.0, 0.0, 1.0)
+    s.density = 1.0
+    s.temperature = 2.0
+    src.hide_render = True
+    dom = add_domain(resolution=RESOLUTION, frame_end=frame_end, cache_directory=cache_dir + "/")
+    d = dom.plume.domain
+    d.streaks = streaks
+    d.vorticity = 0.3
+    select_only(dom)
+    return dom
+
+
+def surface_objects():
+    return [o for o in bpy.data.objects if o.type == 'SURFACE']
+
+
+def counts():
+    return (len(bpy.data.objects), len(bpy.data.curves), len(bpy.data.materials),
+            len(bpy.data.images), len(bpy.data.collections))
+
+
+def setup_render(path, samples=16):
+    scn = bpy.context.scene
+    scn.render.engine = 'CYCLES'
+    scn.cycles.device = 'CPU'
+    scn.cycles.samples = samples
+    scn.cycles.use_denoising = False
+    scn.render.resolution_x, scn.render.resolution_y = 160, 120
+    scn.render.resolution_percentage = 100
+    scn.render.film_transparent = False
+    scn.render.image_settings.file_format = 'PNG'
+    scn.render.image_settings.color_mode = 'RGBA'
+    scn.render.filepath = path
+    smoke = bpy.data.objects.get("Domain_smoke")
+    if smoke is not None:
+        smoke.hide_render = True  # only the sheets differ between the two renders
+    if scn.world is None:
+        scn.world = bpy.data.worlds.new("World")
+    scn.world.use_nodes = True
+    bg = scn.world.node_tree.nodes.get("Background")
+    bg.inputs["Color"].default_value = (0.02, 0.02, 0.03, 1.0)
+    if scn.camera is None:
+        cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+        scn.collection.objects.link(cam)
+        cam.location = (0.0, -2.2, 1.1)
+        cam.rotation_euler = (np.pi / 2, 0.0, 0.0)
+        scn.camera = cam
+        light = bpy.data.objects.new("Light", bpy.data.lights.new("Light", 'SUN'))
+        scn.collection.objects.link(light)
+        # A backdrop plane with a checker pattern: seen through the sheets where they are thin.
+        bpy.ops.mesh.primitive_plane_add(size=6.0, location=(0.0, 2.0, 1.0),
+                                         rotation=(np.pi / 2, 0.0, 0.0))
+        plane = bpy.context.active_object
+        mat = bpy.data.materials.new("Backdrop")
+        mat.use_nodes = True
+        nt = mat.node_tree
+        checker = nt.nodes.new("ShaderNodeTexChecker")
+        checker.inputs["Scale"].default_value = 12.0
+        checker.inputs["Color1"].default_value = (0.3, 0.05, 0.05, 1.0)
+        checker.inputs["Color2"].default_value = (0.05, 0.05, 0.3, 1.0)
+        em = nt.nodes.new("ShaderNodeEmission")
+        nt.links.new(checker.outputs["Color"], em.inputs["Color"])
+        nt.links.new(em.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+        plane.data.materials.append(mat)
+
+
+def render(path):
+    setup_render(path)
+    bpy.ops.render.render(write_still=True)
+    return image_pixels(path)
+
+
+class StreakSurfacesTest(unittest.TestCase):
+    """One bake shared by the tests (a 50³ bake of 40 frames takes a while on 2 cores)."""
+
+    @classmethod
+    def setUpClass(cls):
+        reset_scene()
+        cls.tmp = temp_dir("plume_streaks_")
+        cls.cache = os.path.join(cls.tmp, "cache")
+        cls.dom = build_scene(cls.cache)
+        t0 = time.perf_counter()
+        assert bpy.ops.plume.bake() == {'FINISHED'}
+        print(f"  bake took {time.perf_counter() - t0:.1f} s")
+        cls.folder = os.path.join(cls.cache, "Domain")
+
+    @classmethod
+    def tearDownClass(cls):
+        rmtree(cls.tmp)
+
+    def setUp(self):
+        select_only(bpy.data.objects["Domain"])
+        bpy.context.scene.frame_set(1)
+
+    def build(self):
+        t0 = time.perf_counter()
+        self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})
+        print(f"  surfaces_build took {time.perf_counter() - t0:.2f} s")
+        return surface_objects()
+
+    def test_1_streak_files_written(self):
+        from plume import _native
+        for f in range(1, FRAMES + 1):
+            self.assertTrue(os.path.isfile(os.path.join(self.folder, f"streaks_{f:04d}.bin")), f)
+        snap = _native.read_streak_file(os.path.join(self.folder, f"streaks_{FRAMES:04d}.bin"))
+        self.assertEqual(len(snap["counts"]) % POINT_SOURCES, 0)
+        self.assertGreaterEqual(len(snap["counts"]), POINT_SOURCES)
+        self.assertGreater(int(snap["counts"][0]), FRAMES)  # one particle per step
+        self.assertFalse(os.path.isfile(os.path.join(self.folder, "state.bin")))
+
+    def test_2_build_and_frame_change(self):
+        obs = self.build()  # default h0 (mean of h): one cell's streaklines chain into one sheet
+        self.assertGreaterEqual(len(obs), 1)
+        # The artist lowers h0 watching the panel's live count (h cached by the first build).
+        from plume.operators.surfaces import cached_distances, live_summary
+        dom = bpy.data.objects["Domain"]
+        groups = cached_distances(dom)
+        self.assertIsNotNone(groups)
+        h = np.concatenate([g.h[np.triu_indices(len(g.h), 1)] for g in groups.values()])
+        for q in (30, 20, 10, 5):
+            dom.plume.domain.streak_threshold = float(np.percentile(h, q))
+            n_surfaces, n_lines = live_summary(dom)
+            print(f"  h0 = {q}th percentile of h: {n_surfaces} surfaces from {n_lines} streaklines")
+            if n_surfaces >= 2:
+                break
+        self.assertGreaterEqual(n_surfaces, 2)
+        obs = self.build()
+        self.assertEqual(len(obs), n_surfaces, [o.name for o in obs])
+        coll = bpy.data.collections.get("Domain_surfaces")
+        self.assertIsNotNone(coll)
+        self.assertEqual(set(coll.objects), set(obs))
+        for ob in obs:
+            sp = ob.data.splines[0]
+            self.assertEqual(len(ob.data.splines), 1)
+            self.assertGreaterEqual(sp.point_count_v, 2)
+            self.assertGreater(sp.point_count_u, FRAMES)
+            self.assertTrue(ob.data.materials[0].name.startswith("Plume Smoke Sheet"))
+        # Fixed net, points follow the cache on frame changes.
+        from plume.build import surfaces as build
+        scn = bpy.context.scene
+        before = {}
+        for ob in obs:
+            co = np.empty(len(ob.data.splines[0].points) * 4, np.float32)
+            ob.data.splines[0].points.foreach_get("co", co)
+            before[ob.name] = co
+        times = []
+        for f in range(25, 31):
+            scn.frame_set(f)
+            self.assertEqual(len(build.last_update_seconds), len(obs))
+            times += build.last_update_seconds
+        print(f"  per-surface update: max {max(times) * 1e3:.3f} ms, "
+              f"mean {np.mean(times) * 1e3:.3f} ms")
+        self.assertLess(max(times), 0.005)
+        for ob in obs:
+            co = np.empty(len(ob.data.splines[0].points) * 4, np.float32)
+            ob.data.splines[0].points.foreach_get("co", co)
+            self.assertEqual(co.shape, before[ob.name].shape)
+            self.assertGreater(np.abs(co - before[ob.name]).max(), 0.05, ob.name)
+        # The evaluated surface moved too (the depsgraph saw the update).
+        dg = bpy.context.evaluated_depsgraph_get()
+        top = max(max((ob.evaluated_get(dg).matrix_world @ __import__("mathutils").Vector(c)).z
+                      for c in ob.evaluated_get(dg).bound_box) for ob in obs)
+        self.assertGreater(top, 0.5)
+
+    def test_3_render_is_semi_transparent(self):
+        if not surface_objects():
+            self.build()
+        os.makedirs(OUT_DIR, exist_ok=True)
+        scn = bpy.context.scene
+        scn.frame_set(FRAMES)
+        with_sheets = render(os.path.join(OUT_DIR, "streak_surfaces.png"))
+        for ob in surface_objects():
+            ob.hide_render = True
+        try:
+            empty = render(os.path.join(OUT_DIR, "streak_surfaces_empty.png"))
+        finally:
+            for ob in surface_objects():
+                ob.hide_render = False
+        diff = np.abs(with_sheets[..., :3] - empty[..., :3]).max(axis=-1)
+        covered = diff > 4 / 255
+        share = covered.mean()
+        print(f"  pixels changed by the sheets: {share:.3%}")
+        self.assertGreater(share, 0.005, "the sheets do not show")
+        # Semi-transparent: the checker backdrop still shows through covered pixels, so their
+        # red/blue contrast survives partly; and the changes span a range of strengths.
+        vals = diff[covered]
+        levels = np.unique(np.round(vals * 255))
+        print(f"  change strengths: {np.percentile(vals, [5, 50, 95])}, {len(levels)} levels")
+        self.assertGreater(len(levels), 10)
+        bg_contrast = np.abs(empty[..., 0] - empty[..., 2])
+        fg_contrast = np.abs(with_sheets[..., 0] - with_sheets[..., 2])
+        see_through = covered & (bg_contrast > 0.05) & (fg_contrast > 0.2 * bg_contrast)
+        self.assertGreater(see_through.sum(), 0.5 * covered.sum() * 0.1,
+                           "nothing of the backdrop shows through the sheets")
+        self.assertLess(vals.min(), 0.5 * vals.max())
+
+    # ------------------------------------------------------------------- bad input
+    def assert_error(self, pattern):
+        before = counts()
+        with self.assertRaises(RuntimeError) as ctx:
+            bpy.ops.plume.surfaces_build()
+        self.assertRegex(str(ctx.exception), pattern)
+        self.assertEqual(counts(), before)
+
+    def test_4_negative_threshold(self):
+        d = bpy.data.objects["Domain"].plume.domain
+        d.streak_threshold = -1.0
+        try:
+            self.assert_error(r"streak_threshold \(h0\) must be >= 0")
+        finally:
+            d.streak_threshold = 0.0
+
+    def test_5_negative_sampling(self):
+        d = bpy.data.objects["Domain"].plume.domain
+        d.density_k_u = -1
+        try:
+            self.assert_error(r"density_k_u must be >= 0")
+        finally:
+            d.density_k_u = 4
+
+    def test_6_missing_streak_file(self):
+        path = os.path.join(self.folder, "streaks_0010.bin")
+        keep = path + ".keep"
+        os.rename(path, keep)
+        try:
+            self.assert_error(r"streaks_0010\.bin is missing")
+        finally:
+            os.rename(keep, path)
+
+
+class StreakBadInputTest(unittest.TestCase):
+    def setUp(self):
+        reset_scene()
+        self.tmp = temp_dir("plume_streaks_bad_")
+        self.cache = os.path.join(self.tmp, "cache")
+
+    def tearDown(self):
+        rmtree(self.tmp)
+
+    def assert_error(self, pattern):
+        before = counts()
+        with self.assertRaises(RuntimeError) as ctx:
+            bpy.ops.plume.surfaces_build()
+        self.assertRegex(str(ctx.exception), pattern)
+        self.assertEqual(counts(), before)
+
+    def test_no_bake_yet(self):
+        build_scene(self.cache, frame_end=3)
+        self.assert_error(r"has no bake yet")
+
+    def test_baked_without_streaks(self):
+        build_scene(self.cache, frame_end=2, streaks=False)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assert_error(r"baked without streak surfaces")
+
+    def test_group_with_one_source(self):
+        build_scene(self.cache, frame_end=2, point_sources=1)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assert_error(r"candidate group 0 has a single point source")
+
+    def test_bad_emission_period_writes_nothing(self):
+        dom = build_scene(self.cache, frame_end=2)
+        dom.plume.domain.emission_period = 0
+        with self.assertRaises(RuntimeError) as ctx:
+            bpy.ops.plume.bake()
+        self.assertIn("emission_period must be in [1, 100000]", str(ctx.exception))
+        self.assertFalse(os.path.exists(self.cache))
+
+
+if __name__ == "__main__":
+    run(StreakSurfacesTest, StreakBadInputTest)
