@@ -8,7 +8,8 @@
 
 #include "io/state_file.h"
 
-#include <cstdio>
+#include "io/byte_buffer.h"
+
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -36,98 +37,6 @@ std::vector<GridRef> stateGrids(SmokeSolver& s) {
           {"pressure", &s.pressure()}};
 }
 
-bool hostIsLittleEndian() {
-  const std::uint32_t one = 1;
-  unsigned char b;
-  std::memcpy(&b, &one, 1);
-  return b == 1;
-}
-
-/// FNV-1a, 64 bit, over a byte range, continuing from `hash`.
-std::uint64_t fnv1a(const unsigned char* data, std::size_t size,
-                    std::uint64_t hash = 0xcbf29ce484222325ull) {
-  for (std::size_t n = 0; n < size; ++n) {
-    hash ^= data[n];
-    hash *= 0x100000001b3ull;
-  }
-  return hash;
-}
-
-/// Appends little-endian bytes to a buffer.
-class Writer {
- public:
-  void bytes(const void* p, std::size_t n) {
-    const auto* c = static_cast<const unsigned char*>(p);
-    mBuf.insert(mBuf.end(), c, c + n);
-  }
-  template <typename T>
-  void integer(T v) {
-    for (std::size_t b = 0; b < sizeof(T); ++b)
-      mBuf.push_back(static_cast<unsigned char>((static_cast<std::uint64_t>(v) >> (8 * b)) & 0xff));
-  }
-  void floats(const std::vector<float>& v) {
-    const std::size_t start = mBuf.size();
-    mBuf.resize(start + 4 * v.size());
-    if (hostIsLittleEndian()) {
-      std::memcpy(mBuf.data() + start, v.data(), 4 * v.size());
-    } else {
-      for (std::size_t n = 0; n < v.size(); ++n) {
-        std::uint32_t u;
-        std::memcpy(&u, &v[n], 4);
-        for (int b = 0; b < 4; ++b) mBuf[start + 4 * n + b] = (u >> (8 * b)) & 0xff;
-      }
-    }
-  }
-  std::vector<unsigned char>& buffer() { return mBuf; }
-
- private:
-  std::vector<unsigned char> mBuf;
-};
-
-/// Reads little-endian values from a buffer whose size has already been checked.
-class Reader {
- public:
-  Reader(const std::vector<unsigned char>& buf, const std::string& path) : mBuf(buf), mPath(path) {}
-  void need(std::size_t n) const {
-    if (mPos + n > mBuf.size() || mPos + n < mPos)
-      throw std::runtime_error("state file '" + mPath + "' is truncated");
-  }
-  template <typename T>
-  T integer() {
-    need(sizeof(T));
-    std::uint64_t v = 0;
-    for (std::size_t b = 0; b < sizeof(T); ++b) v |= std::uint64_t(mBuf[mPos + b]) << (8 * b);
-    mPos += sizeof(T);
-    return static_cast<T>(v);
-  }
-  std::string string(std::size_t n) {
-    need(n);
-    std::string s(reinterpret_cast<const char*>(mBuf.data() + mPos), n);
-    mPos += n;
-    return s;
-  }
-  void floats(std::vector<float>& out, std::size_t n) {
-    need(4 * n);
-    out.resize(n);
-    if (hostIsLittleEndian()) {
-      std::memcpy(out.data(), mBuf.data() + mPos, 4 * n);
-    } else {
-      for (std::size_t m = 0; m < n; ++m) {
-        std::uint32_t u = 0;
-        for (int b = 0; b < 4; ++b) u |= std::uint32_t(mBuf[mPos + 4 * m + b]) << (8 * b);
-        std::memcpy(&out[m], &u, 4);
-      }
-    }
-    mPos += 4 * n;
-  }
-  std::size_t position() const { return mPos; }
-
- private:
-  const std::vector<unsigned char>& mBuf;
-  const std::string& mPath;
-  std::size_t mPos = 0;
-};
-
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw std::runtime_error("state file '" + path + "' " + what);
 }
@@ -138,7 +47,7 @@ void writeState(const std::string& path, const SmokeSolver& solver) {
   // stateGrids only reads through these pointers here.
   auto grids = stateGrids(const_cast<SmokeSolver&>(solver));
   const glm::ivec3 n = solver.params().resolution;
-  Writer w;
+  ByteWriter w;
   std::size_t total = kHeaderSize + 8;
   for (const GridRef& g : grids) total += 4 + std::strlen(g.name) + 8 + 4 * g.grid->count();
   w.buffer().reserve(total);
@@ -154,32 +63,12 @@ void writeState(const std::string& path, const SmokeSolver& solver) {
     w.integer<std::uint32_t>(std::uint32_t(len));
     w.bytes(g.name, len);
     w.integer<std::uint64_t>(std::uint64_t(g.grid->count()));
-    w.floats(g.grid->values());
+    w.floats(g.grid->data(), g.grid->count());
   }
-  const std::uint64_t sum = fnv1a(w.buffer().data(), w.buffer().size());
+  const std::uint64_t sum = fnv1a64(w.buffer().data(), w.buffer().size());
   w.integer<std::uint64_t>(sum);
 
-  const std::string tmp = path + ".tmp";
-  bool ok = false;
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (out) {
-      out.write(reinterpret_cast<const char*>(w.buffer().data()),
-                std::streamsize(w.buffer().size()));
-      out.flush();
-      ok = bool(out);
-      out.close();
-      ok = ok && !out.fail();
-    }
-  }
-  if (!ok) {
-    std::remove(tmp.c_str());
-    fail(path, "cannot be written (missing directory, no permission or disk full?)");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    fail(path, "cannot be written: renaming the temporary file '" + tmp + "' failed");
-  }
+  writeFileAtomic(path, w.buffer(), "state file");
 }
 
 void readState(const std::string& path, SmokeSolver& solver) {
@@ -193,7 +82,7 @@ void readState(const std::string& path, SmokeSolver& solver) {
   std::vector<unsigned char> header(kHeaderSize);
   if (!in.read(reinterpret_cast<char*>(header.data()), std::streamsize(kHeaderSize)))
     fail(path, "cannot be read");
-  Reader h(header, path);
+  ByteReader h(header.data(), header.size(), "state file", path);
   if (h.string(sizeof(kMagic)) != std::string(kMagic, sizeof(kMagic)))
     fail(path, "is not a Plume state file (bad magic)");
   const std::uint32_t version = h.integer<std::uint32_t>();
@@ -235,11 +124,10 @@ void readState(const std::string& path, SmokeSolver& solver) {
   if (!in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(expectedSize)))
     fail(path, "cannot be read");
 
-  Reader r(buf, path);
+  ByteReader r(buf.data(), buf.size(), "state file", path);
   {
-    Reader tail(buf, path);
-    tail.string(expectedSize - 8);
-    if (fnv1a(buf.data(), expectedSize - 8) != tail.integer<std::uint64_t>())
+    ByteReader tail(buf.data() + expectedSize - 8, 8, "state file", path);
+    if (fnv1a64(buf.data(), expectedSize - 8) != tail.integer<std::uint64_t>())
       fail(path, "is corrupt (checksum mismatch)");
   }
   r.string(kHeaderSize);
@@ -256,7 +144,8 @@ void readState(const std::string& path, SmokeSolver& solver) {
         << grids[g].grid->count();
       fail(path, s.str());
     }
-    r.floats(values[g], std::size_t(count));
+    values[g].resize(std::size_t(count));
+    r.floats(values[g].data(), std::size_t(count));
   }
   if (r.position() + 8 != expectedSize) fail(path, "is corrupt (unexpected trailing bytes)");
 
