@@ -10,6 +10,8 @@ import time
 import bpy
 import numpy as np
 
+from . import surface_edits
+
 #: Custom properties of a surface object: its control-point cache and the domain it came from.
 CACHE_KEY = "plume_surface_cache"
 DOMAIN_KEY = "plume_surface_domain"
@@ -54,21 +56,30 @@ def _control_points(path):
     return hit
 
 
-def update_object(ob, frame):
-    """Sets the surface's control points of `frame` (clamped to the baked range). True if set."""
+def cache_of(ob):
+    """(frame_start, control points (frames, n, 4) float32) of a Plume surface, or None."""
     path = ob.get(CACHE_KEY)
     if not path or ob.type != 'SURFACE' or not ob.data.splines:
-        return False
+        return None
     hit = _control_points(bpy.path.abspath(path))
+    if hit is None or len(ob.data.splines[0].points) != hit[2].shape[1]:
+        return None  # missing cache, or the artist changed the net's topology: leave it alone
+    return hit[1], hit[2]
+
+
+def update_object(ob, frame):
+    """Sets the surface's control points of `frame` (clamped to the baked range) plus the hand
+    edits (surface_edits.py), capturing first any edit made since the last update. True if set.
+    Baked surfaces (keyframes) and surfaces in edit mode are left alone."""
+    if ob.get(surface_edits.BAKED_KEY) or ob.mode == 'EDIT':
+        return False
+    hit = cache_of(ob)
     if hit is None:
         return False
-    _, frame_start, cps = hit
-    points = ob.data.splines[0].points
-    if len(points) != cps.shape[1]:
-        return False  # the artist changed the net's topology: leave it alone
+    frame_start, cps = hit
+    surface_edits.capture(ob, cps)
     i = min(max(frame - frame_start, 0), len(cps) - 1)
-    points.foreach_set("co", cps[i].ravel())
-    ob.data.update_tag()
+    surface_edits.write(ob, cps, i)
     return True
 
 
@@ -173,6 +184,7 @@ def build_surfaces(context, domain, folder, frame_start, anims, sheets, settings
             sp = ob.data.splines[0]
             frame = min(max(scene.frame_current - frame_start, 0), len(anim.control_points) - 1)
             sp.points.foreach_set("co", anim.control_points[frame].ravel())
+            ob[surface_edits.FRAME_KEY] = frame
             sp.order_u, sp.order_v = anim.order_u, anim.order_v
             sp.use_endpoint_u = sp.use_endpoint_v = True
             sp.resolution_u, sp.resolution_v = RESOLUTION_U, RESOLUTION_V

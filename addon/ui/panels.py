@@ -196,6 +196,15 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         row = col.row()
         row.enabled = not is_baking(ob)
         row.operator("plume.surfaces_build", icon='SURFACE_NSURFACE')
+        # On the built surfaces (all of this domain's; §5 hand edits, keyframes, mesh export).
+        if d.surfaces_collection:
+            sub = col.column(align=True)
+            row = sub.row(align=True)
+            row.operator("plume.surface_edits_store", icon='EDITMODE_HLT')
+            row.operator("plume.surface_edits_clear", icon='X')
+            row = sub.row(align=True)
+            row.operator("plume.surfaces_bake_keyframes", icon='KEYINGSET')
+            row.operator("plume.surfaces_export_mesh", icon='MESH_GRID')
 
 
 class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):

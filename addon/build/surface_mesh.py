@@ -1,0 +1,98 @@
+"""Mesh export of a streak surface: the current frame's control net refined with OpenSubdiv
+(_native.subdivide_mesh, Catmull-Clark to the limit surface) into a MESH object carrying the §3.4
+density map of that frame as the float point attribute "density" (clamped to [0, 1], like the
+sheet material's opacity), for other render engines and quick previews."""
+
+import os
+import re
+
+import bpy
+import numpy as np
+
+from .. import _native, cache
+from ..settings import BakeError
+from . import surface_edits
+from .surfaces import CACHE_KEY, cache_of
+
+#: Custom property of an exported mesh object: the surface it came from.
+SOURCE_KEY = "plume_mesh_of"
+
+
+def mesh_name(ob):
+    return f"{ob.name}_mesh"
+
+
+def expected_vertex_count(nu, nv, level):
+    return ((nu - 1) * 2 ** level + 1) * ((nv - 1) * 2 ** level + 1)
+
+
+def sheet_file(ob, frame):
+    """The density-map EXR of the surface at `frame` (clamped to the cached frames)."""
+    path = bpy.path.abspath(ob[CACHE_KEY])
+    m = re.search(r"surface_(\d+)\.npz$", path)
+    hit = cache_of(ob)
+    if m is None or hit is None:
+        raise BakeError(f"Plume: the control-point cache of surface '{ob.name}' ({path}) is "
+                        "missing or does not match its control net: build the surfaces again")
+    frame_start, cps = hit
+    f = min(max(frame, frame_start), frame_start + len(cps) - 1)
+    sheet = cache.sheet_path(os.path.dirname(path), int(m.group(1)), f)
+    if not os.path.isfile(sheet):
+        raise BakeError(f"Plume: density map {sheet} of surface '{ob.name}' is missing: build "
+                        "the surfaces again (plume.surfaces_build)")
+    return sheet
+
+
+def read_density(path):
+    """The density map (rows = v, columns = u) of a sheet EXR, float32."""
+    img = bpy.data.images.load(path, check_existing=False)
+    try:
+        w, h = img.size
+        px = np.empty(w * h * 4, dtype=np.float32)
+        img.pixels.foreach_get(px)
+    finally:
+        bpy.data.images.remove(img)
+    return np.ascontiguousarray(px.reshape(h, w, 4)[..., 0])
+
+
+def export_mesh(ob, frame, level):
+    """Creates or replaces the MESH object f"{ob.name}_mesh"; returns it. BakeError on bad input
+    (the scene is unchanged then)."""
+    sp = ob.data.splines[0]
+    nu, nv = sp.point_count_u, sp.point_count_v
+    density = read_density(sheet_file(ob, frame))
+    try:
+        verts, quads, dens = _native.subdivide_mesh(surface_edits.current_points(ob), nu, nv,
+                                                    level, density, True)
+    except ValueError as e:
+        raise BakeError(f"Plume: mesh export of '{ob.name}': {e}") from None
+    verts = np.asarray(verts, dtype=np.float32)
+    quads = np.asarray(quads, dtype=np.int32)
+    dens = np.clip(np.asarray(dens, dtype=np.float32), 0.0, 1.0)
+
+    name = mesh_name(ob)
+    me = bpy.data.meshes.new(name)
+    me.vertices.add(len(verts))
+    me.vertices.foreach_set("co", verts.ravel())
+    me.loops.add(quads.size)
+    me.loops.foreach_set("vertex_index", quads.ravel())
+    me.polygons.add(len(quads))
+    me.polygons.foreach_set("loop_start", np.arange(0, quads.size, 4, dtype=np.int32))
+    me.polygons.foreach_set("loop_total", np.full(len(quads), 4, dtype=np.int32))
+    me.update(calc_edges=True)
+    me.attributes.new("density", 'FLOAT', 'POINT').data.foreach_set("value", dens)
+    me.polygons.foreach_set("use_smooth", np.ones(len(quads), dtype=bool))
+
+    out = bpy.data.objects.get(name)
+    if out is not None and out.type == 'MESH':
+        old = out.data
+        out.data = me
+        if old.users == 0:
+            bpy.data.meshes.remove(old)
+    else:
+        out = bpy.data.objects.new(name, me)
+        for coll in ob.users_collection:
+            coll.objects.link(out)
+    out.matrix_world = ob.matrix_world.copy()
+    out[SOURCE_KEY] = ob.name
+    return out

@@ -1,0 +1,242 @@
+"""Hand edits of streak surfaces (smoke_surfaces.txt §5, Figure 13), Bake to Keyframes and the
+OpenSubdiv mesh export, on the Figure 1 setup of test_streak_surfaces.py (50³, 20 point sources).
+
+An edit made on frame 10 is stored as offsets in (u, v) control-point index space and shows,
+moved with the surface, on frame 1, the last frame and frame 200: point = cache(frame) + offset.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_surface_edits.py
+"""
+
+import os
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import add_domain, reset_scene, rmtree, run, select_only, temp_dir  # noqa: E402
+from test_streak_surfaces import FRAMES, build_scene, counts, surface_objects  # noqa: E402
+
+EDIT_FRAME = 10
+MOVE = np.array([0.15, -0.05, 0.25], dtype=np.float32)
+
+
+def points_of(ob, evaluated=False):
+    if evaluated:
+        ob = ob.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    pts = ob.data.splines[0].points
+    co = np.empty(len(pts) * 4, np.float32)
+    pts.foreach_get("co", co)
+    return co.reshape(-1, 4)
+
+
+def cache_points(ob):
+    """The surface's control points per cached frame, read straight from its file."""
+    with np.load(bpy.path.abspath(ob["plume_surface_cache"])) as z:
+        return int(z["frame_start"]), np.array(z["control_points"])
+
+
+def cache_at(ob, frame):
+    start, cps = cache_points(ob)
+    return cps[min(max(frame - start, 0), len(cps) - 1)]
+
+
+def edited_indices(ob):
+    """A few control points in the middle of the net (u, v index space)."""
+    sp = ob.data.splines[0]
+    nu, nv = sp.point_count_u, sp.point_count_v
+    v = nv // 2
+    return [v * nu + u for u in range(nu // 3, nu // 3 + 4)]
+
+
+class SurfaceEditsTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        reset_scene()
+        cls.tmp = temp_dir("plume_edits_")
+        cls.dom = build_scene(os.path.join(cls.tmp, "cache"))
+        assert bpy.ops.plume.bake() == {'FINISHED'}
+        assert bpy.ops.plume.surfaces_build() == {'FINISHED'}
+        # Two or more sheets, so edits of one are seen not to touch the others.
+        from plume.operators.surfaces import cached_distances
+        groups = cached_distances(cls.dom)
+        h = np.concatenate([g.h[np.triu_indices(len(g.h), 1)] for g in groups.values()])
+        cls.dom.plume.domain.streak_threshold = float(np.percentile(h, 10))
+        assert bpy.ops.plume.surfaces_build() == {'FINISHED'}
+
+    @classmethod
+    def tearDownClass(cls):
+        rmtree(cls.tmp)
+
+    def setUp(self):
+        select_only(bpy.data.objects["Domain"])
+        bpy.context.scene.frame_set(1)
+        self.obs = sorted(surface_objects(), key=lambda o: o.name)
+        self.assertGreaterEqual(len(self.obs), 1)
+
+    def edit_on_frame(self, ob, frame=EDIT_FRAME):
+        """The artist's move by script (spline.points[i].co) on `frame`."""
+        bpy.context.scene.frame_set(frame)
+        sp = ob.data.splines[0]
+        for k in edited_indices(ob):
+            x, y, z, w = sp.points[k].co
+            sp.points[k].co = (x + MOVE[0], y + MOVE[1], z + MOVE[2], w)
+        return points_of(ob)
+
+    def assert_follows(self, ob, frame, moved=True, evaluated=False):
+        bpy.context.scene.frame_set(frame)
+        want = cache_at(ob, frame).copy()
+        if moved:
+            want[edited_indices(ob), :3] += MOVE
+        np.testing.assert_allclose(points_of(ob, evaluated), want, atol=1e-5,
+                                   err_msg=f"{ob.name} on frame {frame}")
+
+    def test_1_edit_moves_with_surface(self):
+        ob, others = self.obs[0], self.obs[1:]
+        edited = self.edit_on_frame(ob)
+        for f in (1, FRAMES, 200):  # captured by the handler on the first frame change
+            self.assert_follows(ob, f)
+        off = np.asarray(ob["plume_surface_edits"]).reshape(-1, 3)
+        self.assertEqual(off.shape[0], len(ob.data.splines[0].points))
+        np.testing.assert_allclose(off[edited_indices(ob)], np.tile(MOVE, (4, 1)), atol=1e-5)
+        mask = np.ones(len(off), bool)
+        mask[edited_indices(ob)] = False
+        self.assertEqual(np.abs(off[mask]).max(), 0.0)
+        # Back on frame 10 the edited net is exactly what the artist left.
+        bpy.context.scene.frame_set(EDIT_FRAME)
+        np.testing.assert_allclose(points_of(ob), edited, atol=1e-5)
+        # The surface moved between frames 1 and the last, so did the edited points.
+        self.assertGreater(np.abs(cache_at(ob, 1) - cache_at(ob, FRAMES)).max(), 0.05)
+        for o in others:  # the other sheets follow the plain cache
+            self.assertNotIn("plume_surface_edits", o)
+            self.assert_follows(o, FRAMES, moved=False)
+        # Clear Edits (domain active: all its surfaces) puts the cache back.
+        self.assertEqual(bpy.ops.plume.surface_edits_clear(), {'FINISHED'})
+        self.assertNotIn("plume_surface_edits", ob)
+        np.testing.assert_allclose(points_of(ob), cache_at(ob, bpy.context.scene.frame_current),
+                                   atol=0)
+        for f in (1, FRAMES):
+            self.assert_follows(ob, f, moved=False)
+
+    def test_2_store_operator_from_edit_mode(self):
+        ob = self.obs[-1]
+        bpy.context.scene.frame_set(EDIT_FRAME)
+        select_only(ob)
+        bpy.ops.object.mode_set(mode='EDIT')
+        try:
+            sp = ob.data.splines[0]  # the edit-mode net
+            for k in edited_indices(ob):
+                x, y, z, w = sp.points[k].co
+                sp.points[k].co = (x + MOVE[0], y + MOVE[1], z + MOVE[2], w)
+            self.assertEqual(bpy.ops.plume.surface_edits_store(), {'FINISHED'})
+        finally:
+            bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertIn("plume_surface_edits", ob)
+        for f in (1, FRAMES, 200):
+            self.assert_follows(ob, f)
+        select_only(ob)
+        self.assertEqual(bpy.ops.plume.surface_edits_clear(), {'FINISHED'})
+        self.assert_follows(ob, 5, moved=False)
+
+    def test_3_store_operator_by_script(self):
+        ob = self.obs[0]
+        self.edit_on_frame(ob)
+        select_only(ob)
+        self.assertEqual(bpy.ops.plume.surface_edits_store(), {'FINISHED'})
+        np.testing.assert_allclose(np.asarray(ob["plume_surface_edits"]).reshape(-1, 3)[
+            edited_indices(ob)], np.tile(MOVE, (4, 1)), atol=1e-5)
+        self.assert_follows(ob, 1)
+        self.assertEqual(bpy.ops.plume.surface_edits_clear(), {'FINISHED'})
+
+    def test_4_export_mesh(self):
+        from plume.build.surface_mesh import expected_vertex_count
+        scn = bpy.context.scene
+        scn.frame_set(FRAMES // 2)
+        self.assertEqual(bpy.ops.plume.surfaces_export_mesh(), {'FINISHED'})
+        for level, obs in ((2, self.obs), (1, self.obs[:1])):
+            if level != 2:
+                select_only(obs[0])
+                self.assertEqual(bpy.ops.plume.surfaces_export_mesh(level=level), {'FINISHED'})
+            for ob in obs:
+                m = bpy.data.objects.get(f"{ob.name}_mesh")
+                self.assertIsNotNone(m, ob.name)
+                self.assertEqual(m.type, 'MESH')
+                sp = ob.data.splines[0]
+                nu, nv = sp.point_count_u, sp.point_count_v
+                self.assertEqual(len(m.data.vertices), expected_vertex_count(nu, nv, level))
+                self.assertEqual(len(m.data.polygons), (nu - 1) * (nv - 1) * 4 ** level)
+                attr = m.data.attributes.get("density")
+                self.assertIsNotNone(attr)
+                self.assertEqual((attr.domain, attr.data_type), ('POINT', 'FLOAT'))
+                d = np.empty(len(m.data.vertices), np.float32)
+                attr.data.foreach_get("value", d)
+                self.assertGreaterEqual(d.min(), 0.0)
+                self.assertLessEqual(d.max(), 1.0)
+                self.assertGreater(d.max(), 0.0, "no density on the exported mesh")
+                # Limit surface inside the control net's bounding box (convex hull property).
+                v = np.empty(len(m.data.vertices) * 3, np.float32)
+                m.data.vertices.foreach_get("co", v)
+                v = v.reshape(-1, 3)
+                c = points_of(ob)[:, :3]
+                self.assertTrue(np.all(v >= c.min(0) - 1e-4) and np.all(v <= c.max(0) + 1e-4))
+                self.assertEqual(set(m.users_collection), set(ob.users_collection))
+        n = len(bpy.data.meshes)
+        select_only(bpy.data.objects["Domain"])
+        self.assertEqual(bpy.ops.plume.surfaces_export_mesh(), {'FINISHED'})  # replaces
+        self.assertEqual(len(bpy.data.meshes), n)
+
+    def test_5_bake_keyframes(self):
+        ob = self.obs[0]
+        self.edit_on_frame(ob)
+        select_only(bpy.data.objects["Domain"])
+        self.assertEqual(bpy.ops.plume.surfaces_bake_keyframes(), {'FINISHED'})
+        start, cps = cache_points(ob)
+        for o in self.obs:
+            self.assertTrue(o.get("plume_surface_baked"))
+            fcs = o.data.animation_data.action.fcurves
+            self.assertEqual(len(fcs), len(o.data.splines[0].points) * 3)
+            self.assertEqual({len(fc.keyframe_points) for fc in fcs}, {len(cps)})
+        # Without the handler, the F-curves alone give cache + offsets.
+        from plume.build import surfaces as build
+        handlers = bpy.app.handlers.frame_change_pre
+        handlers.remove(build.frame_change_pre)
+        try:
+            for f in (3, FRAMES - 5):
+                self.assert_follows(ob, f, evaluated=True)
+                for o in self.obs[1:]:
+                    self.assert_follows(o, f, moved=False, evaluated=True)
+        finally:
+            handlers.append(build.frame_change_pre)
+        bpy.context.scene.frame_set(7)
+        self.assertEqual(build.last_update_seconds, [])  # baked surfaces are not rewritten
+        # Store on a baked surface: a clear error.
+        with self.assertRaises(RuntimeError) as ctx:
+            bpy.ops.plume.surface_edits_store()
+        self.assertIn("baked to keyframes", str(ctx.exception))
+
+    def test_6_errors(self):
+        for op, name in ((bpy.ops.plume.surface_edits_store, "store"),
+                         (bpy.ops.plume.surfaces_bake_keyframes, "bake"),
+                         (bpy.ops.plume.surfaces_export_mesh, "export")):
+            select_only(bpy.data.objects["Incense"])
+            before = counts()
+            with self.assertRaises(RuntimeError) as ctx:
+                op()
+            self.assertRegex(str(ctx.exception), r"'Incense' is not a Plume streak surface", name)
+            self.assertEqual(counts(), before)
+        other = add_domain(name="Empty Domain", location=(5.0, 0.0, 1.0))
+        select_only(other)
+        before = counts()
+        for op in (bpy.ops.plume.surface_edits_clear, bpy.ops.plume.surfaces_export_mesh):
+            with self.assertRaises(RuntimeError) as ctx:
+                op()
+            self.assertIn("has no streak surfaces: build them first", str(ctx.exception))
+        self.assertEqual(counts(), before)
+        bpy.data.objects.remove(other, do_unlink=True)
+
+
+if __name__ == "__main__":
+    run(SurfaceEditsTest)
