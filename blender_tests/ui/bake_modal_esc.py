@@ -62,7 +62,7 @@ def step():
         for ob in list(bpy.data.objects):
             bpy.data.objects.remove(ob, do_unlink=True)
         cache = tempfile.mkdtemp(prefix="plume_ui_")
-        dom = add_domain(resolution=24, frame_end=FRAMES, cache_directory=cache + "/")
+        dom = add_domain(resolution=40, frame_end=FRAMES, cache_directory=cache + "/")
         add_sphere_source()
         select_only(dom)
         win, area = window_and_area()
