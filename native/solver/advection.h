@@ -74,7 +74,38 @@ class Advector {
               const BlockMask* mask, float background);
 
  private:
+  /// The trilinear taps of each velocity component at the samples of a traced grid, per axis:
+  /// sample m of the grid reads component a along axis d at index i and i+1 with fraction t, as
+  /// sampleLinear() would (t is 0, ½ or, on the last sample, 1).
+  class Taps {
+   public:
+    struct Tap {
+      int i;
+      float t;
+    };
+    void build(const MacGrid3& velocity, glm::ivec3 size, glm::vec3 offset);
+    Tap at(int component, int axis, int m) const { return mTaps[component][axis][std::size_t(m)]; }
+    /// sampleLinear()'s lerps, x then y then z, skipping those with fraction 0 (which return
+    /// their first operand unchanged): q points at x-tap i of row 0; row[] holds the offsets of
+    /// rows (j,k), (j+1,k), (j,k+1), (j+1,k+1).
+    static float lerp3(const float* q, const std::ptrdiff_t* row, float tx, float ty, float tz) {
+      auto lx = [&](std::ptrdiff_t r) {
+        return tx != 0.f ? q[r] + tx * (q[r + 1] - q[r]) : q[r];
+      };
+      auto ly = [&](std::ptrdiff_t r0, std::ptrdiff_t r1) {
+        const float a = lx(r0);
+        return ty != 0.f ? a + ty * (lx(r1) - a) : a;
+      };
+      const float c0 = ly(row[0], row[1]);
+      return tz != 0.f ? c0 + tz * (ly(row[2], row[3]) - c0) : c0;
+    }
+
+   private:
+    std::vector<Tap> mTaps[3][3];
+  };
+
   ScalarGrid mForward, mBackward;
+  Taps mTaps;
   std::vector<glm::vec3> mBack, mFore;  ///< traced positions in the grid's index space
   Advection mScheme = Advection::SemiLagrangian;
 };
