@@ -82,6 +82,7 @@ int StreakTracer::addPointSources(const std::vector<glm::vec3>& positions,
     mPositions.push_back(positions[n]);
     mDensity.push_back(0.f);
     mOutside.push_back(0);
+    mExitVelocity.emplace_back(0.f);
   }
   return first;
 }
@@ -97,6 +98,7 @@ void StreakTracer::emit() {
     mPositions.push_back(s.position);
     mDensity.push_back(0.f);
     mOutside.push_back(0);
+    mExitVelocity.emplace_back(0.f);
   }
   ++mEmissions;
 }
@@ -119,8 +121,14 @@ void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const Sca
   parallelFor(0, (count + kChunk - 1) / kChunk, [&](int chunk) {
     const int end = std::min(count, (chunk + 1) * kChunk);
     for (int n = chunk * kChunk; n < end; ++n) {
-      if (mOutside[std::size_t(n)]) continue;  // frozen on an open side
       const glm::vec3 x = mPositions[std::size_t(n)];
+      if (mOutside[std::size_t(n)]) {
+        // No air is simulated out there: the particle keeps the velocity it left with, so a
+        // streakline leaving the domain stays evenly spaced instead of piling up on the side
+        // (a pile of coincident particles makes the interpolating surface overshoot).
+        mPositions[std::size_t(n)] = x + dt * mExitVelocity[std::size_t(n)];
+        continue;
+      }
       glm::vec3 k1(0.f);
       if (std::size_t(n) >= newborn) k1 = mSources[std::size_t(n) % std::size_t(sources)].velocity;
       if (k1 == glm::vec3(0.f)) k1 = sampleVelocity(before, toCell(x), scheme);
@@ -132,16 +140,21 @@ void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const Sca
       if (!finite(xn)) xn = x;  // a broken field must not poison the cache
       bool left = false;
       for (int a = 0; a < 3; ++a) {
+        // A closed side holds the particle on it; through an open side it leaves.
         if (xn[a] < mLo[a]) {
-          xn[a] = mLo[a];
-          left = left || mBoundaries[std::size_t(2 * a)] == Boundary::Open;
+          if (mBoundaries[std::size_t(2 * a)] == Boundary::Open) left = true;
+          else xn[a] = mLo[a];
         } else if (xn[a] > mHi[a]) {
-          xn[a] = mHi[a];
-          left = left || mBoundaries[std::size_t(2 * a + 1)] == Boundary::Open;
+          if (mBoundaries[std::size_t(2 * a + 1)] == Boundary::Open) left = true;
+          else xn[a] = mHi[a];
         }
       }
       mPositions[std::size_t(n)] = xn;
-      if (left) mOutside[std::size_t(n)] = 1;
+      if (left) {
+        mOutside[std::size_t(n)] = 1;
+        mExitVelocity[std::size_t(n)] = um;
+        mDensity[std::size_t(n)] = 0.f;  // no smoke is simulated outside the domain
+      }
     }
   });
   ++mSteps;

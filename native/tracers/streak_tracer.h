@@ -8,11 +8,11 @@
 /// point sources are added, the others at the end of the step that reaches their instant. After S
 /// steps every source therefore holds floor(S / P) + 1 particles, the youngest at the source.
 ///
-/// Boundaries. Particles never leave the domain box: a particle pushed through a closed side is
-/// clamped onto it and keeps moving; one carried through an open side is clamped onto that side,
-/// marked `outside` and frozen there (position and density no longer change). It is kept so that
-/// every streakline of a bake has the same particle count, which the distance h(α,β) of §3.3 and
-/// the fixed control nets of the surfaces need.
+/// Boundaries. A particle pushed through a closed side is clamped onto it and keeps moving; one
+/// carried through an open side is marked `outside`, its density becomes 0 (no smoke is
+/// simulated there) and it goes on in a straight line with the velocity it left with, so the
+/// streakline stays evenly spaced. It is kept so that every streakline of a bake has the same
+/// particle count, which the distance h(α,β) of §3.3 and the fixed control nets need.
 
 #include "core/grid3.h"
 #include "core/mac_grid3.h"
@@ -119,6 +119,7 @@ class StreakTracer {
   std::vector<glm::vec3> mPositions;
   std::vector<float> mDensity;
   std::vector<std::uint8_t> mOutside;
+  std::vector<glm::vec3> mExitVelocity;  ///< velocity a particle left the domain with
   int mEmissions = 1;  ///< emission instants reached: floor(steps / P) + 1
   long long mSteps = 0;
   MacGrid3 mPrevious;
