@@ -143,31 +143,9 @@ __attribute__((target("avx2"))) inline __m256 cubic1D(__m256 f0, __m256 f1, __m2
   return _mm256_max_ps(lo, _mm256_min_ps(hi, value));
 }
 
-/// stencilXY() with the x pass on eight rows at once: rows (b, c) in the low half of each
-/// register and (b, c+1) in the high half, transposed within each half.
-__attribute__((target("avx2"))) __m128 stencilXYAvx2(const float* base, std::ptrdiff_t sy,
-                                                     std::ptrdiff_t sz, float tx, float ty) {
-  const __m256 vx = _mm256_set1_ps(tx);
-  __m128 ys[4];
-  for (int c = 0; c < 4; c += 2) {
-    __m256 r[4];
-    for (int b = 0; b < 4; ++b) {
-      const float* row = base + b * sy + c * sz;
-      r[b] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(row)),
-                                  _mm_loadu_ps(row + sz), 1);
-    }
-    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
-    const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-    const __m256 y = cubic1D(_mm256_shuffle_ps(t0, t1, 0x44), _mm256_shuffle_ps(t0, t1, 0xEE),
-                             _mm256_shuffle_ps(t2, t3, 0x44), _mm256_shuffle_ps(t2, t3, 0xEE), vx);
-    ys[c] = _mm256_castps256_ps128(y);
-    ys[c + 1] = _mm256_extractf128_ps(y, 1);
-  }
-  _MM_TRANSPOSE4_PS(ys[0], ys[1], ys[2], ys[3]);
-  return cubic1D(ys[0], ys[1], ys[2], ys[3], _mm_set1_ps(ty));
-}
-
-/// The x pass of stencilXYAvx2() alone: ys[b] holds, per lane c, the x-cubic of row (b, c).
+/// The x pass on eight rows at once: rows (b, c) in the low half of each register and (b, c+1)
+/// in the high half, transposed within each half, so that ys[b] holds, per lane c, the x-cubic
+/// of row (b, c).
 __attribute__((target("avx2"))) inline void stencilXAvx2(const float* base, std::ptrdiff_t sy,
                                                          std::ptrdiff_t sz, float tx,
                                                          __m128* ys) {
@@ -187,6 +165,14 @@ __attribute__((target("avx2"))) inline void stencilXAvx2(const float* base, std:
     ys[c + 1] = _mm256_extractf128_ps(y, 1);
   }
   _MM_TRANSPOSE4_PS(ys[0], ys[1], ys[2], ys[3]);
+}
+
+/// stencilXY() with the x pass of stencilXAvx2().
+__attribute__((target("avx2"))) __m128 stencilXYAvx2(const float* base, std::ptrdiff_t sy,
+                                                     std::ptrdiff_t sz, float tx, float ty) {
+  __m128 ys[4];
+  stencilXAvx2(base, sy, sz, tx, ys);
+  return cubic1D(ys[0], ys[1], ys[2], ys[3], _mm_set1_ps(ty));
 }
 
 /// The stencils of sampleMonotonicCubic4() in one AVX2 function (no call per sample): x passes
