@@ -147,7 +147,7 @@ void checkSize(const std::string& kind, const std::string& name, double cells) {
 /// Clips an open mesh to the domain grown by `pad` cells (Sutherland-Hodgman per triangle, fan
 /// re-triangulated). For cells inside the domain, the unsigned distance up to `pad` cells only
 /// depends on the clipped part, so a huge ground plane costs no more than the domain it crosses.
-void clipToDomain(std::vector<openvdb::Vec3s>& points, std::vector<openvdb::Vec3I>& tris,
+void clipAgainstDomain(std::vector<openvdb::Vec3s>& points, std::vector<openvdb::Vec3I>& tris,
                   const GridFrame& grid, float pad) {
   const glm::dvec3 lo = glm::dvec3(grid.origin) - double(pad) * grid.cellSize;
   const glm::dvec3 hi = glm::dvec3(grid.origin) +
@@ -307,7 +307,7 @@ CellSet voxelizeSource(const EmitterMesh& mesh, const GridFrame& grid) {
     // An open mesh (plane, disc) has no inside: emit from the cells it passes through, using an
     // unsigned distance. Triangles far outside the domain cannot matter and are dropped first.
     std::vector<openvdb::Vec3s> clipped = points;
-    clipToDomain(clipped, tris, grid, kHalfWidth + 1.f);
+    clipAgainstDomain(clipped, tris, grid, kHalfWidth + 1.f);
     if (tris.empty()) return result;
     glm::ivec3 lo, hi;
     cellBox(clipped, tris, grid, /*pad=*/1, lo, hi);
