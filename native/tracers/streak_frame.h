@@ -17,7 +17,7 @@ struct StreakFrame {
   std::vector<glm::vec3> positions;    ///< world positions, sources concatenated
   std::vector<float> density;          ///< density sampled at each particle (§3.4)
   std::vector<int> groups;             ///< candidate group of each source (§3.3)
-  std::vector<std::uint8_t> outside;   ///< 1: left through an open side, frozen on the boundary
+  std::vector<std::uint8_t> outside;   ///< 1: left through an open side (moves on with its exit velocity)
 
   int sourceCount() const { return int(counts.size()); }
   std::size_t particleCount() const { return positions.size(); }
