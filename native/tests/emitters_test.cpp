@@ -2,6 +2,7 @@
 /// Voxelization of sources and obstacles (OpenVDB mesh-to-volume) against analytic counts.
 
 #include "solver/emitters.h"
+#include "tests/test_meshes.h"
 
 #include <gtest/gtest.h>
 
@@ -27,33 +28,6 @@ EmitterMesh boxMesh(glm::vec3 lo, glm::vec3 hi, const std::string& name = "box")
     m.triangles.push_back({q[0], q[1], q[2]});
     m.triangles.push_back({q[0], q[2], q[3]});
   }
-  return m;
-}
-
-/// UV sphere of radius r around c (closed, manifold: poles are single vertices).
-EmitterMesh sphereMesh(glm::vec3 c, float r, int rings, int segments) {
-  EmitterMesh m;
-  m.name = "sphere";
-  m.vertices.push_back(c + glm::vec3(0, 0, r));
-  for (int a = 1; a < rings; ++a) {
-    const double th = M_PI * a / rings;
-    for (int b = 0; b < segments; ++b) {
-      const double ph = 2 * M_PI * b / segments;
-      m.vertices.push_back(c + r * glm::vec3(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph),
-                                             std::cos(th)));
-    }
-  }
-  m.vertices.push_back(c - glm::vec3(0, 0, r));
-  const int south = int(m.vertices.size()) - 1;
-  auto ring = [&](int a, int b) { return 1 + (a - 1) * segments + (b % segments); };
-  for (int b = 0; b < segments; ++b) m.triangles.push_back({0, ring(1, b), ring(1, b + 1)});
-  for (int a = 1; a + 1 < rings; ++a)
-    for (int b = 0; b < segments; ++b) {
-      m.triangles.push_back({ring(a, b), ring(a + 1, b), ring(a + 1, b + 1)});
-      m.triangles.push_back({ring(a, b), ring(a + 1, b + 1), ring(a, b + 1)});
-    }
-  for (int b = 0; b < segments; ++b)
-    m.triangles.push_back({south, ring(rings - 1, b + 1), ring(rings - 1, b)});
   return m;
 }
 
