@@ -168,6 +168,31 @@ TEST(Advection, MonotonicCubicMakesNoNewExtrema) {
   }
 }
 
+/// A smooth (Gaussian) blob of σ = 2.5 cells around cell coordinates c: on a top-hat the
+/// limiters of the monotone schemes bias the centroid.
+void addGaussianBlob(ScalarGrid& density, glm::vec3 c) {
+  const glm::ivec3 n = density.size();
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        const glm::vec3 d = glm::vec3(i, j, k) + 0.5f - c;
+        density(i, j, k) = std::exp(-glm::dot(d, d) / (2.f * 2.5f * 2.5f));
+      }
+}
+
+/// x of the density's centroid, in cells.
+double centroidX(const ScalarGrid& density) {
+  const glm::ivec3 n = density.size();
+  double m = 0, mx = 0;
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        m += density(i, j, k);
+        mx += density(i, j, k) * (i + 0.5);
+      }
+  return mx / m;
+}
+
 TEST(Advection, ConstantWindCarriesBlobAtItsSpeed) {
   const glm::ivec3 res(40, 12, 12);
   SmokeParams p = smallParams(res);
@@ -175,27 +200,11 @@ TEST(Advection, ConstantWindCarriesBlobAtItsSpeed) {
   p.vorticity = 0.f;
   SmokeSolver solver(p);
   solver.velocity().u().fill(0.5f);  // m/s, divergence free
-  // A smooth (Gaussian) blob: on a top-hat the limiters of the monotone schemes bias the centroid.
-  for (int k = 0; k < res.z; ++k)
-    for (int j = 0; j < res.y; ++j)
-      for (int i = 0; i < res.x; ++i) {
-        const glm::vec3 d = glm::vec3(i, j, k) + 0.5f - glm::vec3(10.f, 6.f, 6.f);
-        solver.density()(i, j, k) = std::exp(-glm::dot(d, d) / (2.f * 2.5f * 2.5f));
-      }
-  auto centroidX = [&] {
-    double m = 0, mx = 0;
-    for (int k = 0; k < res.z; ++k)
-      for (int j = 0; j < res.y; ++j)
-        for (int i = 0; i < res.x; ++i) {
-          m += solver.density()(i, j, k);
-          mx += solver.density()(i, j, k) * (i + 0.5);
-        }
-    return mx / m;
-  };
-  const double x0 = centroidX();
+  addGaussianBlob(solver.density(), {10.f, 6.f, 6.f});
+  const double x0 = centroidX(solver.density());
   for (int f = 0; f < 12; ++f) ASSERT_TRUE(solver.advanceFrame());
   // 0.5 m/s for 0.5 s = 0.25 m = 10 cells; 0.1 cell is 1% of the distance travelled.
-  EXPECT_NEAR(centroidX() - x0, 10.0, 0.1);
+  EXPECT_NEAR(centroidX(solver.density()) - x0, 10.0, 0.1);
 }
 
 TEST(Advection, MacCormackCarriesBlobAtItsSpeed) {
@@ -209,25 +218,10 @@ TEST(Advection, MacCormackCarriesBlobAtItsSpeed) {
     p.conserveMass = false;
     SmokeSolver solver(p);
     solver.velocity().u().fill(0.5f);
-    auto centroidX = [&] {
-      double m = 0, mx = 0;
-      for (int k = 0; k < res.z; ++k)
-        for (int j = 0; j < res.y; ++j)
-          for (int i = 0; i < res.x; ++i) {
-            m += solver.density()(i, j, k);
-            mx += solver.density()(i, j, k) * (i + 0.5);
-          }
-      return mx / m;
-    };
-    for (int k = 0; k < res.z; ++k)
-      for (int j = 0; j < res.y; ++j)
-        for (int i = 0; i < res.x; ++i) {
-          const glm::vec3 d = glm::vec3(i, j, k) + 0.5f - glm::vec3(10.f, 6.f, 6.f);
-          solver.density()(i, j, k) = std::exp(-glm::dot(d, d) / (2.f * 2.5f * 2.5f));
-        }
-    const double x0 = centroidX();
+    addGaussianBlob(solver.density(), {10.f, 6.f, 6.f});
+    const double x0 = centroidX(solver.density());
     for (int f = 0; f < 12; ++f) ASSERT_TRUE(solver.advanceFrame());
-    shift = centroidX() - x0;
+    shift = centroidX(solver.density()) - x0;
     peak = *std::max_element(solver.density().values().begin(), solver.density().values().end());
   };
   double shiftMac = 0, shiftSl = 0;
