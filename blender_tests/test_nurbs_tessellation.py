@@ -2,7 +2,7 @@
 
 For 2, 3, 5 and 11 streaklines of 1, 2, 3, 4 and 7 particles, with endpoint and uniform knots:
 the core interpolates the particles (plume._native.interpolate_surface), a SURFACE object is built
-from its control points with the BLENDER_NOTES.md §2 recipe, and the vertices of the object's
+from its control points by the add-on's builder (BLENDER_NOTES.md §2), and the vertices of the object's
 evaluated mesh must equal plume._native.tessellate() (<= 1e-4 of the domain size).
 
 Uses the installed add-on's native module (CI installs the fresh build before running this).
@@ -19,7 +19,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import native, reset_scene, run, select_only  # noqa: E402
+from helpers import native, reset_scene, run  # noqa: E402
 
 DOMAIN_SIZE = 1.0
 STREAKLINES = (2, 3, 5, 11)
@@ -38,35 +38,14 @@ def particles(nv, nu, seed):
 
 
 def surface_object(name, surface, resolution_u, resolution_v):
-    """A SURFACE object with the core's control net (BLENDER_NOTES.md §2 recipe).
-
-    nv >= 3: one NURBS row per u index merged with make_segment (the merge transposes, so every
-    coordinate is rewritten). nv == 2: make_segment leaves 2-point rows unmerged in 3.4.1, so a
-    single u row is extruded once instead.
-    """
+    """A SURFACE object with the core's control net, made by the add-on's own builder (the
+    BLENDER_NOTES.md §2 recipe, with its 2-streakline workaround), so the test checks the objects
+    Build Surfaces makes."""
+    from plume.build.surfaces import surface_object as make_net
     nu, nv = surface["nu"], surface["nv"]
-    cu = bpy.data.curves.new(name, 'SURFACE')
-    cu.dimensions = '3D'
-    rows = nu if nv > 2 else 1
-    for _ in range(rows):
-        sp = cu.splines.new('NURBS')
-        sp.points.add((nv if nv > 2 else nu) - 1)
-        for p in sp.points:
-            p.select = True
-    ob = bpy.data.objects.new(name, cu)
-    bpy.context.scene.collection.objects.link(ob)
-    select_only(ob)
-    bpy.ops.object.mode_set(mode='EDIT')
-    bpy.ops.curve.select_all(action='SELECT')
-    if nv > 2:
-        bpy.ops.curve.make_segment()
-    else:
-        bpy.ops.curve.extrude_move(CURVE_OT_extrude={"mode": 'TRANSLATION'},
-                                   TRANSFORM_OT_translate={"value": (0.0, 0.0, 1.0)})
-    bpy.ops.object.mode_set(mode='OBJECT')
-    assert len(cu.splines) == 1, f"{len(cu.splines)} splines"
+    ob = make_net(name, bpy.context.scene.collection, nu, nv, bpy.context.view_layer)
+    cu = ob.data
     sp = cu.splines[0]
-    assert (sp.point_count_u, sp.point_count_v) == (nu, nv), (sp.point_count_u, sp.point_count_v)
     co = np.asarray(surface["control_points"], dtype=np.float32)  # (nv*nu, 4), flat v*nu+u
     sp.points.foreach_set("co", co.ravel())
     sp.order_u, sp.order_v = surface["order_u"], surface["order_v"]

@@ -109,7 +109,7 @@ def unregister():
 
 
 # --------------------------------------------------------------------------- objects
-def _surface_object(name, collection, nu, nv, view_layer):
+def surface_object(name, collection, nu, nv, view_layer):
     """SURFACE object with an nu x nv NURBS net (BLENDER_NOTES §2 recipe). make_segment merges
     the 1-D rows and transposes them; with 2 rows it leaves them unmerged in 3.4.1, so one u row
     is extruded once instead (blender_tests/test_nurbs_tessellation.py)."""
@@ -180,7 +180,7 @@ def build_surfaces(context, domain, folder, frame_start, anims, sheets, settings
     try:
         for i, anim in enumerate(anims):
             name = f"{domain.name}_surface_{i}"
-            ob = _surface_object(name, coll, anim.nu, anim.nv, view_layer)
+            ob = surface_object(name, coll, anim.nu, anim.nv, view_layer)
             sp = ob.data.splines[0]
             frame = min(max(scene.frame_current - frame_start, 0), len(anim.control_points) - 1)
             sp.points.foreach_set("co", anim.control_points[frame].ravel())
