@@ -15,15 +15,14 @@ import time
 from dataclasses import dataclass, field
 from typing import List, Optional
 
-import numpy as np
-
 from . import cache
+from .point_sources import domain_point_sources
 
 #: A checkpoint of the solver state is written when the time since the last one is at least this
 #: many times what writing the last one took (and after the last frame): about every frame on
 #: small grids, every few seconds at 128³ (75 MB), never more than ~10% of the bake time.
 CHECKPOINT_COST_RATIO = 10.0
-from .settings import (BakeError, candidate_groups, to_native_params, to_native_source,
+from .settings import (BakeError, to_native_params, to_native_source,
                        validate_python_side, validate_source, validate_streaks)
 
 
@@ -72,6 +71,7 @@ class BakeRunner:
         self._manifest = None
         self._emitter_index = None  # frame index whose emitters are loaded in the solver
         self._tracer = None  # StreakTracer when streak surfaces are on
+        self._params = None  # the validated native SmokeParams
 
     # ---------------------------------------------------------------- validation
     def prepare(self):
@@ -84,6 +84,7 @@ class BakeRunner:
             params = to_native_params(snap.solver, self._native)
         except ValueError as e:
             raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
+        self._params = params
         for emitter in snap.emitters:
             if emitter.role == "SOURCE":
                 validate_source(emitter)
@@ -130,41 +131,18 @@ class BakeRunner:
         self._emitter_index = index
 
     def _make_tracer(self, params):
-        """StreakTracer with `point_sources` random points per source cell of every Source
-        (smoke_surfaces.txt §3.2), seeded by the domain seed and the source's index; candidate
-        group = the source's candidate_group (-1: a group of its own)."""
+        """StreakTracer with the point sources of every Source (smoke_surfaces.txt §3.2):
+        `point_sources` random points per source cell, seeded by the domain seed and the source's
+        index, or the vertices of its point_source_mesh; candidate group = the source's
+        candidate_group (-1: a group of its own), or candidate_split groups of its own (§3.3)."""
         snap, native = self.snapshot, self._native
         try:
             tracer = native.StreakTracer(params, emission_period=snap.streaks.emission_period)
         except ValueError as e:
             raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
-        sources = [e for e in snap.emitters if e.role == "SOURCE"]
-        groups = candidate_groups(snap.emitters)
-        all_points, all_groups, all_vel = [], [], []
-        for index, (e, group) in enumerate(zip(sources, groups)):
-            try:
-                cells, motion = native.source_cells(e.vertices, e.triangles, e.matrix_at(0),
-                                                    e.matrix_at(1), params, e.name)
-                if len(cells) == 0:
-                    continue
-                points = native.random_points_in_cells(
-                    cells, params.resolution, params.cell_size, params.origin, e.point_sources,
-                    seed=snap.solver.seed, stream=index)
-            except ValueError as err:
-                raise BakeError(f"Plume: source '{e.name}': {err}") from None
-            # The source's velocity plus its own motion, as the solver writes into its cells.
-            vel = (np.repeat(np.asarray(motion, np.float32), e.point_sources, axis=0)
-                   * np.float32(e.source.motion_factor)
-                   + np.asarray(e.source.velocity, np.float32))
-            all_points.append(points)
-            all_vel.append(vel)
-            all_groups.append(np.full(len(points), group, dtype=np.int64))
-        if not all_points:
-            raise BakeError(f"Plume: domain '{snap.domain_name}': streak surfaces need point "
-                            "sources, but no Source object has a cell inside the domain")
+        points, groups, velocities = domain_point_sources(native, params, snap)
         try:
-            tracer.add_point_sources(np.concatenate(all_points), np.concatenate(all_groups),
-                                     np.concatenate(all_vel))
+            tracer.add_point_sources(points, groups, velocities)
         except ValueError as e:
             raise BakeError(f"Plume: domain '{snap.domain_name}': point sources: {e}") from None
         return tracer
@@ -198,16 +176,15 @@ class BakeRunner:
         self._manifest = m
         if last >= snap.frame_end:
             self._mode = "complete"
-        elif snap.streaks.enabled:
-            # The tracer has no checkpoint in the native API (StreakTracer cannot be saved or
-            # restored), so a bake with streak surfaces on starts over instead of resuming.
-            return
         else:
             # Checkpoints are written every few seconds, so the state may be some frames behind
             # the last complete frame: resume from it and recompute (bit for bit) what follows.
+            # A traced bake needs the tracers' checkpoint of the same frame too.
             state = m.get("state_frame")
             if (isinstance(state, int) and snap.frame_start <= state <= last
-                    and os.path.isfile(cache.state_path(snap.cache_folder))):
+                    and os.path.isfile(cache.state_path(snap.cache_folder))
+                    and (not snap.streaks.enabled
+                         or os.path.isfile(cache.tracer_state_path(snap.cache_folder)))):
                 self._mode = "resume"
                 self._resume_last = last
                 self._resume_state = state
@@ -246,11 +223,8 @@ class BakeRunner:
 
         first = snap.frame_start
         manifest = self._new_manifest()
-        if self._mode == "resume":
-            try:
-                self._solver.load_state(cache.state_path(folder))
-            except RuntimeError:
-                self._mode = "fresh"  # corrupt checkpoint: load_state left the solver untouched
+        if self._mode == "resume" and not self._load_checkpoints(folder):
+            self._mode = "fresh"
         if self._mode == "resume":
             first = self._resume_state + 1
             result.resumed_from = first
@@ -286,32 +260,65 @@ class BakeRunner:
                     self._native.write_streak_file(cache.streak_path(folder, frame),
                                                    tracer.snapshot())
                 # The checkpoint holds every grid (75 MB at 128³), so it is not written every frame.
-                # With streaks it is useless (the tracer cannot be restored): never written.
+                # The tracers' checkpoint goes with it, for the same frame: both or neither.
                 now = time.perf_counter()
-                if tracer is None and (frame == snap.frame_end
+                if (frame == snap.frame_end
                         or now - last_checkpoint >= CHECKPOINT_COST_RATIO * checkpoint_cost):
                     self._solver.save_state(cache.state_path(folder))
+                    if tracer is not None:
+                        tracer.save_state(cache.tracer_state_path(folder), frame)
                     manifest["state_frame"] = frame
                     last_checkpoint = time.perf_counter()
                     checkpoint_cost = last_checkpoint - now
-                result.last_complete_frame = max(result.last_complete_frame, frame)
-                result.computed_frames.append(frame)
-                manifest["last_complete_frame"] = result.last_complete_frame
                 if frame - snap.frame_start >= len(manifest["frame_inputs"]):
                     manifest["frame_inputs"].append(snap.frame_input_hash(frame))
-                manifest["frames_computed_total"] += 1
-                manifest["last_run"]["computed_frames"].append(frame)
-                cache.write_manifest(folder, manifest)
-                self._report(result, t0)
+                self._frame_done(folder, manifest, result, frame, t0)
         finally:
-            manifest["last_run"]["cancelled"] = result.cancelled
-            manifest["last_run"]["seconds"] = time.perf_counter() - t0
-            try:
-                cache.write_manifest(folder, manifest)
-            except OSError:
-                pass
-        result.seconds = time.perf_counter() - t0
+            self._run_done(folder, manifest, result, t0)
         return result
+
+    def _frame_done(self, folder, manifest, result, frame, t0):
+        """Frame `frame` is in the cache: the result, the manifest (written) and progress say so."""
+        result.last_complete_frame = max(result.last_complete_frame, frame)
+        result.computed_frames.append(frame)
+        manifest["last_complete_frame"] = result.last_complete_frame
+        manifest["frames_computed_total"] += 1
+        manifest["last_run"]["computed_frames"].append(frame)
+        cache.write_manifest(folder, manifest)
+        self._report(result, t0)
+
+    @staticmethod
+    def _run_done(folder, manifest, result, t0):
+        """End of a run, a failed one too: the manifest says how it ended."""
+        manifest["last_run"]["cancelled"] = result.cancelled
+        manifest["last_run"]["seconds"] = time.perf_counter() - t0
+        try:
+            cache.write_manifest(folder, manifest)
+        except OSError:
+            pass
+        result.seconds = time.perf_counter() - t0
+
+    def _load_checkpoints(self, folder):
+        """Loads the checkpoints of frame state_frame (the solver's, and the tracers' in a traced
+        bake). False when one is missing, corrupt or of another frame (a bake killed between a
+        checkpoint and its manifest update); the solver and tracer are then rebuilt as prepare()
+        made them, so that the bake can start over."""
+        expected = self._resume_state - self.snapshot.frame_start + 1  # frames advanced
+        try:
+            self._solver.load_state(cache.state_path(folder))
+            ok = self._solver.frame == expected
+            if ok and self._tracer is not None:
+                label = self._tracer.load_state(cache.tracer_state_path(folder))
+                ok = label == self._resume_state
+        except RuntimeError:
+            ok = False
+        if not ok:
+            self._solver = self._native.SmokeSolver(self._params)
+            self._emitter_index = None
+            self._load_emitters(0)
+            if self._tracer is not None:
+                self._tracer = self._make_tracer(self._params)
+        return ok
 
     def _new_manifest(self):
         snap = self.snapshot

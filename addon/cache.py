@@ -3,6 +3,8 @@
     <cache_directory>/<domain name>/manifest.json
                                     volume_<frame:04d>.vdb
                                     state.bin            (checkpoint of the last complete frame)
+                                    tracer_state.bin     (streak surfaces on: the tracers' checkpoint,
+                                                          same frame as state.bin)
                                     streaks_<frame:04d>.bin   (streak surfaces on: tracers, §3.2)
                                     surface_<n>.npz, sheet_<n>_<frame:04d>.exr  (plume.surfaces_build)
 """
@@ -14,6 +16,7 @@ import uuid
 
 MANIFEST_NAME = "manifest.json"
 STATE_NAME = "state.bin"
+TRACER_STATE_NAME = "tracer_state.bin"
 FORMAT_VERSION = 1
 KIND = "smoke"
 
@@ -81,6 +84,11 @@ def state_path(folder):
     return os.path.join(folder, STATE_NAME)
 
 
+def tracer_state_path(folder):
+    """Checkpoint of the streak tracers, written with state.bin for the same frame."""
+    return os.path.join(folder, TRACER_STATE_NAME)
+
+
 def read_manifest(folder):
     """The manifest as a dict, or None when missing or unreadable (then the bake starts over)."""
     try:
@@ -122,7 +130,7 @@ def volume_frames(folder):
 
 def plume_files(folder):
     """Files of the folder that a bake owns: manifest.json, volume_*.vdb, streaks_*.bin, state.bin,
-    the surfaces' files, *.tmp."""
+    tracer_state.bin, the surfaces' files, *.tmp."""
     try:
         names = sorted(os.listdir(folder))
     except OSError:
@@ -132,7 +140,7 @@ def plume_files(folder):
         path = os.path.join(folder, name)
         if not os.path.isfile(path):
             continue
-        if (name in (MANIFEST_NAME, STATE_NAME) or _frame_of(name) is not None
+        if (name in (MANIFEST_NAME, STATE_NAME, TRACER_STATE_NAME) or _frame_of(name) is not None
                 or _SURFACE_RE.match(name) or name.endswith(".tmp")):
             own.append(path)
     return own

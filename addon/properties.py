@@ -21,6 +21,13 @@ BOUNDARY_ITEMS = (
 )
 
 
+def is_gas_domain(ob):
+    """True for an object with a Blender fluid modifier that is a Gas domain (Mantaflow smoke)."""
+    return ob is not None and any(
+        m.type == 'FLUID' and m.fluid_type == 'DOMAIN' and m.domain_settings is not None
+        and m.domain_settings.domain_type == 'GAS' for m in ob.modifiers)
+
+
 def _boundary(side, default='OPEN'):
     return EnumProperty(name=side, items=BOUNDARY_ITEMS, default=default,
                         description=f"Boundary condition of the domain's {side} side")
@@ -131,6 +138,19 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     emission_period: IntProperty(
         name="Emission Period", default=1, soft_min=1, soft_max=20,
         description="Steps between two particles of a point source (§3.2: one every step)")
+    motion_source: EnumProperty(
+        name="Motion", default='PLUME',
+        items=(('PLUME', "Plume Simulation", "Simulate the smoke with Plume and trace its velocity"),
+               ('MANTAFLOW', "Mantaflow Cache",
+                "Trace the velocity of an existing Blender Mantaflow gas bake (OpenVDB cache) "
+                "instead of simulating; the volume frames hold the Mantaflow density")),
+        description="What moves the streak particles (smoke_surfaces.txt §3.2: particles "
+                    "\"advected by the velocity field\")")
+    mantaflow_domain: PointerProperty(
+        name="Mantaflow Domain", type=bpy.types.Object, poll=lambda _self, ob: is_gas_domain(ob),
+        description="Blender fluid domain (type Gas, adaptive domain off) whose OpenVDB cache, "
+                    "baked over this domain's frame range, moves the particles when Motion is "
+                    "Mantaflow Cache")
     streak_threshold: FloatProperty(
         name="Threshold (h0)", default=0.0, soft_min=0.0, soft_max=100.0, precision=4,
         description="h0: streaklines with h(α,β) < h0 share a surface (§3.3); 0 = the default, "
@@ -186,6 +206,17 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
     candidate_group: IntProperty(
         name="Candidate Group", default=-1, soft_min=-1, soft_max=64,
         description="Streaklines are clustered only inside a candidate group (-1: the source's own group)")
+    point_source_mesh: PointerProperty(
+        name="Point Source Mesh", type=bpy.types.Object, poll=lambda _self, ob: ob.type == 'MESH',
+        description="Mesh whose vertices (world space, evaluated at the domain's first frame) are "
+                    "this source's point sources, one streakline each, instead of Point Sources "
+                    "random points per cell (smoke_surfaces.txt §3.2); they must lie in the domain")
+    candidate_split: IntProperty(
+        name="Split Into Groups", default=1, soft_min=1, soft_max=64,
+        description="Splits this source's point sources into this many candidate groups of equal "
+                    "count along their longest extent, so that streaklines of different parts "
+                    "never share a surface (smoke_surfaces.txt §3.3); 1 = no split, more replaces "
+                    "Candidate Group; validated at bake time to [1, 64]")
 
 
 class PlumeObstacleSettings(bpy.types.PropertyGroup):

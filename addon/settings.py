@@ -88,6 +88,11 @@ class EmitterSnapshot:
     slip: str = "NO_SLIP"
     point_sources: int = 16  # streak surfaces: tracer point sources per source cell (§3.2)
     candidate_group: int = -1  # §3.3 candidate group, -1: the source's own group
+    candidate_split: int = 1  # §3.3: the source's point sources split into this many groups
+    #: §3.2 "the vertices of a mesh the user picks": that mesh's name and its vertices in world
+    #: space at frame_start, float32 (N, 3); None: `point_sources` random points per cell.
+    point_source_mesh: str = ""
+    point_source_vertices: Optional[np.ndarray] = None
 
     @property
     def animated(self):
@@ -112,6 +117,19 @@ class EmitterSnapshot:
         h.update(np.ascontiguousarray(tris, dtype=np.int32).tobytes())
         return h.hexdigest()
 
+    def streak_fingerprint(self):
+        """The source's streak settings as JSON-friendly data (the manifest compares it); the
+        newer settings only when not default, so older caches still resume."""
+        data = [self.name, self.point_sources, self.candidate_group]
+        extra = {}
+        if self.candidate_split != 1:
+            extra["candidate_split"] = self.candidate_split
+        if self.point_source_vertices is not None:
+            v = np.ascontiguousarray(self.point_source_vertices, dtype=np.float32)
+            extra["point_source_mesh"] = [self.point_source_mesh,
+                                          hashlib.sha1(v.tobytes()).hexdigest()]
+        return data + [extra] if extra else data
+
     def fingerprint(self):
         """Everything but the motion, as JSON-friendly data (the manifest compares it)."""
         data = {"name": self.name, "role": self.role, "mesh": self.mesh_hash()}
@@ -125,6 +143,8 @@ class EmitterSnapshot:
 #: Accepted range of the streak settings (the native StreakParams / random_points_in_cells bounds).
 EMISSION_PERIOD_RANGE = (1, 100000)
 POINT_SOURCES_RANGE = (1, 10000)
+#: Accepted range of a source's candidate_split (§3.3).
+CANDIDATE_SPLIT_RANGE = (1, 64)
 
 
 @dataclass
@@ -149,6 +169,9 @@ class BakeSnapshot:
     emitters: List[EmitterSnapshot] = field(default_factory=list)
     addon_version: str = "0.1.0"
     streaks: StreakSettings = field(default_factory=StreakSettings)
+    #: motion_source 'MANTAFLOW': the Mantaflow domain to trace (mantaflow_cache.MantaflowSource);
+    #: None: Plume simulates.
+    mantaflow: Optional[object] = None
 
     @property
     def frame_count(self):
@@ -173,8 +196,7 @@ class BakeSnapshot:
         if self.streaks.enabled:  # absent when off, so older caches still resume
             data["streaks"] = {
                 "emission_period": self.streaks.emission_period,
-                "sources": [[e.name, e.point_sources, e.candidate_group]
-                            for e in self.emitters if e.role == "SOURCE"]}
+                "sources": [e.streak_fingerprint() for e in self.emitters if e.role == "SOURCE"]}
         return data
 
     def frame_input_hash(self, frame):
@@ -251,10 +273,15 @@ def validate_streaks(domain_name, streaks, emitters):
         raise BakeError(f"Plume: domain '{domain_name}': streak surfaces need at least one Source "
                         "object (its cells hold the point sources)")
     lo, hi = POINT_SOURCES_RANGE
+    split_lo, split_hi = CANDIDATE_SPLIT_RANGE
     for e in sources:
-        if not (lo <= e.point_sources <= hi):
+        # Unused (and not checked) when a point source mesh gives the points.
+        if e.point_source_vertices is None and not (lo <= e.point_sources <= hi):
             raise BakeError(f"Plume: source '{e.name}': point_sources must be in [{lo}, {hi}] "
                             f"(got {e.point_sources})")
+        if not (split_lo <= e.candidate_split <= split_hi):
+            raise BakeError(f"Plume: source '{e.name}': candidate_split must be in [{split_lo}, "
+                            f"{split_hi}] candidate groups (got {e.candidate_split})")
         if e.candidate_group < -1:
             raise BakeError(f"Plume: source '{e.name}': candidate_group must be >= -1 "
                             f"(-1 = its own group; got {e.candidate_group})")
@@ -262,18 +289,28 @@ def validate_streaks(domain_name, streaks, emitters):
 
 def candidate_groups(emitters):
     """Candidate group of each Source (§3.3), in source order: the explicit group, or for -1 a
-    number of its own that no explicit group uses."""
+    number of its own that no explicit group uses. A source split in k > 1 groups
+    (candidate_split) gets the first of k consecutive numbers, all after every other source's
+    group (its candidate_group is then unused)."""
     sources = [e for e in emitters if e.role == "SOURCE"]
-    used = {e.candidate_group for e in sources if e.candidate_group >= 0}
+    whole = [e for e in sources if e.candidate_split <= 1]
+    used = {e.candidate_group for e in whole if e.candidate_group >= 0}
     groups, next_free = [], 0
     for e in sources:
-        if e.candidate_group >= 0:
+        if e.candidate_split > 1:
+            groups.append(None)  # numbered below, once every other group is known
+        elif e.candidate_group >= 0:
             groups.append(e.candidate_group)
-            continue
-        while next_free in used:
-            next_free += 1
-        used.add(next_free)
-        groups.append(next_free)
+        else:
+            while next_free in used:
+                next_free += 1
+            used.add(next_free)
+            groups.append(next_free)
+    next_split = max(used, default=-1) + 1
+    for n, e in enumerate(sources):
+        if groups[n] is None:
+            groups[n] = next_split
+            next_split += e.candidate_split
     return groups
 
 

@@ -1,5 +1,6 @@
 """Scene -> BakeSnapshot (bpy side). Runs on the main thread before a bake starts."""
 
+import dataclasses
 import os
 
 import bpy
@@ -7,6 +8,7 @@ import numpy as np
 from mathutils import Vector
 
 from . import cache
+from .mantaflow_cache import BORDER_SETTINGS, MantaflowSource
 from .settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, EmitterSnapshot, SolverSettings,
                        SourceParams, StreakSettings, domain_grid)
 
@@ -115,7 +117,8 @@ def emitter_snapshots(context, domain, frame_start, frame_end):
                                 motion_factor=float(s.motion_factor))
             if o.plume.role == 'SOURCE' else None,
             slip=o.plume.obstacle.slip,
-            point_sources=int(s.point_sources), candidate_group=int(s.candidate_group)))
+            point_sources=int(s.point_sources), candidate_group=int(s.candidate_group),
+            candidate_split=int(s.candidate_split)))
     animated = [i for i, o in enumerate(objs) if _is_animated(o)]
     if animated:
         current, subframe = scene.frame_current, scene.frame_subframe
@@ -128,7 +131,58 @@ def emitter_snapshots(context, domain, frame_start, frame_end):
                     snaps[i].matrices.append(np.array(objs[i].matrix_world, dtype=np.float64))
         finally:
             scene.frame_set(current, subframe=subframe)
+    point_source_vertices(context, objs, snaps, frame_start)
     return snaps
+
+
+def point_source_vertices(context, objs, snaps, frame_start):
+    """Fills the point_source_mesh of each Source snapshot whose source has one: the world
+    positions of the evaluated mesh's vertices at frame_start (smoke_surfaces.txt §3.2, one point
+    source per vertex). The current frame is restored."""
+    picked = [(o.plume.source.point_source_mesh, snap) for o, snap in zip(objs, snaps)
+              if o.plume.role == 'SOURCE' and o.plume.source.point_source_mesh is not None]
+    for mesh_obj, snap in picked:
+        if mesh_obj.type != 'MESH':  # a script can bypass the property's poll
+            raise BakeError(f"Plume: source '{snap.name}': point_source_mesh '{mesh_obj.name}' "
+                            f"must be a mesh object (got {mesh_obj.type})")
+    if not picked:
+        return
+    scene = context.scene
+    current, subframe = scene.frame_current, scene.frame_subframe
+    moved = (current, subframe) != (frame_start, 0.0)
+    try:
+        if moved:
+            scene.frame_set(frame_start)
+        depsgraph = context.evaluated_depsgraph_get()
+        for mesh_obj, snap in picked:
+            local, _ = mesh_arrays(mesh_obj, depsgraph)
+            m = np.array(mesh_obj.evaluated_get(depsgraph).matrix_world, dtype=np.float64)
+            world = local.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
+            snap.point_source_mesh = mesh_obj.name
+            snap.point_source_vertices = world.astype(np.float32)
+    finally:
+        if moved:
+            scene.frame_set(current, subframe=subframe)
+
+
+def mantaflow_source(domain, scene):
+    """The Mantaflow domain a streak bake traces (motion_source 'MANTAFLOW'), as plain data;
+    mantaflow_cache.check_source() validates it."""
+    ob = domain.plume.domain.mantaflow_domain
+    source = MantaflowSource(domain_name=domain.name, object_name=ob.name if ob else "")
+    mod = next((m for m in ob.modifiers if m.type == 'FLUID'), None) if ob else None
+    ds = mod.domain_settings if mod is not None and mod.fluid_type == 'DOMAIN' else None
+    if ds is None or ds.domain_type != 'GAS':
+        return source
+    base = bpy.path.abspath(ds.cache_directory)
+    if base.startswith("//"):  # unsaved file: relative to the working directory, as Blender does
+        base = base[2:]
+    return dataclasses.replace(
+        source, is_gas_domain=True, cache_directory=os.path.abspath(base or "."),
+        cache_data_format=ds.cache_data_format, cache_frame_start=int(ds.cache_frame_start),
+        cache_frame_end=int(ds.cache_frame_end), use_adaptive_domain=bool(ds.use_adaptive_domain),
+        borders_closed=tuple(bool(getattr(ds, n)) for n in BORDER_SETTINGS),
+        fps=scene.render.fps / scene.render.fps_base, time_scale=float(ds.time_scale))
 
 
 def take_snapshot(context, addon_version="0.1.0"):
@@ -154,4 +208,5 @@ def take_snapshot(context, addon_version="0.1.0"):
         cache_folder=cache_folder_of(domain), solver=solver,
         emitters=emitter_snapshots(context, domain, frame_start, frame_end),
         addon_version=addon_version,
-        streaks=StreakSettings(enabled=bool(d.streaks), emission_period=int(d.emission_period)))
+        streaks=StreakSettings(enabled=bool(d.streaks), emission_period=int(d.emission_period)),
+        mantaflow=mantaflow_source(domain, scene) if d.motion_source == 'MANTAFLOW' else None)

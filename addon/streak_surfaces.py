@@ -116,6 +116,29 @@ def summary(native, groups, h0):
     return surfaces, lines
 
 
+def most_surfaces_threshold(native, groups):
+    """The h0 > 0 giving the most surfaces over all candidate groups (ties: the most streaklines,
+    then the smallest h0): what an artist looks for on the (h0 -> surfaces) curve of Figure 4.
+    The counts only change where h0 passes a value of h, so h0 just above each distinct h value
+    covers every possible clustering exactly."""
+    values = np.unique(np.concatenate(
+        [g.h[np.triu_indices(len(g.ids), 1)] for g in groups.values()]))
+    values = values[np.isfinite(values)]
+    best = None
+    for v in values:
+        h0 = float(np.nextafter(v, np.inf))
+        if h0 <= 0.0:
+            continue
+        surfaces, lines = summary(native, groups, h0)
+        key = (surfaces, lines, -h0)
+        if best is None or key > best[0]:
+            best = (key, h0)
+    if best is None or best[0][0] == 0:
+        raise BakeError("Plume: no threshold h0 joins two streaklines (all h are 0 or not "
+                        "finite): check the point sources")
+    return best[1]
+
+
 def plan_surfaces(native, groups, h0) -> List[SurfacePlan]:
     """Clusters (h < h0, transitively) of every group, each in greedy minimum-length order."""
     plans = []

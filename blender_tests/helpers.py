@@ -84,6 +84,16 @@ def add_cube_obstacle(size=0.3, location=(0.45, 0.0, 1.1), name="Obstacle"):
     return ob
 
 
+def assert_reports_error(test, operator, pattern, state):
+    """`operator()` fails with a reported error (RuntimeError in a script) matching `pattern`,
+    and `state()` (e.g. datablock counts) is the same after as before: bad input changes nothing."""
+    before = state()
+    with test.assertRaises(RuntimeError) as ctx:
+        operator()
+    test.assertRegex(str(ctx.exception), pattern)
+    test.assertEqual(state(), before)
+
+
 def temp_dir(prefix):
     return tempfile.mkdtemp(prefix=prefix)
 

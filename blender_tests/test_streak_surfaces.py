@@ -18,8 +18,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (OUT_DIR, add_domain, image_pixels, reset_scene, rmtree, run,  # noqa: E402
-                     select_only, temp_dir)
+from helpers import (OUT_DIR, add_domain, assert_reports_error, image_pixels,  # noqa: E402
+                     reset_scene, rmtree, run, select_only, temp_dir)
 
 RESOLUTION = 50
 FRAMES = 40
@@ -145,7 +145,9 @@ class StreakSurfacesTest(unittest.TestCase):
         self.assertEqual(len(snap["counts"]) % POINT_SOURCES, 0)
         self.assertGreaterEqual(len(snap["counts"]), POINT_SOURCES)
         self.assertGreater(int(snap["counts"][0]), FRAMES)  # one particle per step
-        self.assertFalse(os.path.isfile(os.path.join(self.folder, "state.bin")))
+        # The last frame's checkpoints, solver and tracers together (resume, test_streak_sources).
+        for name in ("state.bin", "tracer_state.bin"):
+            self.assertTrue(os.path.isfile(os.path.join(self.folder, name)), name)
 
     def test_2_build_and_frame_change(self):
         obs = self.build()  # default h0 (mean of h): one cell's streaklines chain into one sheet
@@ -201,6 +203,25 @@ class StreakSurfacesTest(unittest.TestCase):
                       for c in ob.evaluated_get(dg).bound_box) for ob in obs)
         self.assertGreater(top, 0.5)
 
+    def test_2b_most_surfaces_threshold(self):
+        """plume.surfaces_pick_threshold sets the h0 of the peak of the Figure-4 curve: no h0
+        (checked just above and below every value of h) gives more surfaces."""
+        from plume import _native
+        from plume import streak_surfaces as ss
+        from plume.operators.surfaces import compute_distances
+        dom = bpy.data.objects["Domain"]
+        self.assertEqual(bpy.ops.plume.surfaces_pick_threshold(), {'FINISHED'})
+        h0 = dom.plume.domain.streak_threshold
+        groups = compute_distances(dom)[3]
+        best = ss.summary(_native, groups, h0)
+        print(f"  most surfaces: h0 = {h0:.4g} -> {best[0]} surfaces, {best[1]} streaklines")
+        self.assertGreaterEqual(best[0], 2)
+        h = np.concatenate([g.h[np.triu_indices(len(g.h), 1)] for g in groups.values()])
+        for v in np.unique(h):
+            for t in (v * (1 + 1e-6), v * (1 - 1e-6)):
+                if t > 0:
+                    self.assertLessEqual(ss.summary(_native, groups, t)[0], best[0], t)
+
     def test_3_render_is_semi_transparent(self):
         if not surface_objects():
             self.build()
@@ -235,11 +256,7 @@ class StreakSurfacesTest(unittest.TestCase):
 
     # ------------------------------------------------------------------- bad input
     def assert_error(self, pattern):
-        before = counts()
-        with self.assertRaises(RuntimeError) as ctx:
-            bpy.ops.plume.surfaces_build()
-        self.assertRegex(str(ctx.exception), pattern)
-        self.assertEqual(counts(), before)
+        assert_reports_error(self, bpy.ops.plume.surfaces_build, pattern, counts)
 
     def test_4_negative_threshold(self):
         d = bpy.data.objects["Domain"].plume.domain
@@ -277,11 +294,7 @@ class StreakBadInputTest(unittest.TestCase):
         rmtree(self.tmp)
 
     def assert_error(self, pattern):
-        before = counts()
-        with self.assertRaises(RuntimeError) as ctx:
-            bpy.ops.plume.surfaces_build()
-        self.assertRegex(str(ctx.exception), pattern)
-        self.assertEqual(counts(), before)
+        assert_reports_error(self, bpy.ops.plume.surfaces_build, pattern, counts)
 
     def test_no_bake_yet(self):
         build_scene(self.cache, frame_end=3)

@@ -23,7 +23,6 @@ import sys
 import time
 
 import bpy
-import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import scene_kit  # noqa: E402
@@ -83,19 +82,12 @@ def make_source(frames, resolution=RESOLUTION, point_sources=POINT_SOURCES):
 
 
 def pick_threshold(dom):
-    """h0 giving the most surfaces, read off the (h0 -> surfaces, streaklines) curve the panel
-    shows live (the paper's Figure 4) - what an artist does by dragging the threshold."""
-    from plume import _native
-    from plume.operators import surfaces as ops
-    _folder, _m, _frames, groups = ops.compute_distances(dom)
-    best = (0, 0.0)
-    for g in groups.values():
-        h = g.h[np.triu_indices(len(g.ids), 1)]
-        for h0 in np.linspace(0.02, 1.0, 50) * h.mean():
-            surfaces, _lines = _native.cluster_summary(g.h, float(h0))
-            best = max(best, (surfaces, float(h0)))
-    dom.plume.domain.streak_threshold = best[1]
-    return best[1]
+    """h0 giving the most surfaces (the Most Surfaces button next to the threshold): the peak of
+    the (h0 -> surfaces) curve the panel shows live, the paper's Figure 4."""
+    bpy.context.view_layer.objects.active = dom
+    if bpy.ops.plume.surfaces_pick_threshold() != {'FINISHED'}:
+        sys.exit("the threshold could not be picked")
+    return dom.plume.domain.streak_threshold
 
 
 def main():

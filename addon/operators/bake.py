@@ -11,6 +11,7 @@ import bpy
 from .. import bake_runner, cache
 from .. import _native
 from ..build import volume
+from ..mantaflow_trace import MantaflowTraceRunner
 from ..settings import BakeError
 from ..snapshot import NOT_A_DOMAIN, active_domain, cache_folder_of, take_snapshot
 
@@ -28,7 +29,9 @@ def _prepare(context):
     snap = take_snapshot(context, addon_version=_addon_version())
     if snap.domain_name in _running:
         raise BakeError(f"Plume: domain '{snap.domain_name}' is already baking")
-    runner = bake_runner.BakeRunner(snap, _native)
+    # motion_source 'MANTAFLOW': trace the Mantaflow cache's velocity instead of simulating.
+    runner_class = bake_runner.BakeRunner if snap.mantaflow is None else MantaflowTraceRunner
+    runner = runner_class(snap, _native)
     runner.prepare()
     return runner
 

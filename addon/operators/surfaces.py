@@ -137,4 +137,26 @@ class PLUME_OT_surfaces_build(bpy.types.Operator):
         return maps
 
 
-classes = (PLUME_OT_surfaces_build,)
+class PLUME_OT_surfaces_pick_threshold(bpy.types.Operator):
+    """Set h0 to the threshold giving the most surfaces (the peak of the paper's Figure 4 curve)"""
+
+    bl_idname = "plume.surfaces_pick_threshold"
+    bl_label = "Most Surfaces"
+    bl_options = {'REGISTER', 'UNDO'}  # changes one property, nothing on disk
+
+    def execute(self, context):
+        try:
+            domain = active_domain(context)
+            _folder, _m, _frames, groups = compute_distances(domain)
+            h0 = ss.most_surfaces_threshold(_native, groups)
+        except BakeError as e:
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
+        domain.plume.domain.streak_threshold = h0
+        surfaces, lines = ss.summary(_native, groups, h0)
+        self.report({'INFO'}, f"Plume: h0 = {h0:.4g} gives {surfaces} surfaces from {lines} "
+                              "streaklines")
+        return {'FINISHED'}
+
+
+classes = (PLUME_OT_surfaces_build, PLUME_OT_surfaces_pick_threshold)

@@ -179,7 +179,13 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         col = layout.column()
         col.active = d.streaks
         col.prop(d, "emission_period")
-        col.prop(d, "streak_threshold")
+        col.prop(d, "motion_source")
+        sub = col.column()
+        sub.active = d.motion_source == 'MANTAFLOW'  # its cache moves the particles, no simulation
+        sub.prop(d, "mantaflow_domain")
+        row = col.row(align=True)
+        row.prop(d, "streak_threshold")
+        row.operator("plume.surfaces_pick_threshold", text="", icon='SORTSIZE')
         # Live count from the h cached by the last build (never computed here, §3.3 Figure 4).
         counts = live_summary(ob)
         if counts is not None:
@@ -226,8 +232,14 @@ class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
         layout.prop(s, "velocity")
         layout.prop(s, "motion_factor")
         col = layout.column(heading="Streak Surfaces")
-        col.prop(s, "point_sources")
-        col.prop(s, "candidate_group")
+        col.prop(s, "point_source_mesh")
+        sub = col.column()
+        sub.active = s.point_source_mesh is None  # the mesh's vertices replace the random points
+        sub.prop(s, "point_sources")
+        sub = col.column()
+        sub.active = s.candidate_split <= 1  # split groups are numbered after all the others
+        sub.prop(s, "candidate_group")
+        col.prop(s, "candidate_split")
 
 
 class PHYSICS_PT_plume_obstacle(PlumePanel, bpy.types.Panel):

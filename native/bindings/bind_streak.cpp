@@ -6,6 +6,7 @@
 #include "bindings/bindings.h"
 
 #include "io/streak_file.h"
+#include "io/tracer_state_file.h"
 #include "solver/emitters.h"
 #include "solver/smoke_solver.h"
 #include "streak/clustering.h"
@@ -301,6 +302,28 @@ void bindTracer(py::module_& m) {
         "sum(counts[:s]), oldest first.");
   c.def("cancel", &StreakTracer::cancel,
         "Thread-safe: a running advance_frame_with_tracers() returns False before its next step.");
+  c.def(
+      "save_state",
+      [](const StreakTracer& t, const py::object& path, int frame) {
+        const std::string p = pathArg(path);
+        py::gil_scoped_release release;
+        writeTracerState(p, t, frame);
+      },
+      py::arg("path"), py::arg("frame"),
+      "Writes a checkpoint (point sources, particles, density, outside flags, exit velocities, "
+      "emission count, steps and settings) labelled with `frame`, atomically. RuntimeError "
+      "naming the path if it cannot be written.");
+  c.def(
+      "load_state",
+      [](StreakTracer& t, const py::object& path) {
+        const std::string p = pathArg(path);
+        py::gil_scoped_release release;
+        return readTracerState(p, t);
+      },
+      py::arg("path"),
+      "Reads a checkpoint written by save_state() and returns its frame label. RuntimeError on a "
+      "missing, truncated, corrupt or mismatched file (other emission period, interpolation, "
+      "domain or boundaries), leaving the tracer unchanged.");
   c.def_property_readonly("source_count", &StreakTracer::sourceCount, "Number of point sources.");
   c.def_property_readonly("particles_per_source", &StreakTracer::particlesPerSource,
                           "floor(steps / emission_period) + 1.");

@@ -18,6 +18,8 @@ void bindIo(pybind11::module_& m);
 void bindNurbs(pybind11::module_& m);
 /// Point sources, StreakTracer, streak files, distances/clusters/order (bind_streak.cpp).
 void bindStreak(pybind11::module_& m);
+/// Mantaflow cache frames, volumes and the tracer driven by them (bind_mantaflow.cpp).
+void bindMantaflow(pybind11::module_& m);
 
 /// A path argument given as str or os.PathLike, as a std::string (needs the GIL).
 inline std::string pathArg(const pybind11::object& path) {

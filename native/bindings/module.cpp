@@ -42,4 +42,5 @@ PYBIND11_MODULE(_native, m) {
   plume::bindings::bindIo(m);
   plume::bindings::bindNurbs(m);
   plume::bindings::bindStreak(m);
+  plume::bindings::bindMantaflow(m);
 }

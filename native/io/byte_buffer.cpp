@@ -56,6 +56,22 @@ void ByteReader::floats(float* out, std::size_t n) {
   mPos += 4 * n;
 }
 
+void ByteReader::header(const char* magic, std::size_t magicSize, std::uint32_t version) {
+  if (string(magicSize) != std::string(magic, magicSize))
+    throw std::runtime_error(mKind + " '" + mPath + "' is not a Plume " + mKind + " (bad magic)");
+  const auto found = integer<std::uint32_t>();
+  if (found != version)
+    throw std::runtime_error(mKind + " '" + mPath + "' has version " + std::to_string(found) +
+                             "; this build reads version " + std::to_string(version));
+}
+
+bool ByteReader::checksumMatches() const {
+  if (mSize < 8) return false;
+  std::uint64_t stored = 0;
+  for (std::size_t b = 0; b < 8; ++b) stored |= std::uint64_t(mData[mSize - 8 + b]) << (8 * b);
+  return fnv1a64(mData, mSize - 8) == stored;
+}
+
 void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,
                      const std::string& kind) {
   const std::string tmp = path + ".tmp";

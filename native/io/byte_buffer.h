@@ -30,6 +30,8 @@ class ByteWriter {
   }
   /// `n` 32-bit floats starting at p.
   void floats(const float* p, std::size_t n);
+  /// Appends the u64 FNV-1a 64 checksum of every byte so far (the trailer of Plume's files).
+  void checksum() { integer<std::uint64_t>(fnv1a64(mBuf.data(), mBuf.size())); }
   std::vector<unsigned char>& buffer() { return mBuf; }
   const std::vector<unsigned char>& buffer() const { return mBuf; }
 
@@ -60,6 +62,12 @@ class ByteReader {
   }
   /// `n` 32-bit floats into out (n entries, already sized by the caller).
   void floats(float* out, std::size_t n);
+  /// Reads a file header: `magicSize` magic bytes, then a u32 version that must be `version`.
+  /// Throws std::runtime_error "<kind> '<path>' is not a Plume <kind> (bad magic)" or "... has
+  /// version N; this build reads version M".
+  void header(const char* magic, std::size_t magicSize, std::uint32_t version);
+  /// Whether the whole buffer ends with the u64 FNV-1a 64 checksum of the bytes before it.
+  bool checksumMatches() const;
   void bytes(void* out, std::size_t n) {
     need(n);
     std::memcpy(out, mData + mPos, n);

@@ -54,7 +54,7 @@ void writeStreakFile(const std::string& path, const StreakFrame& frame) {
   w.floats(frame.density.data(), particles);
   for (int g : frame.groups) w.integer<std::int32_t>(g);
   w.bytes(frame.outside.data(), particles);
-  w.integer<std::uint64_t>(fnv1a64(w.buffer().data(), w.buffer().size()));
+  w.checksum();
   writeFileAtomic(path, w.buffer(), kKind);
 }
 
@@ -62,12 +62,7 @@ StreakFrame readStreakFile(const std::string& path) {
   const std::vector<unsigned char> buf =
       readFileChecked(path, kHeaderSize + kChecksumSize, std::size_t(1) << 36, kKind);
   ByteReader r(buf.data(), buf.size(), kKind, path);
-  if (r.string(sizeof(kMagic)) != std::string(kMagic, sizeof(kMagic)))
-    fail(path, "is not a Plume streak file (bad magic)");
-  const std::uint32_t version = r.integer<std::uint32_t>();
-  if (version != kVersion)
-    fail(path, "has version " + std::to_string(version) + "; this build reads version " +
-                   std::to_string(kVersion));
+  r.header(kMagic, sizeof(kMagic), kVersion);
   const std::uint64_t sources = r.integer<std::uint32_t>();
   // The per-source arrays must fit before they are allocated.
   if (sources * kPerSource > buf.size() - kHeaderSize - kChecksumSize)
@@ -92,10 +87,7 @@ StreakFrame readStreakFile(const std::string& path) {
   if (expected != buf.size())
     fail(path, "has " + std::to_string(buf.size()) + " bytes; its header announces " +
                    std::to_string(expected) + " (truncated or corrupt)");
-  if (fnv1a64(buf.data(), buf.size() - kChecksumSize) !=
-      ByteReader(buf.data() + buf.size() - kChecksumSize, kChecksumSize, kKind, path)
-          .integer<std::uint64_t>())
-    fail(path, "is corrupt (checksum mismatch)");
+  if (!r.checksumMatches()) fail(path, "is corrupt (checksum mismatch)");
   const std::size_t m = std::size_t(particles);
   f.positions.resize(m);
   r.floats(reinterpret_cast<float*>(f.positions.data()), 3 * m);

@@ -4,24 +4,18 @@
 #include "io/vdb_frame.h"
 
 #include "core/parallel.h"
+#include "io/vdb_grids.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
-#include <cstdio>
 #include <limits>
-#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
 namespace plume {
 namespace {
-
-void initializeOpenVdb() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
 
 /// Cell (i,j,k) is voxel (i,j,k): voxel size Δx, voxel centre origin + (i+½, j+½, k+½) Δx.
 openvdb::math::Transform::Ptr cellTransform(const SmokeParams& p) {
@@ -30,25 +24,6 @@ openvdb::math::Transform::Ptr cellTransform(const SmokeParams& p) {
                                       double(p.origin.y) + 0.5 * double(p.cellSize),
                                       double(p.origin.z) + 0.5 * double(p.cellSize)));
   return xform;
-}
-
-openvdb::CoordBBox cellBox(glm::ivec3 n) {
-  return openvdb::CoordBBox(openvdb::Coord(0, 0, 0), openvdb::Coord(n.x - 1, n.y - 1, n.z - 1));
-}
-
-/// A fog-volume float grid holding the non-zero cells of `values` (x-fastest, solver layout).
-/// copyFromDense converts leaf-sized blocks in parallel (TBB).
-openvdb::FloatGrid::Ptr floatGrid(const std::string& name, const float* values, glm::ivec3 n,
-                                  const openvdb::math::Transform::Ptr& xform) {
-  auto grid = openvdb::FloatGrid::create(/*background=*/0.f);
-  // Dense only reads here; it wants a mutable pointer because it can also be written to.
-  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(cellBox(n),
-                                                                const_cast<float*>(values));
-  openvdb::tools::copyFromDense(dense, *grid, /*tolerance=*/0.f);
-  grid->setName(name);
-  grid->setTransform(xform);
-  grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-  return grid;
 }
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
@@ -74,10 +49,10 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
     parallelFor(0, slabs, [&](int k) {
       for (std::size_t m = std::size_t(k) * slab, e = m + slab; m < e; ++m) density[m] = d[m] + s[m];
     });
-    grids.push_back(floatGrid("density", density.data(), n, xform));
+    grids.push_back(denseFloatGrid("density", density.data(), n, xform));
   }
-  grids.push_back(floatGrid("temperature", solver.temperature().data(), n, xform));
-  if (p.combustion) grids.push_back(floatGrid("flame", solver.flame().data(), n, xform));
+  grids.push_back(denseFloatGrid("temperature", solver.temperature().data(), n, xform));
+  if (p.combustion) grids.push_back(denseFloatGrid("flame", solver.flame().data(), n, xform));
   {
     // Cell-centred velocity (the mean of each cell's two faces per axis), stored only where
     // there is smoke or flame: the projection leaves tiny velocities in the whole domain, which
@@ -95,45 +70,13 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
           velocity[m] = openvdb::Vec3s(c.x, c.y, c.z);
         }
     });
-    auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
-    openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dense(cellBox(n),
-                                                                           velocity.data());
-    openvdb::tools::copyFromDense(dense, *grid, /*tolerance=*/openvdb::Vec3s(0.f));
-    grid->setName("velocity");
-    grid->setTransform(xform);
-    grid->setGridClass(openvdb::GRID_UNKNOWN);
-    grid->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
-    grids.push_back(grid);
+    grids.push_back(denseVectorGrid("velocity", velocity.data(), n, xform));
   }
 
-  const std::string tmp = path + ".tmp";
-  try {
-    openvdb::MetaMap meta;
-    meta.insertMeta("creator", openvdb::StringMetadata("plume"));
-    meta.insertMeta("frame", openvdb::Int32Metadata(solver.frame()));
-    {
-      openvdb::io::File file(tmp);
-      if (openvdb::io::File::hasBloscCompression())
-        file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-      file.write(grids, meta);
-      file.close();
-    }
-    // io::File::write does not report a failed stream (a full disk): read the grid descriptors
-    // back, which fails on a short file.
-    openvdb::io::File check(tmp);
-    check.open(/*delayLoad=*/true);
-    std::size_t written = 0;
-    for (auto it = check.beginName(); it != check.endName(); ++it) ++written;
-    check.close();
-    if (written != grids.size()) throw std::runtime_error("grids missing after writing");
-  } catch (const std::exception& e) {
-    std::remove(tmp.c_str());
-    fail(path, std::string("cannot be written: ") + e.what());
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    fail(path, "cannot rename the temporary file '" + tmp + "' to it");
-  }
+  openvdb::MetaMap meta;
+  meta.insertMeta("creator", openvdb::StringMetadata("plume"));
+  meta.insertMeta("frame", openvdb::Int32Metadata(solver.frame()));
+  writeGridsAtomic(path, grids, meta);
 }
 
 std::vector<std::string> vdbGridNames(const std::string& path) {

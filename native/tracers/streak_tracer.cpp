@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace plume {
 namespace {
@@ -54,7 +55,7 @@ StreakTracer::StreakTracer(const StreakParams& params, const SmokeParams& smoke)
 int StreakTracer::addPointSources(const std::vector<glm::vec3>& positions,
                                   const std::vector<int>& groups,
                                   const std::vector<glm::vec3>& velocities) {
-  if (mSteps != 0)
+  if (mState.steps != 0)
     throw std::invalid_argument(
         "point sources must be added before the first step (every streakline needs the same "
         "particle count)");
@@ -64,27 +65,59 @@ int StreakTracer::addPointSources(const std::vector<glm::vec3>& positions,
   if (!velocities.empty() && velocities.size() != positions.size())
     throw std::invalid_argument("point sources: " + std::to_string(velocities.size()) +
                                 " velocities for " + std::to_string(positions.size()) + " positions");
+  for (std::size_t n = 0; n < positions.size(); ++n)
+    checkPointSource(n, positions[n], velocities.empty() ? glm::vec3(0.f) : velocities[n]);
+  const int first = int(mState.sources.size());
   for (std::size_t n = 0; n < positions.size(); ++n) {
-    const glm::vec3 p = positions[n];
-    if (!finite(p) || (!velocities.empty() && !finite(velocities[n])))
-      throw std::invalid_argument("point source " + std::to_string(n) +
-                                  ": position and velocity must be finite");
-    if (glm::any(glm::lessThan(p, mLo)) || glm::any(glm::greaterThan(p, mHi)))
-      throw std::invalid_argument("point source " + std::to_string(n) + " at (" +
-                                  std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
-                                  std::to_string(p.z) + ") lies outside the domain");
-  }
-  const int first = int(mSources.size());
-  for (std::size_t n = 0; n < positions.size(); ++n) {
-    mSources.push_back({positions[n], groups[n], velocities.empty() ? glm::vec3(0.f) : velocities[n]});
+    mState.sources.push_back(
+        {positions[n], groups[n], velocities.empty() ? glm::vec3(0.f) : velocities[n]});
     // Emission 0 (instant t = 0). Before the first step the storage holds only emission 0, so
     // appending keeps the emission-major layout. Density is unknown until the first step.
-    mPositions.push_back(positions[n]);
-    mDensity.push_back(0.f);
-    mOutside.push_back(0);
-    mExitVelocity.emplace_back(0.f);
+    mState.positions.push_back(positions[n]);
+    mState.density.push_back(0.f);
+    mState.outside.push_back(0);
+    mState.exitVelocity.emplace_back(0.f);
   }
   return first;
+}
+
+void StreakTracer::checkPointSource(std::size_t n, glm::vec3 p, glm::vec3 velocity) const {
+  if (!finite(p) || !finite(velocity))
+    throw std::invalid_argument("point source " + std::to_string(n) +
+                                ": position and velocity must be finite");
+  if (glm::any(glm::lessThan(p, mLo)) || glm::any(glm::greaterThan(p, mHi)))
+    throw std::invalid_argument("point source " + std::to_string(n) + " at (" +
+                                std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
+                                std::to_string(p.z) + ") lies outside the domain");
+}
+
+void StreakTracerState::validate(int emissionPeriod) const {
+  if (emissionPeriod < 1) throw std::invalid_argument("emission_period must be >= 1");
+  if (steps < 0 || emissions < 1 || steps / emissionPeriod + 1 != emissions)
+    throw std::invalid_argument("tracer state: " + std::to_string(emissions) +
+                                " emissions after " + std::to_string(steps) +
+                                " steps do not match emission period " +
+                                std::to_string(emissionPeriod));
+  const std::size_t m = sources.size() * std::size_t(emissions);
+  if (sources.size() != 0 && m / sources.size() != std::size_t(emissions))
+    throw std::invalid_argument("tracer state: too many particles");
+  if (positions.size() != m || density.size() != m || outside.size() != m ||
+      exitVelocity.size() != m)
+    throw std::invalid_argument("tracer state: " + std::to_string(sources.size()) + " sources x " +
+                                std::to_string(emissions) + " emissions need " +
+                                std::to_string(m) + " particles in every array");
+  for (std::size_t n = 0; n < m; ++n)
+    if (outside[n] > 1 || !finite(positions[n]) || !finite(exitVelocity[n]) ||
+        !std::isfinite(density[n]))
+      throw std::invalid_argument("tracer state: particle " + std::to_string(n) +
+                                  " has a non-finite value or a bad outside flag");
+}
+
+void StreakTracer::setState(StreakTracerState state) {
+  state.validate(mParams.emissionPeriod);
+  for (std::size_t n = 0; n < state.sources.size(); ++n)
+    checkPointSource(n, state.sources[n].position, state.sources[n].velocity);
+  mState = std::move(state);
 }
 
 void StreakTracer::checkGrid(glm::ivec3 size, glm::ivec3 expected, const char* what) const {
@@ -94,13 +127,13 @@ void StreakTracer::checkGrid(glm::ivec3 size, glm::ivec3 expected, const char* w
 }
 
 void StreakTracer::emit() {
-  for (const PointSource& s : mSources) {
-    mPositions.push_back(s.position);
-    mDensity.push_back(0.f);
-    mOutside.push_back(0);
-    mExitVelocity.emplace_back(0.f);
+  for (const PointSource& s : mState.sources) {
+    mState.positions.push_back(s.position);
+    mState.density.push_back(0.f);
+    mState.outside.push_back(0);
+    mState.exitVelocity.emplace_back(0.f);
   }
-  ++mEmissions;
+  ++mState.emissions;
 }
 
 void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const ScalarGrid& density,
@@ -112,25 +145,26 @@ void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const Sca
   checkGrid(density.size(), mGrid.resolution, "density");
   const Interpolation scheme = mParams.interpolation;
   const int sources = sourceCount();
-  // Particles of the emission made at this step's start (instant mSteps) are newborn.
-  const std::size_t newborn = mSteps % mParams.emissionPeriod == 0
-                                  ? std::size_t(mEmissions - 1) * std::size_t(sources)
-                                  : mPositions.size();
-  const int count = int(mPositions.size());
+  // Particles of the emission made at this step's start (instant steps) are newborn.
+  const std::size_t newborn = mState.steps % mParams.emissionPeriod == 0
+                                  ? std::size_t(mState.emissions - 1) * std::size_t(sources)
+                                  : mState.positions.size();
+  const int count = int(mState.positions.size());
   const float half = 0.5f * dt;
   parallelFor(0, (count + kChunk - 1) / kChunk, [&](int chunk) {
     const int end = std::min(count, (chunk + 1) * kChunk);
     for (int n = chunk * kChunk; n < end; ++n) {
-      const glm::vec3 x = mPositions[std::size_t(n)];
-      if (mOutside[std::size_t(n)]) {
+      const glm::vec3 x = mState.positions[std::size_t(n)];
+      if (mState.outside[std::size_t(n)]) {
         // No air is simulated out there: the particle keeps the velocity it left with, so a
         // streakline leaving the domain stays evenly spaced instead of piling up on the side
         // (a pile of coincident particles makes the interpolating surface overshoot).
-        mPositions[std::size_t(n)] = x + dt * mExitVelocity[std::size_t(n)];
+        mState.positions[std::size_t(n)] = x + dt * mState.exitVelocity[std::size_t(n)];
         continue;
       }
       glm::vec3 k1(0.f);
-      if (std::size_t(n) >= newborn) k1 = mSources[std::size_t(n) % std::size_t(sources)].velocity;
+      if (std::size_t(n) >= newborn)
+        k1 = mState.sources[std::size_t(n) % std::size_t(sources)].velocity;
       if (k1 == glm::vec3(0.f)) k1 = sampleVelocity(before, toCell(x), scheme);
       const glm::vec3 xm = x + half * k1;
       const glm::vec3 cm = toCell(xm);
@@ -149,23 +183,24 @@ void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const Sca
           else xn[a] = mHi[a];
         }
       }
-      mPositions[std::size_t(n)] = xn;
+      mState.positions[std::size_t(n)] = xn;
       if (left) {
-        mOutside[std::size_t(n)] = 1;
-        mExitVelocity[std::size_t(n)] = um;
-        mDensity[std::size_t(n)] = 0.f;  // no smoke is simulated outside the domain
+        mState.outside[std::size_t(n)] = 1;
+        mState.exitVelocity[std::size_t(n)] = um;
+        mState.density[std::size_t(n)] = 0.f;  // no smoke is simulated outside the domain
       }
     }
   });
-  ++mSteps;
-  if (mSteps % mParams.emissionPeriod == 0) emit();
+  ++mState.steps;
+  if (mState.steps % mParams.emissionPeriod == 0) emit();
   // Density at every particle still inside, at the end of the step (§3.2: stored every step).
-  const int total = int(mPositions.size());
+  const int total = int(mState.positions.size());
   parallelFor(0, (total + kChunk - 1) / kChunk, [&](int chunk) {
     const int end = std::min(total, (chunk + 1) * kChunk);
     for (int n = chunk * kChunk; n < end; ++n)
-      if (!mOutside[std::size_t(n)])
-        mDensity[std::size_t(n)] = sample(density, toCell(mPositions[std::size_t(n)]), scheme);
+      if (!mState.outside[std::size_t(n)])
+        mState.density[std::size_t(n)] =
+            sample(density, toCell(mState.positions[std::size_t(n)]), scheme);
   });
 }
 
@@ -179,20 +214,20 @@ void StreakTracer::observeStep(const SmokeSolver& solver, const MacGrid3& veloci
 
 StreakFrame StreakTracer::snapshot() const {
   StreakFrame f;
-  const std::size_t sources = mSources.size(), emissions = std::size_t(mEmissions);
-  f.counts.assign(sources, mEmissions);
+  const std::size_t sources = mState.sources.size(), emissions = std::size_t(mState.emissions);
+  f.counts.assign(sources, mState.emissions);
   f.groups.reserve(sources);
-  for (const PointSource& s : mSources) f.groups.push_back(s.group);
-  f.positions.resize(mPositions.size());
-  f.density.resize(mPositions.size());
-  f.outside.resize(mPositions.size());
+  for (const PointSource& s : mState.sources) f.groups.push_back(s.group);
+  f.positions.resize(mState.positions.size());
+  f.density.resize(mState.positions.size());
+  f.outside.resize(mState.positions.size());
   // Emission-major storage to source-major snapshot, oldest particle first.
   for (std::size_t s = 0; s < sources; ++s)
     for (std::size_t e = 0; e < emissions; ++e) {
       const std::size_t from = e * sources + s, to = s * emissions + e;
-      f.positions[to] = mPositions[from];
-      f.density[to] = mDensity[from];
-      f.outside[to] = mOutside[from];
+      f.positions[to] = mState.positions[from];
+      f.density[to] = mState.density[from];
+      f.outside[to] = mState.outside[from];
     }
   return f;
 }

@@ -49,6 +49,25 @@ struct PointSource {
   glm::vec3 velocity{0.f};
 };
 
+/// Everything a StreakTracer accumulates while it runs (§3.2): its point sources and their
+/// particles, emission-major (particle e of source s at e * sources.size() + s), with the density
+/// sampled at each, the outside flag and exit velocity of particles that left through an open
+/// side, the emission instants reached and the steps seen. A checkpoint
+/// (io/tracer_state_file.h) saves it so that a traced bake resumes bit for bit.
+struct StreakTracerState {
+  std::vector<PointSource> sources;
+  std::vector<glm::vec3> positions;
+  std::vector<float> density;
+  std::vector<std::uint8_t> outside;     ///< 0 or 1
+  std::vector<glm::vec3> exitVelocity;   ///< velocity a particle left the domain with
+  int emissions = 1;                     ///< floor(steps / emission period) + 1
+  long long steps = 0;
+  /// Throws std::invalid_argument when the counters disagree with each other and with
+  /// `emissionPeriod`, the particle arrays do not hold sources × emissions entries, a flag is
+  /// not 0/1 or a value is not finite.
+  void validate(int emissionPeriod) const;
+};
+
 /// Emits and advects the particles of streaklines (§3.2). Independent of SmokeSolver: step()
 /// takes the velocity at the start and end of a step and the density at the end; observeStep()
 /// and advanceFrameWithTracers() (tracer_driver.h) feed it from a solver.
@@ -63,6 +82,14 @@ class StreakTracer {
 
   const StreakParams& params() const { return mParams; }
   const GridFrame& gridFrame() const { return mGrid; }
+  /// Sides (-x, +x, -y, +y, -z, +z) through which particles leave.
+  const std::array<Boundary, 6>& boundaries() const { return mBoundaries; }
+
+  /// Sources, particles and counters, for checkpoints (io/tracer_state_file.h).
+  const StreakTracerState& state() const { return mState; }
+  /// Replaces sources, particles and counters with a saved state. Throws std::invalid_argument
+  /// (StreakTracerState::validate, or a source outside the domain), leaving the tracer unchanged.
+  void setState(StreakTracerState state);
 
   /// Adds point sources (source ID = index, in the order added) and emits their first particle.
   /// All arrays have one entry per source; `velocities` may be empty (still sources). Only
@@ -71,7 +98,7 @@ class StreakTracer {
   /// the domain. Returns the ID of the first added source.
   int addPointSources(const std::vector<glm::vec3>& positions, const std::vector<int>& groups,
                       const std::vector<glm::vec3>& velocities);
-  const std::vector<PointSource>& pointSources() const { return mSources; }
+  const std::vector<PointSource>& pointSources() const { return mState.sources; }
 
   /// Advances every particle over one step of length dt (seconds) with the explicit midpoint
   /// rule, second order in time: k1 = u(x, t), x½ = x + ½Δt k1, u(x½, t + ½Δt) taken as the mean
@@ -91,11 +118,11 @@ class StreakTracer {
   /// The streaklines now: per source, its particles in birth order (§3.2, Figure 2).
   StreakFrame snapshot() const;
 
-  int sourceCount() const { return int(mSources.size()); }
+  int sourceCount() const { return int(mState.sources.size()); }
   /// Particles per source (equal for all sources).
-  int particlesPerSource() const { return mEmissions; }
+  int particlesPerSource() const { return mState.emissions; }
   /// Steps seen so far.
-  long long steps() const { return mSteps; }
+  long long steps() const { return mState.steps; }
 
   /// Thread-safe: a running advanceFrameWithTracers() returns false before its next step.
   void cancel() { mCancel.store(true); }
@@ -108,20 +135,15 @@ class StreakTracer {
     return (world - mGrid.origin) * mInvCellSize - glm::vec3(0.5f);
   }
   void checkGrid(glm::ivec3 size, glm::ivec3 expected, const char* what) const;
+  /// Throws std::invalid_argument unless source n is finite and inside the domain.
+  void checkPointSource(std::size_t n, glm::vec3 position, glm::vec3 velocity) const;
 
   StreakParams mParams;
   GridFrame mGrid;
   std::array<Boundary, 6> mBoundaries;
   float mInvCellSize;
   glm::vec3 mLo, mHi;  ///< domain box, world space
-  std::vector<PointSource> mSources;
-  // Particles, emission-major: particle e of source s at e * sourceCount() + s.
-  std::vector<glm::vec3> mPositions;
-  std::vector<float> mDensity;
-  std::vector<std::uint8_t> mOutside;
-  std::vector<glm::vec3> mExitVelocity;  ///< velocity a particle left the domain with
-  int mEmissions = 1;  ///< emission instants reached: floor(steps / P) + 1
-  long long mSteps = 0;
+  StreakTracerState mState;
   MacGrid3 mPrevious;
   std::atomic<bool> mCancel{false};
 };

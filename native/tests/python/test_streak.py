@@ -149,6 +149,42 @@ def test_tracer_cancel_and_gil_release():
     assert _native.advance_frame_with_tracers(solver, tracer) is False
 
 
+def test_tracer_checkpoint_resumes_bit_for_bit_with_the_solver(tmp_path):
+    p = small_params()
+    solver, tracer, _ = streaking_solver(p, emission_period=2)
+    for _ in range(2):
+        assert _native.advance_frame_with_tracers(solver, tracer)
+    solver.save_state(tmp_path / "state.bin")
+    tracer.save_state(tmp_path / "tracer_state.bin", frame=2)
+    for _ in range(2):
+        assert _native.advance_frame_with_tracers(solver, tracer)
+    straight = tracer.snapshot()
+
+    solver2, tracer2, _ = streaking_solver(p, emission_period=2)
+    solver2.load_state(tmp_path / "state.bin")
+    assert tracer2.load_state(tmp_path / "tracer_state.bin") == 2
+    for _ in range(2):
+        assert _native.advance_frame_with_tracers(solver2, tracer2)
+    resumed = tracer2.snapshot()
+    assert tracer2.steps == tracer.steps
+    for key in ("counts", "positions", "density", "groups", "outside"):
+        assert resumed[key].tobytes() == straight[key].tobytes(), key
+
+    # Bad files raise RuntimeError naming the path and leave the tracer as it was.
+    data = (tmp_path / "tracer_state.bin").read_bytes()
+    bad = tmp_path / "bad.bin"
+    before = tracer2.snapshot()
+    for content in (data[:len(data) // 2], data[:-1] + bytes([data[-1] ^ 1]), b""):
+        bad.write_bytes(content)
+        with pytest.raises(RuntimeError, match="bad.bin"):
+            tracer2.load_state(bad)
+        assert tracer2.snapshot()["positions"].tobytes() == before["positions"].tobytes()
+    with pytest.raises(RuntimeError, match="emission_period 2"):
+        _native.StreakTracer(p, emission_period=1).load_state(tmp_path / "tracer_state.bin")
+    with pytest.raises(RuntimeError, match="cannot be written"):
+        tracer.save_state(tmp_path / "missing" / "t.bin", frame=1)
+
+
 # --- streak files ----------------------------------------------------------------------------
 
 def test_streak_file_round_trip_and_errors(tmp_path):

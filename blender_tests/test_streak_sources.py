@@ -1,0 +1,268 @@
+"""Streakline point sources (smoke_surfaces.txt §3.2-3.3) through the operators: the vertices of
+a picked mesh as point sources, a source split into candidate groups, and a traced bake resumed
+from the tracers' checkpoint bit for bit. Bad values give clear errors and change nothing.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_streak_sources.py
+"""
+
+import json
+import os
+import sys
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (add_domain, add_sphere_source, assert_reports_error, native,  # noqa: E402
+                     reset_scene, rmtree, run, select_only, temp_dir)
+
+#: 16 cells along 2 units: a bake of a few frames takes well under a second.
+RESOLUTION = 16
+#: Float32 rounding of world positions about 1 unit from the origin (2^-23 ≈ 1.2e-7 relative),
+#: with margin for the matrix product done in float64 here and there.
+POSITION_TOLERANCE = 1e-6
+
+
+def build_scene(cache_dir, frame_end=3, point_sources=4, split=1):
+    """A 2-unit cube domain over z in [0, 2] with a small sphere source low in it, streaks on."""
+    src = add_sphere_source(radius=0.2, location=(0.0, 0.0, 0.35))
+    s = src.plume.source
+    s.point_sources = point_sources
+    s.candidate_split = split
+    s.velocity = (0.0, 0.0, 0.5)
+    dom = add_domain(resolution=RESOLUTION, frame_end=frame_end, cache_directory=cache_dir + "/")
+    dom.plume.domain.streaks = True
+    select_only(dom)
+    return dom, src
+
+
+def add_point_mesh(verts, name="Dots"):
+    """A mesh object of loose vertices (no faces), as an artist would place emission points."""
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in verts], [], [])
+    ob = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def streaks(folder, frame):
+    return native().read_streak_file(os.path.join(folder, f"streaks_{frame:04d}.bin"))
+
+
+def source_positions(snap):
+    """Where each streakline's youngest particle is: at its point source (emission every step)."""
+    ends = np.cumsum(np.asarray(snap["counts"], dtype=np.int64)) - 1
+    return np.asarray(snap["positions"], dtype=np.float64)[ends]
+
+
+def manifest(folder):
+    with open(os.path.join(folder, "manifest.json")) as f:
+        return json.load(f)
+
+
+def counts():
+    return (len(bpy.data.objects), len(bpy.data.meshes), len(bpy.data.volumes),
+            len(bpy.data.curves))
+
+
+class StreakSourcesTest(unittest.TestCase):
+    def setUp(self):
+        reset_scene()
+        self.tmp = temp_dir("plume_streak_sources_")
+        self.cache = os.path.join(self.tmp, "cache")
+        self.folder = os.path.join(self.cache, "Domain")
+
+    def tearDown(self):
+        rmtree(self.tmp)
+
+    def assert_bake_error(self, pattern):
+        """The bake fails with a message matching `pattern` and leaves no file and no datablock."""
+        assert_reports_error(self, bpy.ops.plume.bake, pattern, counts)
+        self.assertFalse(os.path.exists(self.cache), os.listdir(self.tmp))
+
+    # ------------------------------------------------------------------ vertex point sources
+    def test_vertex_sources_one_streakline_per_vertex_at_frame_start(self):
+        dom, src = build_scene(self.cache)
+        dots = add_point_mesh([(x, 0.0, 0.0) for x in (-0.2, -0.1, 0.0, 0.1, 0.2)])
+        dots.scale = (1.5, 1.0, 1.0)
+        # Animated: the vertices count where the mesh is at frame_start (1), not the current frame.
+        scn = bpy.context.scene
+        for frame, loc in ((1, (0.0, 0.1, 0.5)), (5, (0.0, 0.3, 0.9))):
+            dots.location = loc
+            dots.keyframe_insert("location", frame=frame)
+        # Evaluated mesh: the modifier's copies are point sources too.
+        array = dots.modifiers.new("Array", 'ARRAY')
+        array.count, array.use_relative_offset = 2, False
+        array.use_constant_offset, array.constant_offset_displace = True, (0.0, 0.0, 0.2)
+        scn.frame_set(1)
+        dg = bpy.context.evaluated_depsgraph_get()
+        ev = dots.evaluated_get(dg)
+        m = np.array(ev.matrix_world, dtype=np.float64)
+        local = np.array([tuple(v.co) for v in ev.to_mesh().vertices], dtype=np.float64)
+        ev.to_mesh_clear()
+        expected = local @ m[:3, :3].T + m[:3, 3]
+        self.assertEqual(len(expected), 10)
+        scn.frame_set(5)
+        src.plume.source.point_source_mesh = dots
+        select_only(dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assertEqual(scn.frame_current, 5)
+        for frame in (1, 3):
+            snap = streaks(self.folder, frame)
+            self.assertEqual(len(snap["counts"]), 10, frame)  # one streakline per vertex
+            np.testing.assert_allclose(source_positions(snap), expected, rtol=0,
+                                       atol=POSITION_TOLERANCE)
+            self.assertEqual(set(snap["groups"].tolist()), {0})
+        # The vertices are part of the bake's settings: moving the mesh starts over.
+        dots.animation_data_clear()
+        dots.location = (0.0, 0.1, 0.6)
+        dom.plume.domain.frame_end = 4
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assertFalse(manifest(self.folder)["last_run"]["resumed"])
+        snap = streaks(self.folder, 1)
+        self.assertAlmostEqual(float(source_positions(snap)[:, 2].min()), 0.6, places=5)
+
+    def test_bad_point_source_meshes_change_nothing(self):
+        dom, src = build_scene(self.cache)
+        dots = add_point_mesh([(0.0, 0.0, 0.5), (0.5, 0.0, 0.5), (3.0, 0.0, 0.5)])
+        src.plume.source.point_source_mesh = dots
+        select_only(dom)
+        self.assert_bake_error(r"source 'Source': 1 of the 3 vertices of point_source_mesh 'Dots' "
+                               r"lie outside domain 'Domain' .*vertex 2 at \(3, 0, 0\.5\)")
+        src.plume.source.point_source_mesh = add_point_mesh([], name="Empty")
+        self.assert_bake_error(r"source 'Source': point_source_mesh 'Empty' has no vertices")
+        # A script can bypass the property's poll; the bake still refuses a non-mesh.
+        curve = bpy.data.objects.new("Path", bpy.data.curves.new("Path", 'CURVE'))
+        bpy.context.scene.collection.objects.link(curve)
+        try:
+            src.plume.source.point_source_mesh = curve
+        except (TypeError, ValueError, RuntimeError):
+            pass
+        else:
+            self.assert_bake_error(r"point_source_mesh 'Path' must be a mesh object")
+        # Two vertices cannot make two groups of two.
+        src.plume.source.point_source_mesh = add_point_mesh([(0, 0, 0.5), (0.1, 0, 0.5)], "Two")
+        src.plume.source.candidate_split = 2
+        self.assert_bake_error(r"source 'Source': candidate_split 2 needs at least 4 point "
+                               r"sources .*it has 2")
+
+    # ------------------------------------------------------------------ split into groups
+    def test_split_groups_pure(self):
+        from plume.point_sources import split_groups
+        from plume.settings import EmitterSnapshot, candidate_groups
+        # Longest extent along y; equal y values keep their index order; 7 into 3: sizes 3, 2, 2.
+        pts = np.array([[0, 5, 0], [0, 1, 0], [0, 3, 0], [0.5, 1, 0], [0, 0, 0], [0, 6, 1],
+                        [0, 3, 0]], dtype=np.float32)
+        g = split_groups(pts, 10, 3)
+        self.assertEqual(g.tolist(), [12, 10, 11, 10, 10, 12, 11])
+        self.assertEqual(split_groups(pts, 4, 1).tolist(), [4] * 7)
+        # Groups of a split source come after every other group, in source order.
+        def src(name, group=-1, split=1):
+            return EmitterSnapshot(name=name, role="SOURCE", vertices=np.zeros((0, 3)),
+                                   triangles=np.zeros((0, 3)), matrices=[np.eye(4)],
+                                   candidate_group=group, candidate_split=split)
+        self.assertEqual(candidate_groups([src("A"), src("B", 0, 2), src("C", 5), src("D")]),
+                         [0, 6, 5, 1])
+
+    def test_split_source_gives_groups_never_in_one_surface(self):
+        from plume import streak_surfaces as ss
+        from plume.point_sources import split_groups
+        dom, src = build_scene(self.cache, frame_end=4, split=2)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        snap = streaks(self.folder, 4)
+        groups = np.asarray(snap["groups"])
+        n = len(groups)
+        self.assertGreaterEqual(n, 8)
+        self.assertEqual(sorted(set(groups.tolist())), [0, 1])  # the only source: from 0 on
+        self.assertEqual(np.count_nonzero(groups == 0), n // 2)
+        # The groups are the two halves along the axis of largest extent.
+        at = source_positions(snap)
+        self.assertEqual(groups.tolist(), split_groups(at.astype(np.float32), 0, 2).tolist())
+        axis = int(np.argmax(at.max(axis=0) - at.min(axis=0)))
+        self.assertLessEqual(at[groups == 0, axis].max(), at[groups == 1, axis].min())
+        # A threshold joining everything: one surface per group, never one across both.
+        nat = native()
+        frames = ss.load_frames(nat, self.folder, 1, 4)
+        h0 = 1e6
+        everything = nat.cluster_sources(nat.streak_distances(frames, np.arange(n)), h0)
+        self.assertEqual(len(everything), 1)  # unsplit, all would share one surface
+        plans = ss.plan_surfaces(nat, ss.group_distances(nat, frames), h0)
+        self.assertEqual(len(plans), 2)
+        for plan in plans:
+            self.assertEqual(set(groups[plan.sources].tolist()), {plan.group})
+        dom.plume.domain.streak_threshold = h0
+        self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})
+        self.assertEqual(len([o for o in bpy.data.objects if o.type == 'SURFACE']), 2)
+
+    def test_bad_split_changes_nothing(self):
+        dom, src = build_scene(self.cache)
+        for value in (0, 65, -1):
+            src.plume.source.candidate_split = value
+            self.assert_bake_error(r"source 'Source': candidate_split must be in \[1, 64\] "
+                                   rf"candidate groups \(got {value}\)")
+        src.plume.source.candidate_split = 64
+        src.plume.source.point_sources = 1
+        self.assert_bake_error(r"candidate_split 64 needs at least 128 point sources")
+
+    # ------------------------------------------------------------------ resume
+    def test_resumed_traced_bake_matches_straight_bake(self):
+        resumed, straight = os.path.join(self.tmp, "resumed"), os.path.join(self.tmp, "straight")
+        folder = os.path.join(resumed, "Domain")
+        # Interrupted bake: frames 1..3 done. The last frame always gets its checkpoints, whatever
+        # CHECKPOINT_COST_RATIO decides for the others.
+        dom, _src = build_scene(resumed, frame_end=3)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        m = manifest(folder)
+        self.assertEqual((m["last_complete_frame"], m["state_frame"]), (3, 3))
+        self.assertTrue(os.path.isfile(os.path.join(folder, "tracer_state.bin")))
+        mtimes = {f: os.stat(os.path.join(folder, f"streaks_{f:04d}.bin")).st_mtime_ns
+                  for f in (1, 2, 3)}
+        time.sleep(0.05)
+        dom.plume.domain.frame_end = 7
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        m = manifest(folder)
+        self.assertTrue(m["last_run"]["resumed"])
+        self.assertEqual(m["last_run"]["computed_frames"], [4, 5, 6, 7])
+        for f, t in mtimes.items():
+            self.assertEqual(os.stat(os.path.join(folder, f"streaks_{f:04d}.bin")).st_mtime_ns, t)
+
+        dom.plume.domain.cache_directory = straight + "/"
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assertEqual(manifest(os.path.join(straight, "Domain"))["last_run"]["computed_frames"],
+                         list(range(1, 8)))
+        for f in range(1, 8):
+            name = f"streaks_{f:04d}.bin"
+            with open(os.path.join(folder, name), "rb") as a, \
+                    open(os.path.join(straight, "Domain", name), "rb") as b:
+                self.assertEqual(a.read(), b.read(), f"{name}: resumed bake differs")
+
+    def test_bad_tracer_checkpoint_starts_over(self):
+        dom, _src = build_scene(self.cache, frame_end=2)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        reference = streaks(self.folder, 2)
+        path = os.path.join(self.folder, "tracer_state.bin")
+        with open(path, "r+b") as f:  # one flipped bit: the checksum refuses the file
+            f.seek(100)
+            byte = f.read(1)
+            f.seek(100)
+            f.write(bytes([byte[0] ^ 0x01]))
+        dom.plume.domain.frame_end = 4
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        m = manifest(self.folder)
+        self.assertFalse(m["last_run"]["resumed"])
+        self.assertEqual(m["last_run"]["computed_frames"], [1, 2, 3, 4])
+        again = streaks(self.folder, 2)
+        self.assertTrue(np.array_equal(again["positions"], reference["positions"]))
+        # Without the tracers' checkpoint there is nothing to resume from either.
+        os.remove(path)
+        dom.plume.domain.frame_end = 5
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assertEqual(manifest(self.folder)["last_run"]["computed_frames"], [1, 2, 3, 4, 5])
+
+
+if __name__ == "__main__":
+    run(StreakSourcesTest)

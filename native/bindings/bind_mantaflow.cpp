@@ -1,0 +1,216 @@
+/// \file bind_mantaflow.cpp
+/// Streaklines driven by a baked Blender Mantaflow cache (smoke_surfaces.txt §3.2, issue 4):
+/// the Mantaflow grid's placement, its VDB frames, the volume frames written from them and the
+/// tracer that runs through them. Conversions and docstrings only; file reads, writes and
+/// frames release the GIL.
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+
+#include "bindings/bindings.h"
+#include "io/mantaflow_cache.h"
+#include "io/streak_file.h"
+#include "tracers/mantaflow_driver.h"
+
+namespace py = pybind11;
+
+namespace plume::bindings {
+namespace {
+
+using FloatC = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+/// (N, 3) float array as points (an empty array: none).
+std::vector<glm::vec3> pointsArg(const FloatC& a, const char* name) {
+  if (a.size() != 0 && (a.ndim() != 2 || a.shape(1) != 3))
+    throw py::value_error(std::string(name) + " must have shape (N, 3)");
+  const auto* p = reinterpret_cast<const glm::vec3*>(a.data());
+  return std::vector<glm::vec3>(p, p + a.size() / 3);
+}
+
+py::array_t<float> pointsResult(const std::vector<glm::vec3>& p) {
+  py::array_t<float> a({py::ssize_t(p.size()), py::ssize_t(3)});
+  if (!p.empty()) std::memcpy(a.mutable_data(), p.data(), p.size() * sizeof(glm::vec3));
+  return a;
+}
+
+/// A copy of a grid as an (nx, ny, nz) Fortran-ordered array, indexed [i, j, k].
+py::array_t<float> gridResult(const ScalarGrid& g) {
+  const glm::ivec3 n = g.size();
+  py::array_t<float, py::array::f_style> a({py::ssize_t(n.x), py::ssize_t(n.y), py::ssize_t(n.z)});
+  std::memcpy(a.mutable_data(), g.data(), sizeof(float) * g.count());
+  return a;
+}
+
+glm::vec3 vec3Arg(const std::array<float, 3>& v) { return {v[0], v[1], v[2]}; }
+
+template <typename Map>
+py::array_t<float> mapPoints(const FloatC& points, const Map& map) {
+  std::vector<glm::vec3> p = pointsArg(points, "points");
+  for (glm::vec3& q : p) q = map(q);
+  return pointsResult(p);
+}
+
+void bindGrid(py::module_& m) {
+  py::class_<MantaflowGrid> g(
+      m, "MantaflowGrid",
+      "Where a Mantaflow domain's cells lie in world space: base_res cells, the corner of cell "
+      "(0,0,0) at origin, cell_size per axis (Blender stretches the domain box over base_res "
+      "cells, so cells are not cubic), and Mantaflow time units per second (2.5).");
+  g.def(py::init([](const std::array<int, 3>& res, const std::array<float, 3>& origin,
+                    const std::array<float, 3>& cellSize, float unitsPerSecond) {
+          MantaflowGrid grid{glm::ivec3(res[0], res[1], res[2]), vec3Arg(origin), vec3Arg(cellSize),
+                             unitsPerSecond};
+          grid.validate();
+          return grid;
+        }),
+        py::arg("resolution"), py::arg("origin"), py::arg("cell_size"),
+        py::arg("time_units_per_second") = kMantaflowTimeUnitsPerSecond,
+        "ValueError on a resolution outside [1, 2048] or a cell size <= 0.");
+  g.def_property_readonly("resolution", [](const MantaflowGrid& x) {
+    return py::make_tuple(x.resolution.x, x.resolution.y, x.resolution.z);
+  });
+  g.def_property_readonly("origin", [](const MantaflowGrid& x) {
+    return py::make_tuple(x.origin.x, x.origin.y, x.origin.z);
+  });
+  g.def_property_readonly("cell_size", [](const MantaflowGrid& x) {
+    return py::make_tuple(x.cellSize.x, x.cellSize.y, x.cellSize.z);
+  });
+  g.def_property_readonly("time_units_per_second",
+                          [](const MantaflowGrid& x) { return x.timeUnitsPerSecond; });
+  g.def_property_readonly("vdb_voxel_size", &MantaflowGrid::vdbVoxelSize,
+                          "Voxel size of the cache's VDB transform (longest side / resolution).");
+  g.def(
+      "index_to_world",
+      [](const MantaflowGrid& x, const FloatC& p) {
+        return mapPoints(p, [&](glm::vec3 q) { return x.indexToWorld(q); });
+      },
+      py::arg("points"), "(N, 3) cell coordinates (cell (i,j,k) spans [i, i+1]...) to world.");
+  g.def(
+      "world_to_index",
+      [](const MantaflowGrid& x, const FloatC& p) {
+        return mapPoints(p, [&](glm::vec3 q) { return x.worldToIndex(q); });
+      },
+      py::arg("points"), "(N, 3) world positions to cell coordinates.");
+}
+
+void bindFrame(py::module_& m) {
+  py::class_<MantaflowFrame> f(
+      m, "MantaflowFrame",
+      "One Mantaflow frame on its base grid: density at cell centres, face velocities in m/s.");
+  f.def_static(
+      "empty",
+      [](const std::array<int, 3>& r) {
+        return MantaflowFrame::empty({r[0], r[1], r[2]});
+      },
+      py::arg("resolution"), "The state before the first cached frame: all zero.");
+  f.def(
+      "density", [](const MantaflowFrame& x) { return gridResult(x.density); },
+      "Copy of the density, (nx, ny, nz) float32.");
+  f.def(
+      "velocity",
+      [](const MantaflowFrame& x) {
+        const MacGrid3& v = x.velocity;
+        return py::make_tuple(gridResult(v.u()), gridResult(v.v()), gridResult(v.w()));
+      },
+      "Copies of the face velocities (u, v, w) in m/s, shaped (nx+1, ny, nz), (nx, ny+1, nz), "
+      "(nx, ny, nz+1) as SmokeSolver.get_velocity().");
+  f.def("max_cells_per_second", &MantaflowFrame::maxCellsPerSecond, py::arg("grid"),
+        "Largest |u_a| / cell_size_a over all faces.");
+
+  m.def(
+      "read_mantaflow_frame",
+      [](const py::object& path, const MantaflowGrid& grid) {
+        const std::string p = pathArg(path);
+        py::gil_scoped_release release;
+        return readMantaflowFrame(p, grid);
+      },
+      py::arg("path"), py::arg("grid"),
+      "Reads density and velocity of a Blender Mantaflow fluid_data_####.vdb onto grid "
+      "(staggered velocity face by face, in m/s; faces clipped by Mantaflow next to a stored "
+      "cell extrapolated from it). RuntimeError naming the file when it is missing, unreadable "
+      "or does not match the grid.");
+  m.def(
+      "write_mantaflow_volume",
+      [](const py::object& path, const MantaflowFrame& frame, const MantaflowGrid& grid,
+         int number) {
+        const std::string p = pathArg(path);
+        py::gil_scoped_release release;
+        writeMantaflowVolume(p, frame, grid, number);
+      },
+      py::arg("path"), py::arg("frame"), py::arg("grid"), py::arg("frame_number"),
+      "Writes the frame as a Plume volume VDB (density, cell-centred velocity where there is "
+      "smoke) placed in world space by grid, atomically. RuntimeError naming the path.");
+}
+
+void bindTracer(py::module_& m) {
+  py::class_<MantaflowTracer> t(
+      m, "MantaflowTracer",
+      "Streaklines (smoke_surfaces §3.2) advected through a Mantaflow cache: velocity linear in "
+      "time between two cached frames, substeps with at most cfl cells each, the midpoint rule "
+      "per substep (second order in time); positions in world space.");
+  t.def(py::init([](const MantaflowGrid& grid, int emissionPeriod, Interpolation interpolation,
+                    const std::array<Boundary, 6>& boundaries, float cfl) {
+          MantaflowTraceParams p;
+          p.streak.emissionPeriod = emissionPeriod;
+          p.streak.interpolation = interpolation;
+          p.cfl = cfl;
+          return std::make_unique<MantaflowTracer>(p, grid, boundaries);
+        }),
+        py::arg("grid"), py::arg("emission_period") = 1,
+        py::arg("interpolation") = Interpolation::MonotonicCubic,
+        py::arg("boundaries") =
+            std::array<Boundary, 6>{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open,
+                                    Boundary::Open, Boundary::Open},
+        py::arg("cfl") = 1.f,
+        "boundaries: -x, +x, -y, +y, -z, +z (Mantaflow border collisions are CLOSED). ValueError "
+        "on emission_period outside [1, 100000] or cfl outside [0.05, 10].");
+  t.def(
+      "add_point_sources",
+      [](MantaflowTracer& x, const FloatC& positions, const std::vector<int>& groups) {
+        return x.addPointSources(pointsArg(positions, "positions"), groups);
+      },
+      py::arg("positions"), py::arg("groups"),
+      "Still point sources at world positions (N, 3), candidate group of each (N,); only before "
+      "the first frame. ValueError on sizes or positions outside the domain. Returns the first "
+      "ID.");
+  t.def("substeps", &MantaflowTracer::substeps, py::arg("a"), py::arg("b"), py::arg("frame_dt"),
+        "Substeps advance_frame(a, b, frame_dt) takes.");
+  t.def(
+      "advance_frame",
+      [](MantaflowTracer& x, const MantaflowFrame& a, const MantaflowFrame& b, float dt) {
+        py::gil_scoped_release release;
+        return x.advanceFrame(a, b, dt);
+      },
+      py::arg("a"), py::arg("b"), py::arg("frame_dt"),
+      "One frame of frame_dt seconds from frame a's fields to frame b's. Returns the substeps "
+      "taken, 0 when cancel() was called (discard the tracer then). Releases the GIL.");
+  t.def(
+      "write_snapshot",
+      [](const MantaflowTracer& x, const py::object& path) {
+        const std::string p = pathArg(path);
+        py::gil_scoped_release release;
+        writeStreakFile(p, x.snapshot());
+      },
+      py::arg("path"),
+      "Writes the streaklines now (world positions) as a streak file, atomically.");
+  t.def("cancel", &MantaflowTracer::cancel, "Thread-safe: a running advance_frame() returns 0.");
+  t.def_property_readonly("source_count",
+                          [](const MantaflowTracer& x) { return x.tracer().sourceCount(); });
+  t.def_property_readonly("particles_per_source",
+                          [](const MantaflowTracer& x) { return x.tracer().particlesPerSource(); });
+  t.def_property_readonly(
+      "steps", [](const MantaflowTracer& x) { return x.tracer().steps(); },
+      "Substeps taken so far.");
+}
+
+}  // namespace
+
+void bindMantaflow(py::module_& m) {
+  bindGrid(m);
+  bindFrame(m);
+  bindTracer(m);
+}
+
+}  // namespace plume::bindings
