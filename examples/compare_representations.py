@@ -32,9 +32,12 @@ VOLUME_DENSITY = 25.0     # Principled Volume density scale of panels (a), (b)
 
 
 def bake(out_dir, frames, resolution, point_sources):
-    """The incense scene at `resolution` with `point_sources` in its source cell, baked."""
+    """The incense scene at `resolution` with `point_sources` point sources in its tip, baked."""
     scene = scene_kit.new_scene()
-    incense.make_source(frames, resolution, point_sources)
+    if resolution == incense.RESOLUTION:  # the tip is one cell: `point_sources` in that cell
+        incense.make_source(frames, point_sources=point_sources)
+    else:  # the same tip spans several cells: exactly `point_sources` vertices inside it
+        incense.make_source(frames, vertex_sources=point_sources)
     dom = incense.make_domain(frames, resolution, name=f"Incense{resolution}")
     scene_kit.camera(scene, (0.0, -1.7, 0.5), (90.0, 0.0, 0.0), lens=50.0)
     scene_kit.dark_studio(scene, world_color=(0.004, 0.004, 0.006))
