@@ -19,6 +19,7 @@ render times and the surfaces found. Needs the Plume add-on installed (README).
 
 import math
 import os
+import random
 import sys
 import time
 
@@ -57,13 +58,13 @@ def make_domain(frames, resolution=RESOLUTION, name="Incense"):
     return dom
 
 
-def make_source(frames, resolution=RESOLUTION, point_sources=POINT_SOURCES):
-    # The glowing tip: one source cell, the one whose centre is nearest to (0, 0, 5 cm): at 50³
-    # its centre is (1, 1, 5) cm.
-    cell = 1.0 / resolution
-    cx = -0.5 + (math.floor(0.5 * resolution) + 0.5) * cell
-    cz = (math.floor(0.05 * resolution) + 0.5) * cell
-    bpy.ops.mesh.primitive_cube_add(size=0.9 * cell, location=(cx, cx, cz))
+def make_source(frames, point_sources=POINT_SOURCES, vertex_sources=0):
+    """The glowing tip: the 2 cm cell centred at (1, 1, 5) cm of the 50³ grid (several cells of a
+    finer grid: the same physical source at any resolution), with `point_sources` random point
+    sources per source cell, or, when `vertex_sources` > 0, that many seeded random points inside
+    the tip as a Point Source Mesh (one streakline per vertex)."""
+    size, cx, cz = 0.9 / RESOLUTION, 0.01, 0.05
+    bpy.ops.mesh.primitive_cube_add(size=size, location=(cx, cx, cz))
     src = bpy.context.active_object
     src.name = "IncenseTip"
     bpy.ops.plume.role_set(role='SOURCE')
@@ -71,6 +72,16 @@ def make_source(frames, resolution=RESOLUTION, point_sources=POINT_SOURCES):
     s.density, s.temperature = 1.0, 1.0
     s.velocity = (0.0, 0.0, 0.15)
     s.point_sources = point_sources
+    if vertex_sources > 0:
+        rng = random.Random(7)
+        mesh = bpy.data.meshes.new("TipPoints")
+        mesh.from_pydata([tuple(rng.uniform(-0.5, 0.5) * size for _ in range(3))
+                          for _ in range(vertex_sources)], [], [])
+        points = bpy.data.objects.new("TipPoints", mesh)
+        bpy.context.scene.collection.objects.link(points)
+        points.parent = src  # rides along with the tip
+        points.hide_render = True
+        s.point_source_mesh = points
     s.motion_factor = 1.0
     src.hide_render = True
     # A slow circle of 8 mm starting at the cell centre: a hand that is not quite still.
