@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import List, Optional
 
 from . import cache
-from .point_sources import domain_point_sources
+from .point_sources import domain_point_sources, emits_during
 
 #: A checkpoint of the solver state is written when the time since the last one is at least this
 #: many times what writing the last one took (and after the last frame): about every frame on
@@ -65,12 +65,16 @@ class BakeRunner:
         self.progress = progress
         self._solver = None
         self._cancel = threading.Event()
+        self._result = None  # BakeResult of the running run()
+        #: frames computed when cancel() was first called (the frame in flight is then dropped)
+        self.frames_done_at_cancel = None
         self._mode = None  # 'fresh', 'resume' or 'complete'
         self._resume_last = None
         self._resume_state = None
         self._manifest = None
-        self._emitter_index = None  # frame index whose emitters are loaded in the solver
+        self._emitter_inputs = None  # EmitterSnapshot.solver_inputs of the loaded emitters
         self._tracer = None  # StreakTracer when streak surfaces are on
+        self._emitting_sources = []  # Sources with point sources (their emit_particles count)
         self._params = None  # the validated native SmokeParams
 
     # ---------------------------------------------------------------- validation
@@ -87,7 +91,7 @@ class BakeRunner:
         self._params = params
         for emitter in snap.emitters:
             if emitter.role == "SOURCE":
-                validate_source(emitter)
+                validate_source(emitter, snap.frame_start)
         validate_streaks(snap.domain_name, snap.streaks, snap.emitters)
         try:
             self._solver = self._native.SmokeSolver(params)
@@ -108,9 +112,10 @@ class BakeRunner:
         self._plan()
 
     def _load_emitters(self, index):
-        """Voxelizes the emitters for frame frame_start + index (matrices at index, index+1)."""
-        if self._emitter_index is not None and (
-                self._emitter_index == index or not any(e.animated for e in self.snapshot.emitters)):
+        """Voxelizes the emitters for frame frame_start + index (matrices at index, index+1, source
+        settings at index) unless the solver already holds exactly those."""
+        inputs = [e.solver_inputs(index) for e in self.snapshot.emitters]
+        if inputs == self._emitter_inputs:
             return
         solver, native = self._solver, self._native
         solver.clear_emitters()
@@ -119,7 +124,7 @@ class BakeRunner:
             try:
                 if e.role == "SOURCE":
                     solver.add_source(e.vertices, e.triangles, m0, m1,
-                                      to_native_source(e.source, native), name=e.name)
+                                      to_native_source(e.source_at(index), native), name=e.name)
                 else:
                     slip = getattr(native.Slip, e.slip)
                     solver.add_obstacle(e.vertices, e.triangles, m0, m1, slip, name=e.name)
@@ -128,7 +133,7 @@ class BakeRunner:
                 if e.name not in text:
                     text = f"{e.role.lower()} '{e.name}': {text}"
                 raise BakeError(f"Plume: {text}") from None
-        self._emitter_index = index
+        self._emitter_inputs = inputs
 
     def _make_tracer(self, params):
         """StreakTracer with the point sources of every Source (smoke_surfaces.txt §3.2):
@@ -140,7 +145,8 @@ class BakeRunner:
             tracer = native.StreakTracer(params, emission_period=snap.streaks.emission_period)
         except ValueError as e:
             raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
-        points, groups, velocities = domain_point_sources(native, params, snap)
+        points, groups, velocities, self._emitting_sources = domain_point_sources(native, params,
+                                                                                  snap)
         try:
             tracer.add_point_sources(points, groups, velocities)
         except ValueError as e:
@@ -192,6 +198,8 @@ class BakeRunner:
     # ---------------------------------------------------------------- the loop
     def cancel(self):
         """Thread-safe: the running frame stops within one step; completed frames stay."""
+        if self.frames_done_at_cancel is None and self._result is not None:
+            self.frames_done_at_cancel = len(self._result.computed_frames)
         self._cancel.set()
         if self._solver is not None:
             self._solver.cancel()
@@ -209,6 +217,7 @@ class BakeRunner:
         folder = snap.cache_folder
         t0 = time.perf_counter()
         result = BakeResult(frame_start=snap.frame_start, last_complete_frame=snap.frame_start - 1)
+        self._result = result
 
         if self._mode == "complete":
             cache.delete_plume_files(folder, frames_above=snap.frame_end)
@@ -251,6 +260,8 @@ class BakeRunner:
                 if tracer is None:
                     ok = self._solver.advance_frame()
                 else:
+                    tracer.emitting = emits_during(self._emitting_sources,
+                                                   frame - snap.frame_start)
                     ok = self._native.advance_frame_with_tracers(self._solver, tracer)
                 if not ok:
                     result.cancelled = True
@@ -274,6 +285,8 @@ class BakeRunner:
                     manifest["frame_inputs"].append(snap.frame_input_hash(frame))
                 self._frame_done(folder, manifest, result, frame, t0)
         finally:
+            if self.frames_done_at_cancel is not None:
+                manifest["last_run"]["frames_done_at_cancel"] = self.frames_done_at_cancel
             self._run_done(folder, manifest, result, t0)
         return result
 
@@ -314,7 +327,7 @@ class BakeRunner:
             ok = False
         if not ok:
             self._solver = self._native.SmokeSolver(self._params)
-            self._emitter_index = None
+            self._emitter_inputs = None
             self._load_emitters(0)
             if self._tracer is not None:
                 self._tracer = self._make_tracer(self._params)

@@ -12,6 +12,8 @@ Surfaces and the density maps work unchanged: streaks_####.bin (world positions)
 frames frame_start..f, the particles born at the start of frame_start from still point sources in
 the Plume Source objects' cells. The velocity between two cached frames is linear in time (see
 native/tracers/mantaflow_driver.h). A trace is cheap, so it always starts over (no resume).
+Emission pauses on the frames where no Source with point sources has emit_particles on (Figure 10),
+as in a Plume bake; the Sources' smoke settings are unused (the Mantaflow density is traced).
 """
 
 import dataclasses
@@ -22,7 +24,7 @@ import numpy as np
 from . import cache
 from .bake_runner import BakeResult, BakeRunner
 from .mantaflow_cache import TIME_UNITS_PER_SECOND, check_source
-from .point_sources import domain_point_sources
+from .point_sources import domain_point_sources, emits_during
 from .settings import BakeError, to_native_params, validate_python_side, validate_streaks
 
 
@@ -77,7 +79,8 @@ class MantaflowTraceRunner(BakeRunner):
             params = to_native_params(voxel_settings(snap.solver, plan), native)
         except ValueError as e:
             raise BakeError(f"{owner}: {e}") from None
-        points, groups, _velocities = domain_point_sources(native, params, snap)
+        points, groups, _velocities, self._emitting_sources = domain_point_sources(native, params,
+                                                                                   snap)
         try:
             # Still sources: the Mantaflow flow, not the Plume source's velocity, moves them.
             self._tracer.add_point_sources(points, groups)
@@ -117,6 +120,7 @@ class MantaflowTraceRunner(BakeRunner):
                     result.cancelled = True
                     break
                 fields = self._first if n == 0 else self._read(plan.files[n])
+                self._tracer.emitting = emits_during(self._emitting_sources, n)  # Figure 10
                 if self._tracer.advance_frame(previous, fields, plan.frame_dts[n]) == 0:
                     result.cancelled = True
                     break

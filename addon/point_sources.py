@@ -8,7 +8,8 @@ A source's point sources are `point_sources` random points in each of its cells 
 point sources are placed randomly in a source cell"), or the vertices of the mesh the artist
 picked (point_source_mesh), one streakline per vertex. A source split in k candidate groups
 (candidate_split) is cut into k groups of equal count along the axis of largest extent, so the
-streaklines of different parts are never clustered into one surface (§3.3).
+streaklines of different parts are never clustered into one surface (§3.3). Emission pauses on
+the frames where none of the Sources with point sources has emit_particles on (Figure 10's gap).
 """
 
 import numpy as np
@@ -101,20 +102,32 @@ def split_groups(points, first_group, split, source_name=""):
 
 def domain_point_sources(native, params, snapshot):
     """The point sources of every Source of a traced bake on the grid of SmokeParams `params`
-    (§3.2-3.3), Sources in order: world positions float32 (N, 3), candidate groups int64 (N,) and
-    velocities float32 (N, 3). BakeError when no Source has a point source in the domain."""
+    (§3.2-3.3), Sources in order: world positions float32 (N, 3), candidate groups int64 (N,),
+    velocities float32 (N, 3) and the Sources that have point sources (emitter snapshots, for
+    emits_during). BakeError when no Source has a point source in the domain."""
     snap = snapshot
     sources = [e for e in snap.emitters if e.role == "SOURCE"]
-    all_points, all_groups, all_vel = [], [], []
+    emitting, all_points, all_groups, all_vel = [], [], [], []
     for index, (e, group) in enumerate(zip(sources, candidate_groups(snap.emitters))):
         placed = source_point_sources(native, params, snap.domain_name, snap.solver.seed, e, index)
         if placed is None:
             continue
         points, vel = placed
+        emitting.append(e)
         all_points.append(points)
         all_vel.append(vel)
         all_groups.append(split_groups(points, group, e.candidate_split, e.name))
     if not all_points:
         raise BakeError(f"Plume: domain '{snap.domain_name}': streak surfaces need point "
                         "sources, but no Source object has a cell inside the domain")
-    return np.concatenate(all_points), np.concatenate(all_groups), np.concatenate(all_vel)
+    return (np.concatenate(all_points), np.concatenate(all_groups), np.concatenate(all_vel),
+            emitting)
+
+
+def emits_during(sources, index):
+    """Whether the tracer emits during frame frame_start + index (§3.2, Figure 10: "particle
+    emission was turned off"): when one of `sources` (the Sources with point sources) has
+    emit_particles on at that frame. The switch is per tracer, so that every streakline keeps the
+    same particle count; a source that is off while another emits keeps emitting too, and its
+    particles carry the density of the field there."""
+    return any(e.source_at(index).emit_particles for e in sources)

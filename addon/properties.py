@@ -93,6 +93,13 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         items=(('LINEAR', "Linear", "Trilinear sampling"),
                ('MONOTONIC_CUBIC', "Monotonic Cubic", "Monotonic cubic sampling (Fedkiw 2001 eq. 12-13): "
                                                       "keeps small rolling features, no new extrema")))
+    trace: EnumProperty(
+        name="Back-trace", default='MIDPOINT',
+        description="How far back each cell looks for what the flow brings it (Stam 1999 §3.2)",
+        items=(('MIDPOINT', "Midpoint", "Explicit midpoint rule (RK2): second order in time, "
+                                        "follows curved flow more closely"),
+               ('EULER', "Euler", "One step with the velocity at the cell itself: first order, "
+                                  "no interpolation, faster (Mantaflow's default)")))
     conserve_mass: BoolProperty(
         name="Conserve Mass", default=True,
         description="Restore the total smoke after each advection, less what left through open "
@@ -211,6 +218,14 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
         description="Mesh whose vertices (world space, evaluated at the domain's first frame) are "
                     "this source's point sources, one streakline each, instead of Point Sources "
                     "random points per cell (smoke_surfaces.txt §3.2); they must lie in the domain")
+    emit_particles: BoolProperty(
+        name="Emit Particles", default=True,
+        description="Emit streakline particles from this source's point sources (smoke_surfaces.txt "
+                    "§3.2, Figure 10): keyframe it off to leave a gap in the streaklines. Emission "
+                    "pauses only on frames where no Source with point sources emits (every "
+                    "streakline keeps the same particle count); while another source still emits, "
+                    "this one's particles keep coming and carry the smoke's density there (zero "
+                    "if its Density is keyframed to 0 too). The first particle is always emitted")
     candidate_split: IntProperty(
         name="Split Into Groups", default=1, soft_min=1, soft_max=64,
         description="Splits this source's point sources into this many candidate groups of equal "

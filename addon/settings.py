@@ -40,6 +40,7 @@ class SolverSettings:
     cfl: float = 4.0
     advection: str = "BFECC"
     interpolation: str = "MONOTONIC_CUBIC"
+    trace: str = "MIDPOINT"
     conserve_mass: bool = True
     gravity: Tuple[float, float, float] = (0.0, 0.0, -9.81)
     alpha: float = 1.0
@@ -65,13 +66,19 @@ class SolverSettings:
 
 @dataclass
 class SourceParams:
-    """Mirror of ``_native.SourceSettings``."""
+    """Mirror of ``_native.SourceSettings``, plus the tracer's emission switch."""
 
     density: float = 1.0
     temperature: float = 1.0
     fuel: float = 0.0
     velocity: Tuple[float, float, float] = (0.0, 0.0, 0.0)
     motion_factor: float = 1.0
+    #: §3.2 / Figure 10: the source's point sources emit particles (not a solver setting).
+    emit_particles: bool = True
+
+    def for_solver(self):
+        """The settings the solver reads (emit_particles set to its default)."""
+        return dataclasses.replace(self, emit_particles=True)
 
 
 @dataclass
@@ -85,6 +92,9 @@ class EmitterSnapshot:
     #: 4x4 row-major matrices for frames frame_start .. frame_end + 1 (one entry when static).
     matrices: List[np.ndarray]
     source: Optional[SourceParams] = None
+    #: Keyframed or driven source settings: the values at frames frame_start .. frame_end (source
+    #: holds the first); empty when they are constant.
+    source_frames: List[SourceParams] = field(default_factory=list)
     slip: str = "NO_SLIP"
     point_sources: int = 16  # streak surfaces: tracer point sources per source cell (§3.2)
     candidate_group: int = -1  # §3.3 candidate group, -1: the source's own group
@@ -101,6 +111,19 @@ class EmitterSnapshot:
     def matrix_at(self, index):
         """Matrix at frame frame_start + index (static emitters have a single matrix)."""
         return self.matrices[min(index, len(self.matrices) - 1)]
+
+    def source_at(self, index):
+        """Source settings at frame frame_start + index (None for an obstacle)."""
+        if self.source_frames:
+            return self.source_frames[min(index, len(self.source_frames) - 1)]
+        return self.source
+
+    def solver_inputs(self, index):
+        """What the solver's copy of this emitter is made from at frame frame_start + index: the
+        frame of its matrices and its solver settings; a change means voxelizing it again."""
+        source = self.source_at(index)
+        return (min(index, len(self.matrices) - 1),
+                source.for_solver() if source is not None else None)
 
     def mesh_hash(self):
         """Hash of the geometry that ignores the order of the triangles (Blender's primitives do
@@ -135,6 +158,8 @@ class EmitterSnapshot:
         data = {"name": self.name, "role": self.role, "mesh": self.mesh_hash()}
         if self.role == "SOURCE":
             data["source"] = dataclasses.asdict(self.source)
+            if data["source"]["emit_particles"]:  # the default: as older caches stored it
+                del data["source"]["emit_particles"]
         else:
             data["slip"] = self.slip
         return data
@@ -200,12 +225,18 @@ class BakeSnapshot:
         return data
 
     def frame_input_hash(self, frame):
-        """Hash of the emitter matrices that drive frame `frame` (matrices at frame and frame+1)."""
+        """Hash of the emitter matrices that drive frame `frame` (matrices at frame and frame+1)
+        and of the keyframed source settings at `frame` (constant ones are in settings_dict)."""
         index = frame - self.frame_start
         h = hashlib.sha1()
         for emitter in self.emitters:
             for m in (emitter.matrix_at(index), emitter.matrix_at(index + 1)):
                 h.update(np.ascontiguousarray(m, dtype=np.float64).tobytes())
+        for emitter in self.emitters:
+            if emitter.source_frames:
+                s = emitter.source_at(index)
+                h.update(np.array([s.density, s.temperature, s.fuel, *s.velocity,
+                                   s.motion_factor, s.emit_particles], dtype=np.float64).tobytes())
         return h.hexdigest()
 
 
@@ -243,21 +274,26 @@ def validate_python_side(domain_name, resolution, frame_start, frame_end, solver
             f"Plume: domain '{domain_name}': substeps must be at least 1 (got {solver.substeps})")
 
 
-def validate_source(emitter):
-    """Finite, non-negative amounts on a source."""
-    s = emitter.source
-    for name in ("density", "temperature", "fuel", "motion_factor"):
-        v = getattr(s, name)
-        if not math.isfinite(v):
-            raise BakeError(
-                f"Plume: source '{emitter.name}': {name} must be a finite number (got {v})")
-    for name in ("density", "fuel"):
-        v = getattr(s, name)
-        if v < 0.0:
-            raise BakeError(f"Plume: source '{emitter.name}': {name} must be >= 0 (got {v})")
-    if not all(math.isfinite(v) for v in s.velocity):
-        raise BakeError(
-            f"Plume: source '{emitter.name}': velocity must be finite (got {tuple(s.velocity)})")
+def validate_source(emitter, frame_start=None):
+    """Finite, non-negative amounts on a source, on every frame when they are keyframed (the
+    message names the frame; frame_start is the bake's first frame)."""
+    frames = emitter.source_frames or [emitter.source]
+    for index, s in enumerate(frames):
+        at = (f" at frame {frame_start + index}"
+              if emitter.source_frames and frame_start is not None else "")
+        for name in ("density", "temperature", "fuel", "motion_factor"):
+            v = getattr(s, name)
+            if not math.isfinite(v):
+                raise BakeError(f"Plume: source '{emitter.name}': {name} must be a finite number "
+                                f"(got {v}{at})")
+        for name in ("density", "fuel"):
+            v = getattr(s, name)
+            if v < 0.0:
+                raise BakeError(
+                    f"Plume: source '{emitter.name}': {name} must be >= 0 (got {v}{at})")
+        if not all(math.isfinite(v) for v in s.velocity):
+            raise BakeError(f"Plume: source '{emitter.name}': velocity must be finite "
+                            f"(got {tuple(s.velocity)}{at})")
 
 
 def validate_streaks(domain_name, streaks, emitters):
@@ -325,6 +361,8 @@ def to_native_params(solver, native):
             value = getattr(native.Advection, value)
         elif f.name == "interpolation":
             value = getattr(native.Interpolation, value)
+        elif f.name == "trace":
+            value = getattr(native.Trace, value)
         elif isinstance(value, list):
             value = tuple(value)
         setattr(p, f.name, value)

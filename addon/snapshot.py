@@ -53,7 +53,7 @@ def solver_settings(domain, scene, cells, cell_size, origin):
         resolution=tuple(cells), cell_size=float(cell_size), origin=tuple(origin),
         boundaries=tuple(getattr(d, "boundary_" + side) for side in BOUNDARY_SIDES),
         frame_dt=float(d.time_scale) / fps, substeps=int(d.substeps), use_cfl=bool(d.use_cfl),
-        cfl=float(d.cfl), advection=d.advection, interpolation=d.interpolation,
+        cfl=float(d.cfl), advection=d.advection, interpolation=d.interpolation, trace=d.trace,
         conserve_mass=bool(d.conserve_mass),
         gravity=tuple(float(v) for v in d.gravity), alpha=float(d.alpha), beta=float(d.beta),
         ambient_temperature=float(d.ambient_temperature), wind=tuple(float(v) for v in d.wind),
@@ -79,6 +79,26 @@ def _is_animated(obj):
     return False
 
 
+def _source_is_keyed(obj):
+    """True when the object's Plume source settings are keyframed (action or NLA strips) or
+    driven: F-curves or drivers whose data path starts with "plume.source"."""
+    ad = obj.animation_data
+    if ad is None:
+        return False
+    actions = [ad.action] + [strip.action for track in ad.nla_tracks for strip in track.strips]
+    paths = [fc.data_path for a in actions if a is not None for fc in a.fcurves]
+    paths += [d.data_path for d in ad.drivers]
+    return any(p.startswith("plume.source") for p in paths)
+
+
+def source_params(s):
+    """A source's settings (obj.plume.source) now, as plain data."""
+    return SourceParams(density=float(s.density), temperature=float(s.temperature),
+                        fuel=float(s.fuel), velocity=tuple(float(v) for v in s.velocity),
+                        motion_factor=float(s.motion_factor),
+                        emit_particles=bool(s.emit_particles))
+
+
 def mesh_arrays(obj, depsgraph):
     """Object-local vertices (float32 (N,3)) and triangles (int32 (M,3)) of the evaluated mesh."""
     ob = obj.evaluated_get(depsgraph)
@@ -100,8 +120,10 @@ def scene_emitters(scene, domain):
 
 
 def emitter_snapshots(context, domain, frame_start, frame_end):
-    """Meshes at the current frame, matrices at frame_start .. frame_end + 1 (evaluated per frame
-    only when something is animated; the current frame is restored)."""
+    """Meshes at the current frame, matrices at frame_start .. frame_end + 1 and source settings
+    at frame_start .. frame_end (evaluated per frame only for objects that are animated or whose
+    source settings are keyframed or driven, e.g. Figure 10's density and emit_particles; the
+    current frame is restored)."""
     scene = context.scene
     depsgraph = context.evaluated_depsgraph_get()
     objs = scene_emitters(scene, domain)
@@ -112,15 +134,13 @@ def emitter_snapshots(context, domain, frame_start, frame_end):
         snaps.append(EmitterSnapshot(
             name=o.name, role=o.plume.role, vertices=verts, triangles=tris,
             matrices=[np.array(o.matrix_world, dtype=np.float64)],
-            source=SourceParams(density=float(s.density), temperature=float(s.temperature),
-                                fuel=float(s.fuel), velocity=tuple(float(v) for v in s.velocity),
-                                motion_factor=float(s.motion_factor))
-            if o.plume.role == 'SOURCE' else None,
+            source=source_params(s) if o.plume.role == 'SOURCE' else None,
             slip=o.plume.obstacle.slip,
             point_sources=int(s.point_sources), candidate_group=int(s.candidate_group),
             candidate_split=int(s.candidate_split)))
     animated = [i for i, o in enumerate(objs) if _is_animated(o)]
-    if animated:
+    keyed = [i for i, o in enumerate(objs) if o.plume.role == 'SOURCE' and _source_is_keyed(o)]
+    if animated or keyed:
         current, subframe = scene.frame_current, scene.frame_subframe
         for i in animated:
             snaps[i].matrices = []
@@ -129,8 +149,17 @@ def emitter_snapshots(context, domain, frame_start, frame_end):
                 scene.frame_set(f)
                 for i in animated:
                     snaps[i].matrices.append(np.array(objs[i].matrix_world, dtype=np.float64))
+                for i in keyed if f <= frame_end else ():
+                    snaps[i].source_frames.append(source_params(objs[i].plume.source))
         finally:
             scene.frame_set(current, subframe=subframe)
+        for i in animated:  # e.g. only its source settings are keyed: one matrix, no re-voxelizing
+            if all(np.array_equal(m, snaps[i].matrices[0]) for m in snaps[i].matrices):
+                snaps[i].matrices = snaps[i].matrices[:1]
+        for i in keyed:  # keys that change nothing in the frame range give one value
+            snaps[i].source = snaps[i].source_frames[0]
+            if all(p == snaps[i].source for p in snaps[i].source_frames):
+                snaps[i].source_frames = []
     point_source_vertices(context, objs, snaps, frame_start)
     return snaps
 

@@ -23,9 +23,10 @@ DOMAIN_PROPS = (
     "resolution", "frame_start", "frame_end", "cache_directory", "seed", "combustion",
     # every SmokeParams field (resolution/cell_size/origin come from the box, frame_dt from
     # time_scale, boundaries from one enum per side)
-    "time_scale", "substeps", "use_cfl", "cfl", "advection", "interpolation", "gravity", "alpha",
-    "beta", "ambient_temperature", "wind", "wind_strength", "vorticity", "density_dissipation",
-    "pressure_tolerance", "max_pressure_iterations", "burn_rate", "soot_yield", "heat_yield",
+    "time_scale", "substeps", "use_cfl", "cfl", "advection", "interpolation", "trace", "gravity",
+    "alpha", "beta", "ambient_temperature", "wind", "wind_strength", "vorticity",
+    "density_dissipation", "pressure_tolerance", "max_pressure_iterations", "burn_rate",
+    "soot_yield", "heat_yield",
     "conductivity", "cooling_rate", "max_temperature", "expansion", "threads",
     "boundary_neg_x", "boundary_pos_x", "boundary_neg_y", "boundary_pos_y", "boundary_neg_z",
     "boundary_pos_z", "volume_object")

@@ -1,6 +1,7 @@
 """Streakline point sources (smoke_surfaces.txt §3.2-3.3) through the operators: the vertices of
-a picked mesh as point sources, a source split into candidate groups, and a traced bake resumed
-from the tracers' checkpoint bit for bit. Bad values give clear errors and change nothing.
+a picked mesh as point sources, a source split into candidate groups, a traced bake resumed
+from the tracers' checkpoint bit for bit, and Figure 10's keyed source (density 0 and particle
+emission off for some frames). Bad values give clear errors and change nothing.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_streak_sources.py
@@ -62,6 +63,45 @@ def source_positions(snap):
 def manifest(folder):
     with open(os.path.join(folder, "manifest.json")) as f:
         return json.load(f)
+
+
+def key_source(src, keys):
+    """CONSTANT keys (frame, on) on the source's density (1 or 0) and emit_particles, as in
+    Figure 10, written as F-curves of a new action (examples/sphere_collision.py keys them with
+    keyframe_insert)."""
+    action = bpy.data.actions.new("SourceKeys")
+    src.animation_data_create().action = action
+    for path in ("plume.source.density", "plume.source.emit_particles"):
+        fcurve = action.fcurves.new(path)
+        for frame, on in keys:
+            fcurve.keyframe_points.insert(frame, float(on)).interpolation = 'CONSTANT'
+
+
+def source_cells_ijk(dom):
+    """(i, j, k) of the cells the bake's Source fills (native.source_cells on its snapshot)."""
+    from plume.settings import to_native_params
+    from plume.snapshot import take_snapshot
+    nat = native()
+    select_only(dom)
+    snap = take_snapshot(bpy.context)
+    e = next(e for e in snap.emitters if e.role == "SOURCE")
+    params = to_native_params(snap.solver, nat)
+    cells, _ = nat.source_cells(e.vertices, e.triangles, e.matrix_at(0), e.matrix_at(1), params,
+                                e.name)
+    nx, ny, _nz = params.resolution
+    cells = np.asarray(cells, dtype=np.int64)
+    return np.stack([cells % nx, (cells // nx) % ny, cells // (nx * ny)], axis=1)
+
+
+def vdb_at(folder, frame, cells):
+    """The VDB density of a frame at cells (i, j, k) (0 outside the stored box)."""
+    g = native().read_vdb_grid(os.path.join(folder, f"volume_{frame:04d}.vdb"), "density")
+    values, lo = g["values"], np.asarray(g["min"])
+    q = cells - lo
+    inside = np.all((q >= 0) & (q < values.shape), axis=1)
+    out = np.zeros(len(cells))
+    out[inside] = values[tuple(q[inside].T)]
+    return out
 
 
 def counts():
@@ -239,6 +279,64 @@ class StreakSourcesTest(unittest.TestCase):
             with open(os.path.join(folder, name), "rb") as a, \
                     open(os.path.join(straight, "Domain", name), "rb") as b:
                 self.assertEqual(a.read(), b.read(), f"{name}: resumed bake differs")
+
+    # ------------------------------------------------------------------ Figure 10: keyed source
+    def test_keyed_density_and_emission_leave_a_gap(self):
+        # Figure 10: density 0 and particle emission off for a stretch of frames (here 4-6).
+        dom, src = build_scene(self.cache, frame_end=8)
+        s = src.plume.source
+        # 3 m/s carries the smoke out of the source cells within the 3 frames the source is off.
+        s.velocity = (0.0, 0.0, 3.0)
+        key_source(src, ((1, True), (4, False), (7, True)))
+        select_only(dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        rows = {f: int(streaks(self.folder, f)["counts"][0]) for f in range(1, 9)}
+        # Emission pauses while the only source is off and grows again after (one row per step).
+        grew = {f: rows[f] - rows[f - 1] for f in range(2, 9)}
+        self.assertEqual([grew[f] for f in (4, 5, 6)], [0, 0, 0], rows)
+        for f in (2, 3, 7, 8):
+            self.assertGreater(grew[f], 0, rows)
+        # The source cells: smoke while on; none left after three frames off. Sources keep their
+        # cells at max(ρ, ρ_source), so ρ_source = 0 adds nothing, the air flowing in from below
+        # is clean and the mass correction scales values in proportion to them (0 stays 0):
+        # exactly 0, up to float noise.
+        cells = source_cells_ijk(dom)
+        self.assertGreater(max(vdb_at(self.folder, 3, cells)), 0.5)
+        self.assertLessEqual(max(vdb_at(self.folder, 6, cells)), 1e-6)
+        self.assertGreater(max(vdb_at(self.folder, 7, cells)), 0.5)
+        # The keys are per-frame inputs, not settings: the settings dict is as for an un-keyed
+        # source (the values at frame_start, emit_particles on is not stored).
+        m = manifest(self.folder)
+        self.assertNotIn("emit_particles", m["settings"]["emitters"][0]["source"])
+        self.assertEqual(m["settings"]["emitters"][0]["source"]["density"], 1.0)
+
+        # Same keys, longer range: the bake resumes.
+        dom.plume.domain.frame_end = 9
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assertEqual(manifest(self.folder)["last_run"]["computed_frames"], [9])
+        # A changed key makes the stored frames stale: the bake starts over.
+        fcurve = src.animation_data.action.fcurves.find("plume.source.density")
+        next(k for k in fcurve.keyframe_points if k.co.x == 7).co.y = 0.5
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        m = manifest(self.folder)
+        self.assertFalse(m["last_run"]["resumed"])
+        self.assertEqual(m["last_run"]["computed_frames"], list(range(1, 10)))
+        # The new key's density, 0.5, give or take the few % the global mass correction adds.
+        self.assertAlmostEqual(max(vdb_at(self.folder, 7, cells)), 0.5, delta=0.05)
+        # So does a changed emission key alone (it changes only the particles).
+        fcurve = src.animation_data.action.fcurves.find("plume.source.emit_particles")
+        next(k for k in fcurve.keyframe_points if k.co.x == 7).co.y = 0.0
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.assertEqual(manifest(self.folder)["last_run"]["computed_frames"], list(range(1, 10)))
+        self.assertEqual(int(streaks(self.folder, 9)["counts"][0]), rows[3])
+
+    def test_bad_keyed_value_names_its_frame_and_changes_nothing(self):
+        dom, src = build_scene(self.cache, frame_end=4)
+        key_source(src, ((1, True), (3, False)))
+        fcurve = src.animation_data.action.fcurves.find("plume.source.density")
+        fcurve.keyframe_points[1].co.y = -1.0
+        select_only(dom)
+        self.assert_bake_error(r"source 'Source': density must be >= 0 \(got -1\.0 at frame 3\)")
 
     def test_bad_tracer_checkpoint_starts_over(self):
         dom, _src = build_scene(self.cache, frame_end=2)

@@ -57,11 +57,14 @@ class UiBakeTest(unittest.TestCase):
     def test_esc_cancels_within_one_step_and_keeps_finished_frames(self):
         r = self.result
         self.assertLess(r["done_after"], r["total"])
-        # Esc stops the bake within the step in flight. Between the poll that saw `done_at_esc`
-        # frames and the modal handler receiving Esc, at most one more frame can finish (a 40³
-        # frame takes far longer than one event-loop turn), and the frame in flight is dropped.
-        # (No wall-clock bound: machines are shared; the frame count is what Esc must bound.)
-        self.assertLessEqual(r["done_after"] - r["done_at_esc"], 1)
+        # Esc stops the bake within the step in flight: the modal handler's cancel() records
+        # how many frames were complete; at most the frame whose files were being written then
+        # completes after it, the frame being simulated is dropped. (No wall-clock bound and no
+        # bound from the poll that pressed Esc: on a busy machine the event loop may turn late.)
+        self.assertTrue(r["cancelled"])
+        self.assertIsNotNone(r["done_at_cancel"])
+        self.assertGreaterEqual(r["done_at_cancel"], r["done_at_esc"])
+        self.assertLessEqual(r["done_after"] - r["done_at_cancel"], 1)
         self.assertEqual(len(r["vdb_files"]), r["done_after"])
         self.assertEqual(r["volume_frames"], r["done_after"])
 

@@ -99,6 +99,7 @@ class PHYSICS_PT_plume_advection(PlumeDomainPanel, bpy.types.Panel):
         d = context.object.plume.domain
         layout.prop(d, "advection")
         layout.prop(d, "interpolation")
+        layout.prop(d, "trace")
         layout.prop(d, "conserve_mass")
 
 
@@ -232,6 +233,7 @@ class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
         layout.prop(s, "velocity")
         layout.prop(s, "motion_factor")
         col = layout.column(heading="Streak Surfaces")
+        col.prop(s, "emit_particles")
         col.prop(s, "point_source_mesh")
         sub = col.column()
         sub.active = s.point_source_mesh is None  # the mesh's vertices replace the random points

@@ -85,7 +85,10 @@ def step():
         return 0.05
     if state["phase"] == "cancelling" and not baking:
         vol = bpy.data.objects.get("Domain_smoke")
+        with open(os.path.join(state["cache"], "Domain", "manifest.json")) as f:
+            run = json.load(f)["last_run"]
         finish(invoke=state["invoke"], done_at_esc=state["done_at_esc"], done_after=done,
+               done_at_cancel=run.get("frames_done_at_cancel"), cancelled=run.get("cancelled"),
                total=total, seconds_to_stop=time.perf_counter() - state["pressed_at"],
                volume_frames=vol.data.frame_duration if vol else None,
                vdb_files=sorted(n for n in os.listdir(os.path.join(state["cache"], "Domain"))

@@ -1,7 +1,10 @@
 /// \file bench_solver.cpp
 /// Google Benchmark of the smoke solver: whole steps, each stage of step(), and VDB output, on a
-/// warmed-up plume (BFECC + monotonic cubic, vorticity confinement, buoyancy, spherical source on
-/// a closed floor, open sides). Not a test: run build/native/plume_bench by hand.
+/// warmed-up plume (vorticity confinement, buoyancy, spherical source on a closed floor, open
+/// sides) in two configurations: Plume's defaults (BFECC + monotonic cubic, midpoint traces,
+/// pressure tolerance 1e-4) and Mantaflow's (MacCormack + trilinear, first-order Euler traces
+/// from the grid-point velocity, tolerance 1e-3; the "Comparable" benchmarks, see
+/// examples/compare_mantaflow.py). Not a test: run build/native/plume_bench by hand.
 ///
 /// Memory: peak_rss_MB is the peak of the whole process so far, so it includes every solver an
 /// earlier benchmark of the same run built (they are cached). For the peak of one solver, run one
@@ -51,12 +54,33 @@ double rssMb() {
 /// UV sphere of radius r around c: the source mesh.
 EmitterMesh sphere(glm::vec3 c, float r) { return sphereMesh(c, r, 16, 32, "bench source"); }
 
-SmokeParams benchParams(int n, bool fire, Advection scheme) {
+/// What the benchmarks vary: the advection settings and the pressure tolerance.
+struct Config {
+  Advection scheme;
+  Interpolation interpolation;
+  Trace trace;
+  float tolerance;
+  bool operator<(const Config& o) const {
+    return std::tie(scheme, interpolation, trace, tolerance) <
+           std::tie(o.scheme, o.interpolation, o.trace, o.tolerance);
+  }
+};
+/// Plume's defaults.
+constexpr Config kBfecc{Advection::Bfecc, Interpolation::MonotonicCubic, Trace::Midpoint, 1e-4f};
+constexpr Config kMacCormack{Advection::MacCormack, Interpolation::MonotonicCubic,
+                             Trace::Midpoint, 1e-4f};
+/// Mantaflow's gas solver: MacCormack with trilinear sampling and Euler traces (advection.cpp,
+/// orderSpace 1, orderTrace 1), pressure accuracy 1e-3.
+constexpr Config kComparable{Advection::MacCormack, Interpolation::Linear, Trace::Euler, 1e-3f};
+
+SmokeParams benchParams(int n, bool fire, const Config& config) {
   SmokeParams p;
   p.resolution = glm::ivec3(n);
   p.cellSize = 1.f / float(n);
-  p.advection = scheme;
-  p.interpolation = Interpolation::MonotonicCubic;
+  p.advection = config.scheme;
+  p.interpolation = config.interpolation;
+  p.trace = config.trace;
+  p.pressureTolerance = config.tolerance;
   p.vorticity = 0.3f;
   p.alpha = 1.f;
   p.beta = 1.f;
@@ -68,11 +92,11 @@ SmokeParams benchParams(int n, bool fire, Advection scheme) {
 
 /// One warmed-up solver per (resolution, fire), built once: Google Benchmark calls each
 /// benchmark function several times while it sizes the iteration count.
-SmokeSolver& warmSolver(int n, bool fire, Advection scheme = Advection::Bfecc) {
-  static std::map<std::tuple<int, bool, Advection>, std::unique_ptr<SmokeSolver>> cache;
-  auto& slot = cache[{n, fire, scheme}];
+SmokeSolver& warmSolver(int n, bool fire, const Config& config = kBfecc) {
+  static std::map<std::tuple<int, bool, Config>, std::unique_ptr<SmokeSolver>> cache;
+  auto& slot = cache[{n, fire, config}];
   if (!slot) {
-    slot = std::make_unique<SmokeSolver>(benchParams(n, fire, scheme));
+    slot = std::make_unique<SmokeSolver>(benchParams(n, fire, config));
     SourceSettings settings;
     settings.density = 1.f;
     settings.temperature = 2.f;
@@ -103,8 +127,8 @@ struct Snapshot {
   }
 };
 
-void stepBenchmark(benchmark::State& state, Advection scheme) {
-  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false, scheme);
+void stepBenchmark(benchmark::State& state, const Config& config) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false, config);
   const float dt = solver.params().frameDt;
   double iterations = 0.0;
   for (auto _ : state) {
@@ -118,17 +142,20 @@ void stepBenchmark(benchmark::State& state, Advection scheme) {
   state.counters["rss_MB"] = rssMb();
 }
 
-void BM_Step(benchmark::State& state) { stepBenchmark(state, Advection::Bfecc); }
+void BM_Step(benchmark::State& state) { stepBenchmark(state, kBfecc); }
 /// The same step with MacCormack advection (Selle et al. 2008): two interpolation passes a field.
-void BM_StepMacCormack(benchmark::State& state) { stepBenchmark(state, Advection::MacCormack); }
+void BM_StepMacCormack(benchmark::State& state) { stepBenchmark(state, kMacCormack); }
+/// The step with Mantaflow's settings (kComparable).
+void BM_StepComparable(benchmark::State& state) { stepBenchmark(state, kComparable); }
 BENCHMARK(BM_Step)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_StepMacCormack)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_StepComparable)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// Times `stage` alone, each iteration from the state the previous stages of a step leave.
 template <typename Stage>
 void stageBenchmark(benchmark::State& state, bool fire, int before, Stage stage,
-                    Advection scheme = Advection::Bfecc) {
-  SmokeSolver& solver = warmSolver(int(state.range(0)), fire, scheme);
+                    const Config& config = kBfecc) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), fire, config);
   const float dt = solver.params().frameDt;
   using Member = void (SmokeSolver::*)(float);
   const Member order[] = {&SmokeSolver::applySources, &SmokeSolver::addForces,
@@ -160,27 +187,39 @@ void BM_Stage_advect(benchmark::State& state) {
 }
 void BM_Stage_advectMacCormack(benchmark::State& state) {
   stageBenchmark(
-      state, false, 2, [](SmokeSolver& s, float dt) { s.advect(dt); }, Advection::MacCormack);
+      state, false, 2, [](SmokeSolver& s, float dt) { s.advect(dt); }, kMacCormack);
+}
+void BM_Stage_advectComparable(benchmark::State& state) {
+  stageBenchmark(
+      state, false, 2, [](SmokeSolver& s, float dt) { s.advect(dt); }, kComparable);
 }
 void BM_Stage_burn(benchmark::State& state) {
   stageBenchmark(state, /*fire=*/true, 3, [](SmokeSolver& s, float dt) { s.burn(dt); });
 }
-void BM_Stage_project(benchmark::State& state) {
+void projectBenchmark(benchmark::State& state, const Config& config) {
   double iterations = 0.0;
-  stageBenchmark(state, false, 4, [&](SmokeSolver& s, float dt) {
-    // project() adds its iterations to those of the current step: count this call's only.
-    const int before = s.lastStats().pressureIterations;
-    s.project(dt);
-    iterations += s.lastStats().pressureIterations - before;
-  });
+  stageBenchmark(
+      state, false, 4,
+      [&](SmokeSolver& s, float dt) {
+        // project() adds its iterations to those of the current step: count this call's only.
+        const int before = s.lastStats().pressureIterations;
+        s.project(dt);
+        iterations += s.lastStats().pressureIterations - before;
+      },
+      config);
   state.counters["pressure_iters"] = iterations / double(state.iterations());
 }
+void BM_Stage_project(benchmark::State& state) { projectBenchmark(state, kBfecc); }
+/// Projection to Mantaflow's tolerance 1e-3.
+void BM_Stage_projectComparable(benchmark::State& state) { projectBenchmark(state, kComparable); }
 BENCHMARK(BM_Stage_applySources)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_addForces)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_advect)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_advectMacCormack)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stage_advectComparable)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_burn)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Stage_project)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stage_projectComparable)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_WriteVdb(benchmark::State& state) {
   SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false);

@@ -196,6 +196,11 @@ void bindTracer(py::module_& m) {
       py::arg("path"),
       "Writes the streaklines now (world positions) as a streak file, atomically.");
   t.def("cancel", &MantaflowTracer::cancel, "Thread-safe: a running advance_frame() returns 0.");
+  t.def_property(
+      "emitting", [](const MantaflowTracer& x) { return x.tracer().emitting(); },
+      &MantaflowTracer::setEmitting,
+      "False pauses emission (smoke_surfaces §3.2, Figure 10): the emission instants reached "
+      "while paused add no particles, the others keep moving. Default True.");
   t.def_property_readonly("source_count",
                           [](const MantaflowTracer& x) { return x.tracer().sourceCount(); });
   t.def_property_readonly("particles_per_source",

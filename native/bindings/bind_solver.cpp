@@ -135,6 +135,12 @@ void field(py::class_<SmokeParams>& c, const char* name, T SmokeParams::*member,
 }
 
 void bindParams(py::module_& m) {
+  py::enum_<Trace>(m, "Trace",
+                   "Back-trace of semi-Lagrangian advection: MIDPOINT (explicit midpoint rule, "
+                   "second order) or EULER (one step with the velocity at the sample, first "
+                   "order, no interpolation: Mantaflow's default).")
+      .value("MIDPOINT", Trace::Midpoint)
+      .value("EULER", Trace::Euler);
   py::class_<SmokeParams> c(m, "SmokeParams",
                             "Every setting of the smoke/fire solver (Stam 1999; Fedkiw 2001; "
                             "graph_fire_synthesis eqs. 1-5). Units: metres, seconds.");
@@ -182,6 +188,8 @@ void bindParams(py::module_& m) {
         "Advection.SEMI_LAGRANGIAN, Advection.BFECC or Advection.MACCORMACK.");
   field(c, "interpolation", &SmokeParams::interpolation,
         "Interpolation.LINEAR or Interpolation.MONOTONIC_CUBIC (Fedkiw 2001 eq. 12-13).");
+  field(c, "trace", &SmokeParams::trace,
+        "Trace.MIDPOINT (RK2, the default) or Trace.EULER (first order, grid-point velocity).");
   field(c, "conserve_mass", &SmokeParams::conserveMass,
         "Restore the total smoke after each advection, less what left through open sides.");
   c.def_property(

@@ -253,7 +253,8 @@ void bindTracer(py::module_& m) {
       "Streaklines (smoke_surfaces §3.2): particles emitted from point sources every emission "
       "period and advected by the solver's velocity with the midpoint rule (second order in "
       "time). After S steps each source holds floor(S / emission_period) + 1 particles, the "
-      "youngest at the source. Particles carried through an open side stay frozen on it "
+      "youngest at the source, unless emission was paused (emitting = False, Figure 10). "
+      "Particles carried through an open side go on with the velocity they left with "
       "(outside=True), so every streakline keeps the same count.");
   c.def(py::init([](const SmokeParams& p, int emissionPeriod, const py::object& interpolation) {
           StreakParams s;
@@ -300,6 +301,12 @@ void bindTracer(py::module_& m) {
         "The streaklines now: dict(counts (S,) int32, positions (M, 3) float32, density (M,) "
         "float32, groups (S,) int32, outside (M,) bool); source s owns counts[s] particles from "
         "sum(counts[:s]), oldest first.");
+  c.def_property(
+      "emitting", &StreakTracer::emitting, &StreakTracer::setEmitting,
+      "False pauses emission (smoke_surfaces §3.2, Figure 10: \"particle emission was turned "
+      "off\"): the emission instants reached while paused add no particles, so the streaklines "
+      "show a gap; particles already emitted keep moving. Per tracer, so every streakline keeps "
+      "the same count. Saved in checkpoints. Default True.");
   c.def("cancel", &StreakTracer::cancel,
         "Thread-safe: a running advance_frame_with_tracers() returns False before its next step.");
   c.def(
@@ -311,7 +318,7 @@ void bindTracer(py::module_& m) {
       },
       py::arg("path"), py::arg("frame"),
       "Writes a checkpoint (point sources, particles, density, outside flags, exit velocities, "
-      "emission count, steps and settings) labelled with `frame`, atomically. RuntimeError "
+      "emission count, steps, the emitting switch and settings) labelled with `frame`, atomically. RuntimeError "
       "naming the path if it cannot be written.");
   c.def(
       "load_state",
@@ -326,7 +333,8 @@ void bindTracer(py::module_& m) {
       "domain or boundaries), leaving the tracer unchanged.");
   c.def_property_readonly("source_count", &StreakTracer::sourceCount, "Number of point sources.");
   c.def_property_readonly("particles_per_source", &StreakTracer::particlesPerSource,
-                          "floor(steps / emission_period) + 1.");
+                          "floor(steps / emission_period) + 1 less the emission instants "
+                          "skipped while paused.");
   c.def_property_readonly("steps", &StreakTracer::steps, "Steps seen so far.");
   c.def_property_readonly("emission_period",
                           [](const StreakTracer& t) { return t.params().emissionPeriod; },

@@ -1,5 +1,7 @@
 #include "core/sampling.h"
 
+#include "core/sample_points.h"
+
 #include <cmath>
 
 #if defined(__SSE2__)
@@ -10,13 +12,7 @@ namespace plume {
 namespace {
 
 /// Integer cell and fraction of a coordinate clamped into [0, n-1].
-inline void split(float x, int n, int& i, float& t) {
-  const float hi = float(n - 1);
-  x = x < 0.f ? 0.f : (x > hi ? hi : x);
-  i = int(x);
-  if (i >= n - 1) i = n > 1 ? n - 2 : 0;
-  t = x - float(i);
-}
+inline void split(float x, int n, int& i, float& t) { splitCoordinate(x, n, i, t); }
 
 /// Cell and fractions of p in g's index space.
 struct Split {
@@ -175,37 +171,30 @@ __attribute__((target("avx2"))) __m128 stencilXYAvx2(const float* base, std::ptr
   return cubic1D(ys[0], ys[1], ys[2], ys[3], _mm_set1_ps(ty));
 }
 
-/// The stencils of sampleMonotonicCubic4() in one AVX2 function (no call per sample): x passes
-/// as in stencilXYAvx2(), the y cubics of two samples in one 8-lane register, the z cubics of
-/// all four in one 4-lane register. Every lane sees the operations of the SSE form, in the same
-/// order, so the values are bit-identical. Stencils that leave the grid give lane 0 and are
-/// reported in `inside` for the caller to redo.
-__attribute__((target("avx2"))) void cubic4Avx2(const ScalarGrid& g, const glm::vec3* p,
-                                                float* out, bool* inside) {
-  const glm::ivec3 n = g.size();
+/// The stencils of four split points (SamplePoints layout: index with kNearSide, fractions) in
+/// one AVX2 function (no call per sample): x passes as in stencilXYAvx2(), the y cubics of two
+/// samples in one 8-lane register, the z cubics of all four in one 4-lane register. Every lane
+/// sees the operations of the SSE form, in the same order, so the values are bit-identical.
+/// Stencils that leave the grid (kNearSide) give lane 0 for the caller to redo.
+__attribute__((target("avx2"))) void cubic4Avx2(const ScalarGrid& g, const std::uint32_t* index,
+                                                const float* tx, const float* ty,
+                                                const float* tz, float* out) {
   const std::ptrdiff_t sy = g.strideY(), sz = g.strideZ();
   __m128 zs[4];
-  float tz[4];
   for (int m = 0; m < 4; m += 2) {
     __m128 ys[2][4];
-    float ty[2];
     for (int h = 0; h < 2; ++h) {
-      int i, j, k;
-      float tx;
-      split(p[m + h].x, n.x, i, tx);
-      split(p[m + h].y, n.y, j, ty[h]);
-      split(p[m + h].z, n.z, k, tz[m + h]);
-      inside[m + h] = i >= 1 && j >= 1 && k >= 1 && i + 2 < n.x && j + 2 < n.y && k + 2 < n.z;
-      if (inside[m + h]) {
-        stencilXAvx2(g.data() + g.index(i - 1, j - 1, k - 1), sy, sz, tx, ys[h]);
+      if (!(index[m + h] & SamplePoints::kNearSide)) {
+        stencilXAvx2(g.data() + std::ptrdiff_t(index[m + h]) - 1 - sy - sz, sy, sz, tx[m + h],
+                     ys[h]);
       } else {
         for (int b = 0; b < 4; ++b) ys[h][b] = _mm_setzero_ps();
       }
     }
     __m256 y[4];
     for (int b = 0; b < 4; ++b) y[b] = _mm256_insertf128_ps(_mm256_castps128_ps256(ys[0][b]), ys[1][b], 1);
-    const __m256 t = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_set1_ps(ty[0])),
-                                          _mm_set1_ps(ty[1]), 1);
+    const __m256 t = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_set1_ps(ty[m])),
+                                          _mm_set1_ps(ty[m + 1]), 1);
     const __m256 z = cubic1D(y[0], y[1], y[2], y[3], t);
     zs[m] = _mm256_castps256_ps128(z);
     zs[m + 1] = _mm256_extractf128_ps(z, 1);
@@ -215,11 +204,7 @@ __attribute__((target("avx2"))) void cubic4Avx2(const ScalarGrid& g, const glm::
 }
 
 /// Chosen once per process: AVX2 where the CPU has it (same results, fewer instructions).
-bool detectAvx2() {
-  __builtin_cpu_init();  // may run before libgcc's own constructor
-  return __builtin_cpu_supports("avx2");
-}
-const bool kHasAvx2 = detectAvx2();
+const bool kHasAvx2 = hasAvx2();
 
 #endif
 
@@ -306,36 +291,68 @@ float sampleMonotonicCubic(const ScalarGrid& g, glm::vec3 p) {
   return stencilCubic(block, 4, 16, s.tx, s.ty, s.tz);
 }
 
-void sampleMonotonicCubic4(const ScalarGrid& g, const glm::vec3* p, float* out) {
+namespace {
+
+/// Monotonic cubic samples of four split points (SamplePoints layout) into out[0..3], lane 0
+/// for the points flagged kNearSide (the caller redoes those from their positions).
+void cubic4Split(const ScalarGrid& g, const std::uint32_t* index, const float* tx,
+                 const float* ty, const float* tz, float* out) {
 #if defined(PLUME_AVX2_DISPATCH)
   if (kHasAvx2) {
-    bool inside[4];
-    cubic4Avx2(g, p, out, inside);
-    for (int m = 0; m < 4; ++m)
-      if (!inside[m]) out[m] = sampleMonotonicCubic(g, p[m]);  // near the sides
+    cubic4Avx2(g, index, tx, ty, tz, out);
     return;
   }
 #endif
 #if defined(__SSE2__)
   // x and y per sample, then the four z cubics in one register (lane = sample).
   __m128 zs[4];
-  float tz[4];
-  bool inside[4];
-  for (int m = 0; m < 4; ++m) {
-    const Split s = splitPoint(g, p[m]);
-    inside[m] = stencilInside(g, s, -1, 2);
-    tz[m] = s.tz;
-    zs[m] = inside[m] ? stencilXYBest(g.data() + g.index(s.i - 1, s.j - 1, s.k - 1), g.strideY(),
-                                      g.strideZ(), s.tx, s.ty)
-                      : _mm_setzero_ps();
-  }
+  for (int m = 0; m < 4; ++m)
+    zs[m] = index[m] & SamplePoints::kNearSide
+                ? _mm_setzero_ps()
+                : stencilXYBest(g.data() + std::ptrdiff_t(index[m]) - 1 - g.strideY() - g.strideZ(),
+                                g.strideY(), g.strideZ(), tx[m], ty[m]);
   _MM_TRANSPOSE4_PS(zs[0], zs[1], zs[2], zs[3]);  // zs[c] now holds lane m
   _mm_storeu_ps(out, cubic1D(zs[0], zs[1], zs[2], zs[3], _mm_loadu_ps(tz)));
-  for (int m = 0; m < 4; ++m)
-    if (!inside[m]) out[m] = sampleMonotonicCubic(g, p[m]);  // near the sides
 #else
-  for (int m = 0; m < 4; ++m) out[m] = sampleMonotonicCubic(g, p[m]);
+  for (int m = 0; m < 4; ++m) {
+    const std::ptrdiff_t c = std::ptrdiff_t(index[m]) - 1 - g.strideY() - g.strideZ();
+    out[m] = index[m] & SamplePoints::kNearSide
+                 ? 0.f
+                 : stencilCubic(g.data() + c, g.strideY(), g.strideZ(), tx[m], ty[m], tz[m]);
+  }
 #endif
+}
+
+}  // namespace
+
+void sampleMonotonicCubic4(const ScalarGrid& g, const glm::vec3* p, float* out) {
+  // Split the four points as SamplePoints::set() does, then the shared kernel.
+  std::uint32_t index[4];
+  float t[3][4];
+  for (int m = 0; m < 4; ++m) {
+    const Split s = splitPoint(g, p[m]);
+    index[m] = std::uint32_t(g.index(s.i, s.j, s.k)) |
+               (stencilInside(g, s, -1, 2) ? 0u : SamplePoints::kNearSide);
+    t[0][m] = s.tx;
+    t[1][m] = s.ty;
+    t[2][m] = s.tz;
+  }
+  cubic4Split(g, index, t[0], t[1], t[2], out);
+  for (int m = 0; m < 4; ++m)
+    if (index[m] & SamplePoints::kNearSide) out[m] = sampleMonotonicCubic(g, p[m]);  // near the sides
+}
+
+void sampleMonotonicCubic(const ScalarGrid& g, const SamplePoints& points, std::size_t first,
+                          int count, float* out) {
+  const std::uint32_t* index = points.index() + first;
+  int m = 0;
+  for (; m + 4 <= count; m += 4)
+    cubic4Split(g, index + m, points.tx() + first + m, points.ty() + first + m,
+                points.tz() + first + m, out + m);
+  for (int r = 0; r < m; ++r)
+    if (index[r] & SamplePoints::kNearSide)
+      out[r] = sampleMonotonicCubic(g, points.position(first + std::size_t(r)));  // near the sides
+  for (; m < count; ++m) out[m] = sampleMonotonicCubic(g, points.position(first + std::size_t(m)));
 }
 
 void sampleRange(const ScalarGrid& g, glm::vec3 p, float& lo, float& hi) {

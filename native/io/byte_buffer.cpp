@@ -57,12 +57,21 @@ void ByteReader::floats(float* out, std::size_t n) {
 }
 
 void ByteReader::header(const char* magic, std::size_t magicSize, std::uint32_t version) {
+  header(magic, magicSize, version, version);
+}
+
+std::uint32_t ByteReader::header(const char* magic, std::size_t magicSize, std::uint32_t oldest,
+                                 std::uint32_t newest) {
   if (string(magicSize) != std::string(magic, magicSize))
     throw std::runtime_error(mKind + " '" + mPath + "' is not a Plume " + mKind + " (bad magic)");
   const auto found = integer<std::uint32_t>();
-  if (found != version)
+  if (found < oldest || found > newest)
     throw std::runtime_error(mKind + " '" + mPath + "' has version " + std::to_string(found) +
-                             "; this build reads version " + std::to_string(version));
+                             "; this build reads version " +
+                             (oldest == newest ? std::to_string(newest)
+                                               : std::to_string(oldest) + "-" +
+                                                     std::to_string(newest)));
+  return found;
 }
 
 bool ByteReader::checksumMatches() const {
@@ -74,12 +83,19 @@ bool ByteReader::checksumMatches() const {
 
 void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,
                      const std::string& kind) {
+  writeFileAtomic(path, kind, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  });
+}
+
+void writeFileAtomic(const std::string& path, const std::string& kind,
+                     const std::function<void(std::ostream&)>& write) {
   const std::string tmp = path + ".tmp";
   bool ok = false;
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (out) {
-      out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+      write(out);
       out.flush();
       ok = bool(out);
       out.close();

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <cstring>
+#include <functional>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -66,6 +68,10 @@ class ByteReader {
   /// Throws std::runtime_error "<kind> '<path>' is not a Plume <kind> (bad magic)" or "... has
   /// version N; this build reads version M".
   void header(const char* magic, std::size_t magicSize, std::uint32_t version);
+  /// Same, accepting any version in [oldest, newest]; returns the version found ("... has
+  /// version N; this build reads version oldest-newest" otherwise).
+  std::uint32_t header(const char* magic, std::size_t magicSize, std::uint32_t oldest,
+                       std::uint32_t newest);
   /// Whether the whole buffer ends with the u64 FNV-1a 64 checksum of the bytes before it.
   bool checksumMatches() const;
   void bytes(void* out, std::size_t n) {
@@ -87,6 +93,11 @@ class ByteReader {
 /// "<kind> '<path>' cannot be written ..." on failure, leaving no temporary file behind.
 void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,
                      const std::string& kind);
+
+/// The same for a file written piece by piece: write(out) writes the content to the binary
+/// stream `out` (large files need no copy in memory).
+void writeFileAtomic(const std::string& path, const std::string& kind,
+                     const std::function<void(std::ostream&)>& write);
 
 /// The whole file at `path`, after checking that its size is between minSize and maxSize bytes.
 /// Throws std::runtime_error "<kind> '<path>' ..." when it cannot be opened or read, or when its

@@ -1,14 +1,16 @@
 /// \file tracer_state_file.cpp
 /// Tracer checkpoint. Layout (little-endian):
-///   "PLUMETRACE" | u32 version = 1 | i32 frame
+///   "PLUMETRACE" | u32 version = 2 | i32 frame
 ///   | i32 emission period | u32 interpolation | i32 nx, ny, nz | f32 cell size | f32 origin[3]
 ///   | u8 boundaries[6] | i64 steps | i32 emissions | u64 source count S | u64 particle count M
+///   | i64 step of the youngest emission | u8 emitting (0/1)   (version 2 only: Figure 10's pause)
 ///   | per source: f32 position[3], i32 group, f32 velocity[3]
 ///   | f32 positions[3 M] | f32 density[M] | u8 outside[M] | f32 exit velocities[3 M]
 ///   | u64 FNV-1a 64 of every byte before it,
 /// particles emission-major as in StreakTracerState. Reading checks the magic and version, the
 /// checksum, the settings against the tracer's, then the exact size the counts announce; only
 /// then are the arrays allocated and parsed, and the tracer is touched only once all is read.
+/// Version 1 files (written before emission could pause) are read as never paused.
 
 #include "io/tracer_state_file.h"
 
@@ -22,8 +24,12 @@ namespace plume {
 namespace {
 
 constexpr char kMagic[10] = {'P', 'L', 'U', 'M', 'E', 'T', 'R', 'A', 'C', 'E'};
-constexpr std::uint32_t kVersion = 1;
-constexpr std::size_t kHeaderSize = sizeof(kMagic) + 4 + 4 + 4 + 4 + 12 + 4 + 12 + 6 + 8 + 4 + 8 + 8;
+constexpr std::uint32_t kVersion = 2;
+/// Oldest version read: version 1 lacks the pause fields (emission never paused then).
+constexpr std::uint32_t kOldestVersion = 1;
+constexpr std::size_t kHeaderSizeV1 = sizeof(kMagic) + 4 + 4 + 4 + 4 + 12 + 4 + 12 + 6 + 8 + 4 + 8 + 8;
+/// Version 2 adds the step of the youngest emission (i64) and the emitting flag (u8).
+constexpr std::size_t kHeaderSize = kHeaderSizeV1 + 8 + 1;
 constexpr std::size_t kChecksumSize = 8;
 /// Bytes per source (position, group, velocity) and per particle (position, density, outside
 /// flag, exit velocity).
@@ -101,6 +107,8 @@ void writeTracerState(const std::string& path, const StreakTracer& tracer, int f
   w.integer<std::int32_t>(s.emissions);
   w.integer<std::uint64_t>(sources);
   w.integer<std::uint64_t>(particles);
+  w.integer<std::int64_t>(s.lastEmissionStep);
+  w.integer<std::uint8_t>(s.emitting ? 1 : 0);
   for (const PointSource& p : s.sources) {
     w.floats(&p.position.x, 3);
     w.integer<std::int32_t>(p.group);
@@ -116,9 +124,10 @@ void writeTracerState(const std::string& path, const StreakTracer& tracer, int f
 
 int readTracerState(const std::string& path, StreakTracer& tracer) {
   const std::vector<unsigned char> buf =
-      readFileChecked(path, kHeaderSize + kChecksumSize, kMaxFileSize, kKind);
+      readFileChecked(path, kHeaderSizeV1 + kChecksumSize, kMaxFileSize, kKind);
   ByteReader r(buf.data(), buf.size(), kKind, path);
-  r.header(kMagic, sizeof(kMagic), kVersion);
+  const std::uint32_t version = r.header(kMagic, sizeof(kMagic), kOldestVersion, kVersion);
+  const std::size_t headerSize = version == 1 ? kHeaderSizeV1 : kHeaderSize;
   if (!r.checksumMatches()) fail(path, "is corrupt (checksum mismatch)");
   const int frame = r.integer<std::int32_t>();
   checkSettings(r, tracer, path);
@@ -131,10 +140,18 @@ int readTracerState(const std::string& path, StreakTracer& tracer) {
   // Both counts must fit in the file before anything is allocated from them (and each bound
   // keeps the size sum below from overflowing).
   if (sources > buf.size() / kPerSource || particles > buf.size() / kPerParticle ||
-      kHeaderSize + kPerSource * sources + kPerParticle * particles + kChecksumSize != buf.size())
+      headerSize + kPerSource * sources + kPerParticle * particles + kChecksumSize != buf.size())
     fail(path, "has " + std::to_string(buf.size()) + " bytes; " + std::to_string(sources) +
                    " sources and " + std::to_string(particles) +
                    " particles do not fill it exactly (truncated or corrupt)");
+  if (version == 1) {  // every instant emitted: the youngest row is the last instant's
+    s.lastEmissionStep = s.steps / tracer.params().emissionPeriod * tracer.params().emissionPeriod;
+  } else {
+    s.lastEmissionStep = r.integer<std::int64_t>();
+    const auto emitting = r.integer<std::uint8_t>();
+    if (emitting > 1) fail(path, "is corrupt (emitting flag " + std::to_string(emitting) + ")");
+    s.emitting = emitting == 1;
+  }
   s.sources.resize(std::size_t(sources));
   for (PointSource& p : s.sources) {
     p.position = readVec3(r);

@@ -10,19 +10,21 @@
 namespace plume {
 
 /// Buoyancy f = -g (α ρ + β (T - T_amb)) added to every face between two fluid cells; ρ and T
-/// are averaged from the two cells the face separates.
+/// are averaged from the two cells the face separates. cellTypes == nullptr: every cell is
+/// fluid (so are they in the functions below).
 void addBuoyancy(MacGrid3& velocity, const ScalarGrid& density, const ScalarGrid& temperature,
-                 const FlagGrid& cellTypes, const SmokeParams& params, float dt);
+                 const FlagGrid* cellTypes, const SmokeParams& params, float dt);
 
 /// Wind: u += dt k_w (u_wind - u) on fluid faces, with u_wind the constant params.wind or the
 /// per-cell `field` (averaged to faces) when it is not empty.
-void addWind(MacGrid3& velocity, const VectorGrid& field, const FlagGrid& cellTypes,
+void addWind(MacGrid3& velocity, const VectorGrid& field, const FlagGrid* cellTypes,
              const SmokeParams& params, float dt);
 
 /// Vorticity confinement: ω = ∇ × u, N = ∇|ω| / |∇|ω||, f = ε Δx (N × ω) (Fedkiw 2001 eq. 11),
-/// computed at cell centres and averaged to faces. `omega` and `force` are scratch grids sized
-/// like the cells.
-void addVorticityConfinement(MacGrid3& velocity, const FlagGrid& cellTypes, float epsilon,
-                             float cellSize, float dt, VectorGrid& omega, VectorGrid& force);
+/// computed at cell centres and averaged to faces. `omega`, `force` and `magnitude` (|ω|) are
+/// scratch grids sized like the cells.
+void addVorticityConfinement(MacGrid3& velocity, const FlagGrid* cellTypes, float epsilon,
+                             float cellSize, float dt, VectorGrid& omega, VectorGrid& force,
+                             ScalarGrid& magnitude);
 
 }  // namespace plume

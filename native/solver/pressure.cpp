@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/cpu_features.h"
 #include "core/parallel.h"
 #include "solver/band_solver.h"
 #include "solver/multigrid_level.h"
@@ -60,8 +61,9 @@ void forRows(glm::ivec3 n, const RowFn& fn) {
 }
 
 /// Σ a_i b_i (b = nullptr: Σ a_i): float products summed in double in four fixed lanes i mod 4
-/// (deterministic; vectorized).
-double dotRow(const float* a, const float* b, int n) {
+/// (deterministic; vectorized). The row kernels below are PLUME_AVX2_CLONES: the solve is
+/// bound by these loops, AVX2 runs them about 20% faster, with the same values.
+PLUME_AVX2_CLONES double dotRow(const float* a, const float* b, int n) {
   double s[4] = {0, 0, 0, 0};
   int i = 0;
   if (b)
@@ -88,26 +90,28 @@ inline float keepIf(float mask, float v) {
 /// Sum of the 6 neighbours of every cell in a padded row.
 #define PLUME_NEIGHBOURS(v, i) (v[i - 1] + v[i + 1] + v[i - sy] + v[i + sy] + v[i - sz] + v[i + sz])
 
+/// smoothFromZero() on the row at padded offset o.
+PLUME_AVX2_CLONES void smoothFromZeroRow(Level& L, std::size_t o) {
+  const std::ptrdiff_t sy = L.sy, sz = L.sz;
+  const int nx = L.n.x;
+  const float* __restrict b = L.b.data() + o;
+  const float* __restrict w = L.wInv.data() + o;
+  float* __restrict y = L.x.data() + o;
+  for (int i = 0; i < nx; ++i) {
+    const float s = w[i - 1] * b[i - 1] + w[i + 1] * b[i + 1] + w[i - sy] * b[i - sy] +
+                    w[i + sy] * b[i + sy] + w[i - sz] * b[i - sz] + w[i + sz] * b[i + sz];
+    y[i] = w[i] * ((2.f - kOmega) * b[i] + s);
+  }
+}
+
 /// The first two Jacobi sweeps from x = 0, fused: x1 = W b, x2 = (1-ω) x1 + W (b + N x1)
 /// = W ((2-ω) b + N (W b)), where N sums the neighbours.
 void smoothFromZero(Level& L) {
-  const std::ptrdiff_t sy = L.sy, sz = L.sz;
-  const int nx = L.n.x;
-  forRows(L.n, [&](int j, int k) {
-    const std::size_t o = L.at(0, j, k);
-    const float* __restrict b = L.b.data() + o;
-    const float* __restrict w = L.wInv.data() + o;
-    float* __restrict y = L.x.data() + o;
-    for (int i = 0; i < nx; ++i) {
-      const float s = w[i - 1] * b[i - 1] + w[i + 1] * b[i + 1] + w[i - sy] * b[i - sy] +
-                      w[i + sy] * b[i + sy] + w[i - sz] * b[i - sz] + w[i + sz] * b[i + sz];
-      y[i] = w[i] * ((2.f - kOmega) * b[i] + s);
-    }
-  });
+  forRows(L.n, [&](int j, int k) { smoothFromZeroRow(L, L.at(0, j, k)); });
 }
 
 /// One damped Jacobi sweep on a row, y = x + W (b - A x) = (1-ω) x + W (b + N x).
-void smoothRow(const Level& L, const float* __restrict x, float* __restrict y, std::size_t o) {
+PLUME_AVX2_CLONES void smoothRow(const Level& L, const float* __restrict x, float* __restrict y, std::size_t o) {
   const std::ptrdiff_t sy = L.sy, sz = L.sz;
   const float* __restrict b = L.b.data() + o;
   const float* __restrict w = L.wInv.data() + o;
@@ -124,7 +128,7 @@ void smooth(Level& L) {
 }
 
 /// s = b - A x on one row (0 on solid cells).
-void residualRow(const Level& L, std::size_t o, float* __restrict s) {
+PLUME_AVX2_CLONES void residualRow(const Level& L, std::size_t o, float* __restrict s) {
   const std::ptrdiff_t sy = L.sy, sz = L.sz;
   const float* __restrict x = L.x.data() + o;
   const float* __restrict b = L.b.data() + o;
@@ -134,7 +138,7 @@ void residualRow(const Level& L, std::size_t o, float* __restrict s) {
 }
 
 /// c_I += ½ (s_2I + s_2I+1): a residual row restricted along x.
-void restrictPairs(int n, const float* __restrict s, float* __restrict c) {
+PLUME_AVX2_CLONES void restrictPairs(int n, const float* __restrict s, float* __restrict c) {
   for (int ic = 0; ic < n; ++ic) c[ic] += kRestrict * (s[2 * ic] + s[2 * ic + 1]);
 }
 
@@ -153,7 +157,7 @@ void restrictResidual(Level& F, Level& C) {
 }
 
 /// x_2I += e_I, x_2I+1 += e_I on fluid cells: a coarse row prolonged along x.
-void prolongPairs(int n, const float* __restrict e, const float* __restrict d,
+PLUME_AVX2_CLONES void prolongPairs(int n, const float* __restrict e, const float* __restrict d,
                   float* __restrict x) {
   for (int ic = 0; ic < n / 2; ++ic) {
     x[2 * ic] += keepIf(d[2 * ic], e[ic]);
@@ -168,6 +172,36 @@ void prolongAdd(Level& F, const Level& C) {
     const std::size_t o = F.at(0, j, k);
     prolongPairs(F.n.x, C.x.data() + C.at(0, j >> 1, k >> 1), F.diag.data() + o, F.x.data() + o);
   });
+}
+
+/// q = A d on a padded row (0 on solid cells).
+PLUME_AVX2_CLONES void applyPaddedRow(int nx, std::ptrdiff_t sy, std::ptrdiff_t sz,
+                                      const float* __restrict dd, const float* __restrict dg,
+                                      float* __restrict qq) {
+  for (int i = 0; i < nx; ++i) qq[i] = keepIf(dg[i], dg[i] * dd[i] - PLUME_NEIGHBOURS(dd, i));
+}
+
+/// CG's step on a row: p += α d (in double), r -= α q (q less its mean on fluid cells when the
+/// system is singular).
+PLUME_AVX2_CLONES void stepRow(int nx, double alpha, float alphaF, bool singular, float meanQ,
+                               const float* __restrict dd, const float* __restrict qq,
+                               const float* __restrict dg, float* __restrict rp,
+                               double* __restrict pp) {
+  for (int i = 0; i < nx; ++i) pp[i] += alpha * dd[i];
+  if (singular)
+    for (int i = 0; i < nx; ++i) rp[i] -= keepIf(dg[i], alphaF * (qq[i] - meanQ));
+  else
+    for (int i = 0; i < nx; ++i) rp[i] -= alphaF * qq[i];
+}
+
+/// d = z' + β d on a row (z' = z - mean on fluid cells when the system is singular).
+PLUME_AVX2_CLONES void directionRow(int nx, float beta, bool singular, float meanZ,
+                                    const float* __restrict z, const float* __restrict dg,
+                                    float* __restrict dd) {
+  if (singular)
+    for (int i = 0; i < nx; ++i) dd[i] = keepIf(dg[i], z[i] - meanZ) + beta * dd[i];
+  else
+    for (int i = 0; i < nx; ++i) dd[i] = z[i] + beta * dd[i];
 }
 
 }  // namespace
@@ -269,13 +303,7 @@ struct PressureSolver::Impl {
     const int nx = size.x;
     forRows(size, [&](int j, int k) {
       const std::size_t o = L0.at(0, j, k);
-      const float* __restrict z = L0.x.data() + o;
-      const float* __restrict dg = L0.diag.data() + o;
-      float* __restrict dd = d.data() + o;
-      if (singular)
-        for (int i = 0; i < nx; ++i) dd[i] = keepIf(dg[i], z[i] - meanZ) + bt * dd[i];
-      else
-        for (int i = 0; i < nx; ++i) dd[i] = z[i] + bt * dd[i];
+      directionRow(nx, bt, singular, meanZ, L0.x.data() + o, L0.diag.data() + o, d.data() + o);
     });
   }
 
@@ -348,11 +376,9 @@ struct PressureSolver::Impl {
         double dq = 0.0, qs = 0.0;
         for (int j = 0; j < size.y; ++j) {
           const std::size_t o = L0.at(0, j, k);
-          const float* __restrict dd = d.data() + o;
-          const float* __restrict dg = L0.diag.data() + o;
-          float* __restrict qq = q + o;
-          for (int i = 0; i < nx; ++i)
-            qq[i] = keepIf(dg[i], dg[i] * dd[i] - PLUME_NEIGHBOURS(dd, i));
+          const float* dd = d.data() + o;
+          float* qq = q + o;
+          applyPaddedRow(nx, sy, sz, dd, L0.diag.data() + o, qq);
           dq += dotRow(dd, qq, nx);
           if (singular) qs += dotRow(qq, nullptr, nx);
         }
@@ -370,16 +396,9 @@ struct PressureSolver::Impl {
         double s = 0.0;
         for (int j = 0; j < size.y; ++j) {
           const std::size_t o = L0.at(0, j, k);
-          const float* __restrict dd = d.data() + o;
-          const float* __restrict qq = q + o;
-          const float* __restrict dg = L0.diag.data() + o;
-          float* __restrict rp = L0.b.data() + o;
-          double* __restrict pp = pd.data() + urow(j, k);
-          for (int i = 0; i < nx; ++i) pp[i] += alpha * dd[i];
-          if (singular)
-            for (int i = 0; i < nx; ++i) rp[i] -= keepIf(dg[i], alphaF * (qq[i] - meanQ));
-          else
-            for (int i = 0; i < nx; ++i) rp[i] -= alphaF * qq[i];
+          float* rp = L0.b.data() + o;
+          stepRow(nx, alpha, alphaF, singular, meanQ, d.data() + o, q + o, L0.diag.data() + o, rp,
+                  pd.data() + urow(j, k));
           s += dotRow(rp, rp, nx);
         }
         put(k, s);

@@ -7,6 +7,31 @@
 #include <cmath>
 
 namespace plume {
+namespace {
+
+/// Calls body(f) for the linear index f of every face of a face grid of size fs whose index
+/// along axis a is `layer` (the faces of one side of the domain), slices in parallel.
+template <typename Body>
+void forEachFaceOfLayer(glm::ivec3 fs, int a, int layer, const Body& body) {
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  parallelFor(0, fs[c], [&](int y) {
+    for (int x = 0; x < fs[b]; ++x) {
+      glm::ivec3 f;
+      f[a] = layer;
+      f[b] = x;
+      f[c] = y;
+      body(std::size_t(f.x) + std::size_t(fs.x) * (std::size_t(f.y) + std::size_t(fs.y) * f.z));
+    }
+  });
+}
+
+/// (i, j, k) of linear index f in a grid of size fs.
+inline glm::ivec3 faceCoords(glm::ivec3 fs, std::size_t f) {
+  const std::size_t nx = std::size_t(fs.x), ny = std::size_t(fs.y);
+  return {int(f % nx), int((f / nx) % ny), int(f / (nx * ny))};
+}
+
+}  // namespace
 
 float SmokeSolver::fluxSum(int i, int j, int k) const {
   // Δx div u: net outflow through the six faces of cell (i,j,k).
@@ -17,6 +42,19 @@ float SmokeSolver::fluxSum(int i, int j, int k) const {
 
 void SmokeSolver::enforceBoundaryVelocities() {
   const glm::ivec3 n = mParams.resolution;
+  if (!mHasSolids) {
+    // No obstacle: only the faces on closed sides change (to 0), the rest stays as it is.
+    for (int a = 0; a < 3; ++a) {
+      ScalarGrid& comp = mVelocity.component(a);
+      const glm::ivec3 fs = comp.size();
+      for (int side = 0; side < 2; ++side) {
+        if (mParams.boundaries[2 * a + side] != Boundary::Closed) continue;
+        const int layer = side == 0 ? 0 : n[a];
+        forEachFaceOfLayer(fs, a, layer, [&](std::size_t f) { comp[f] = 0.f; });
+      }
+    }
+    return;
+  }
   const bool noSlip = [&] {
     for (const Obstacle& o : mObstacles)
       if (o.slip == Slip::NoSlip) return true;
@@ -74,6 +112,44 @@ void SmokeSolver::applyPressureGradient() {
   // u -= Δt/(ρ Δx) ∇p; the solve works with p̂ = p Δt/(ρ Δx) in velocity units. Air beyond an
   // open side has p̂ = 0; faces on walls or obstacles keep their prescribed velocity.
   const glm::ivec3 n = mParams.resolution;
+  if (!mHasSolids) {
+    // No obstacle: every interior face takes pHi - pLo, row by row (vectorized); the faces of
+    // open sides take p̂ inside against 0 outside. The same subtractions as below.
+    const std::ptrdiff_t strides[3] = {1, mPressure.strideY(), mPressure.strideZ()};
+    for (int a = 0; a < 3; ++a) {
+      ScalarGrid& comp = mVelocity.component(a);
+      const glm::ivec3 fs = comp.size();
+      const std::ptrdiff_t s = strides[a];
+      parallelFor(0, fs.z, [&](int k) {
+        for (int j = 0; j < fs.y; ++j) {
+          // Cells (i, j, k) of the row; face (i, j, k) lies between cell (i,j,k) - e_a and it.
+          float* __restrict u = &comp(0, j, k);
+          const glm::ivec3 c(0, j, k);
+          if (a == 0) {
+            const float* __restrict p = &mPressure(0, j, k);
+            for (int i = 1; i < n.x; ++i) u[i] -= p[i] - p[i - 1];
+            continue;
+          }
+          if (c[a] == 0 || c[a] == n[a]) continue;  // the sides, below
+          const float* __restrict hi = &mPressure(0, j, k);
+          const float* __restrict lo = hi - s;
+          for (int i = 0; i < fs.x; ++i) u[i] -= hi[i] - lo[i];
+        }
+      });
+      for (int side = 0; side < 2; ++side) {
+        if (mParams.boundaries[2 * a + side] != Boundary::Open) continue;
+        const int layer = side == 0 ? 0 : n[a];
+        forEachFaceOfLayer(fs, a, layer, [&](std::size_t f) {
+          // The cell inside: face f itself on the low side, f - e_a (in cell indices) on the high.
+          glm::ivec3 cell = faceCoords(fs, f);
+          if (side == 1) cell[a] -= 1;
+          const float pIn = mPressure(cell.x, cell.y, cell.z);
+          comp[f] -= side == 0 ? pIn - 0.f : 0.f - pIn;
+        });
+      }
+    }
+    return;
+  }
   for (int a = 0; a < 3; ++a) {
     ScalarGrid& comp = mVelocity.component(a);
     const glm::ivec3 fs = comp.size();
@@ -103,17 +179,22 @@ void SmokeSolver::project(float /*dt*/) {
   const float h = mParams.cellSize;
   const bool burning = mParams.combustion;
   // A p̂ = Δx φ - Δx div u*  (see PressureSolver for A).
+  const MacGrid3& u = mVelocity;
   parallelFor(0, n.z, [&](int k) {
-    for (int j = 0; j < n.y; ++j)
+    for (int j = 0; j < n.y; ++j) {
+      // fluxSum() along the row, the same additions in the same order (vectorized).
+      const float* __restrict ux = &u.u()(0, j, k);
+      const float *__restrict vlo = &u.v()(0, j, k), *__restrict vhi = &u.v()(0, j + 1, k);
+      const float *__restrict wlo = &u.w()(0, j, k), *__restrict whi = &u.w()(0, j, k + 1);
+      const float* __restrict phi = &mDivergenceTarget(0, j, k);
+      const std::uint8_t* __restrict type = &mCellTypes(0, j, k);
+      float* __restrict rhs = &mRhs(0, j, k);
       for (int i = 0; i < n.x; ++i) {
-        const std::size_t c = mRhs.index(i, j, k);
-        if (mCellTypes[c] != kFluid) {
-          mRhs[c] = 0.f;
-          continue;
-        }
-        const float target = burning ? h * mDivergenceTarget[c] : 0.f;
-        mRhs[c] = target - fluxSum(i, j, k);
+        const float flux = ux[i + 1] - ux[i] + vhi[i] - vlo[i] + whi[i] - wlo[i];
+        const float target = burning ? h * phi[i] : 0.f;
+        rhs[i] = type[i] != kFluid ? 0.f : target - flux;
       }
+    }
   });
   const PressureStats stats = mPressureSolver.solve(mRhs, mPressure, mParams.pressureTolerance,
                                                     mParams.maxPressureIterations);

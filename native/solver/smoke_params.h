@@ -16,6 +16,12 @@ namespace plume {
 /// (Selle et al. 2008: BFECC's accuracy with two interpolation passes instead of three).
 enum class Advection { SemiLagrangian, Bfecc, MacCormack };
 
+/// How a semi-Lagrangian step traces a sample back through the velocity field (Stam 1999 §3.2):
+/// the explicit midpoint rule (RK2, second order in time: one more velocity sample halfway), or
+/// one Euler step with the velocity at the sample itself, first order, which on the MAC grid is
+/// an exact average of 2 or 4 faces and needs no interpolation (Mantaflow's default trace).
+enum class Trace { Midpoint, Euler };
+
 /// A side of the domain is open (air: p = 0, outflow; smoke_surfaces.txt's default) or a wall.
 enum class Boundary { Open, Closed };
 
@@ -40,6 +46,7 @@ struct SmokeParams {
   // --- Advection ---
   Advection advection = Advection::Bfecc;
   Interpolation interpolation = Interpolation::MonotonicCubic;
+  Trace trace = Trace::Midpoint;  ///< back-trace order (Euler: Mantaflow's first-order trace)
   bool conserveMass = true;  ///< restore Σρ after advection (minus outflow), see mass_conservation.h
 
   // --- Forces (Fedkiw 2001 eq. 8, 9) ---

@@ -5,6 +5,7 @@
 #include "solver/forces.h"
 #include "solver/mass_conservation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -45,11 +46,15 @@ SmokeSolver::SmokeSolver(const SmokeParams& params) : mParams(params) {
   const glm::ivec3 n = mParams.resolution;
   mVelocity.resize(n);
   mVelocityTmp.resize(n);
-  for (ScalarGrid* g : {&mDensity, &mTemperature, &mFuel, &mSoot, &mFlame, &mScalarTmp,
+  // One advection result per advected scalar: ρ and T, plus F and S when burning.
+  const std::size_t advected = mParams.combustion ? 4 : 2;
+  for (std::size_t f = 0; f < advected; ++f) mScalarTmp[f].resize(n);
+  for (ScalarGrid* g : {&mDensity, &mTemperature, &mFuel, &mSoot, &mFlame,
                         &mPressure, &mRhs, &mDivergenceTarget})
     g->resize(n);
   mTemperature.fill(mParams.ambientTemperature);
   mVorticity.resize(n);
+  mVorticityMagnitude.resize(n);
   mForce.resize(n);
   mCellTypes.resize(n, kFluid);
   mCellTypesNext.resize(n, kFluid);
@@ -58,7 +63,7 @@ SmokeSolver::SmokeSolver(const SmokeParams& params) : mParams(params) {
   // Scratch for BFECC must hold the largest face grid.
   const std::size_t largest = std::max({mVelocity.u().count(), mVelocity.v().count(),
                                         mVelocity.w().count()});
-  mAdvector.reserve(largest);
+  mAdvector.reserve(largest, advected, mParams.advection);
   mPressureSolver.setup(mCellTypes, mParams.boundaries);
   mCellTypesDirty = false;
 }
@@ -106,6 +111,8 @@ void SmokeSolver::rebuildCellTypes() {
       mNoSlip[c] = o.slip == Slip::NoSlip ? 1 : 0;
       mSolidVelocity[c] = o.cells.velocity.empty() ? glm::vec3(0.f) : o.cells.velocity[n];
     }
+  mHasSolids = std::any_of(mObstacles.begin(), mObstacles.end(),
+                           [](const Obstacle& o) { return !o.cells.cells.empty(); });
   // The multigrid hierarchy is rebuilt only when the solid cells really changed (a moving
   // obstacle changes them, a still one re-added every frame does not).
   if (mCellTypesNext.values() != mCellTypes.values()) {
@@ -187,10 +194,12 @@ void SmokeSolver::applySources(float /*dt*/) {
 
 void SmokeSolver::addForces(float dt) {
   rebuildCellTypes();
-  addBuoyancy(mVelocity, mDensity, mTemperature, mCellTypes, mParams, dt);
-  addWind(mVelocity, mWindField, mCellTypes, mParams, dt);
-  addVorticityConfinement(mVelocity, mCellTypes, mParams.vorticity, mParams.cellSize, dt,
-                          mVorticity, mForce);
+  // Without solid cells the face loops run without a test per face.
+  const FlagGrid* types = mHasSolids ? &mCellTypes : nullptr;
+  addBuoyancy(mVelocity, mDensity, mTemperature, types, mParams, dt);
+  addWind(mVelocity, mWindField, types, mParams, dt);
+  addVorticityConfinement(mVelocity, types, mParams.vorticity, mParams.cellSize, dt, mVorticity,
+                          mForce, mVorticityMagnitude);
 }
 
 void SmokeSolver::advect(float dt) {
@@ -222,21 +231,28 @@ void SmokeSolver::advect(float dt) {
     }
     mask = &mMask;
   }
-  mAdvector.trace(mVelocity, mParams.resolution, kCellOffset, dt, h, scheme, mask);
+  mAdvector.trace(mVelocity, mParams.resolution, kCellOffset, dt, h, scheme, mask, mParams.trace);
+  // All scalars in one advect() call: each run's split trace is read once for all of them.
+  double targets[Advector::kMaxFields];
+  Advector::Field carried[Advector::kMaxFields];
   for (std::size_t m = 0; m < fieldCount; ++m) {
     const Field& f = scalars[m];
-    const double target =
+    targets[m] =
         f.conserve ? totalMass(*f.grid) - outflowMass(*f.grid, mVelocity, mParams.boundaries, dt, h)
                    : 0.0;
-    mAdvector.advect(*f.grid, mScalarTmp, interp, mask, f.background);
-    std::swap(f.grid->values(), mScalarTmp.values());
-    if (f.conserve) restoreMass(*f.grid, target);
+    carried[m] = {f.grid, &mScalarTmp[m], f.background};
+  }
+  mAdvector.advect(carried, fieldCount, interp, mask);
+  for (std::size_t m = 0; m < fieldCount; ++m) {
+    const Field& f = scalars[m];
+    std::swap(f.grid->values(), mScalarTmp[m].values());
+    if (f.conserve) restoreMass(*f.grid, targets[m]);
   }
   // Then each velocity component along the trace of its own faces.
   static const glm::vec3 kOffsets[3] = {kFaceOffsetU, kFaceOffsetV, kFaceOffsetW};
   for (int a = 0; a < 3; ++a) {
     const ScalarGrid& comp = mVelocity.component(a);
-    mAdvector.trace(mVelocity, comp.size(), kOffsets[a], dt, h, scheme, nullptr);
+    mAdvector.trace(mVelocity, comp.size(), kOffsets[a], dt, h, scheme, nullptr, mParams.trace);
     mAdvector.advect(comp, mVelocityTmp.component(a), interp, nullptr, 0.f);
   }
   std::swap(mVelocity, mVelocityTmp);
@@ -246,7 +262,7 @@ void SmokeSolver::advect(float dt) {
 void SmokeSolver::burn(float dt) {
   if (!mParams.combustion) return;
   burnFuel(mFuel, mSoot, mTemperature, mFlame, mDivergenceTarget, mCellTypes, mParams, dt);
-  coolAndConduct(mTemperature, mScalarTmp, mCellTypes, mParams, dt);
+  coolAndConduct(mTemperature, mScalarTmp[0], mCellTypes, mParams, dt);
 }
 
 void SmokeSolver::dissipate(float dt) {

@@ -131,9 +131,10 @@ class SmokeSolver {
   SmokeParams mParams;
   MacGrid3 mVelocity, mVelocityTmp, mVelocityTmp2;
   ScalarGrid mDensity, mTemperature, mFuel, mSoot, mFlame;
-  ScalarGrid mScalarTmp, mScalarTmp2;  ///< advection scratch
+  ScalarGrid mScalarTmp[Advector::kMaxFields];  ///< advected scalars (burn: [0] is scratch)
   ScalarGrid mPressure, mRhs, mDivergenceTarget;
   VectorGrid mVorticity, mForce, mWindField;
+  ScalarGrid mVorticityMagnitude;  ///< |ω|, scratch of vorticity confinement
   Advector mAdvector;
   BlockMask mMask, mMaskTmp;  ///< blocks of cells near smoke (advection skips the rest)
   FlagGrid mCellTypes, mCellTypesNext;
@@ -142,6 +143,7 @@ class SmokeSolver {
   std::vector<Source> mSources;
   std::vector<Obstacle> mObstacles;
   bool mCellTypesDirty = true;
+  bool mHasSolids = false;  ///< some cell is solid (else the boundary stages take a fast path)
   PressureSolver mPressureSolver;
   std::atomic<bool> mCancel{false};
   int mFrame = 0;

@@ -74,6 +74,8 @@ void expectSameState(const StreakTracer& a, const StreakTracer& b) {
   const StreakTracerState &x = a.state(), &y = b.state();
   EXPECT_EQ(x.steps, y.steps);
   EXPECT_EQ(x.emissions, y.emissions);
+  EXPECT_EQ(x.lastEmissionStep, y.lastEmissionStep);
+  EXPECT_EQ(x.emitting, y.emitting);
   ASSERT_EQ(x.sources.size(), y.sources.size());
   for (std::size_t s = 0; s < x.sources.size(); ++s) {
     EXPECT_EQ(x.sources[s].position, y.sources[s].position);
@@ -85,6 +87,14 @@ void expectSameState(const StreakTracer& a, const StreakTracer& b) {
   EXPECT_TRUE(sameBits(x.exitVelocity.data(), y.exitVelocity.data(), x.exitVelocity.size() * 12));
   EXPECT_EQ(x.density, y.density);
   EXPECT_EQ(x.outside, y.outside);
+}
+
+void expectSameSnapshot(const StreakTracer& a, const StreakTracer& b) {
+  const StreakFrame x = a.snapshot(), y = b.snapshot();
+  EXPECT_EQ(x.counts, y.counts);
+  EXPECT_TRUE(sameBits(x.positions.data(), y.positions.data(), x.positions.size() * 12));
+  EXPECT_EQ(x.density, y.density);
+  EXPECT_EQ(x.groups, y.groups);
 }
 
 fs::path scratchDir(const std::string& name) {
@@ -128,11 +138,61 @@ TEST(TracerStateFile, RestoredTracerContinuesBitForBit) {
   expectSameState(restored, saved);
   run(restored, 11, 25);
   expectSameState(restored, straight);
-  const StreakFrame a = restored.snapshot(), b = straight.snapshot();
-  EXPECT_EQ(a.counts, b.counts);
-  EXPECT_TRUE(sameBits(a.positions.data(), b.positions.data(), a.positions.size() * 12));
-  EXPECT_EQ(a.density, b.density);
-  EXPECT_EQ(a.groups, b.groups);
+  expectSameSnapshot(restored, straight);
+}
+
+TEST(TracerStateFile, PausedTracerRestoresPausedAndContinuesBitForBit) {
+  // Figure 10: emission off after step 6, back on after step 16. The checkpoint is taken at step
+  // 10, right after a skipped instant: the restored tracer must neither emit at instants 12, 14
+  // and 16 nor treat the row of instant 6 as newborn (its source velocity would move it
+  // differently).
+  const fs::path dir = scratchDir("paused");
+  StreakTracer straight = makeTracer(), saved = makeTracer();
+  for (StreakTracer* t : {&straight, &saved}) {
+    addSources(*t);
+    run(*t, 0, 6);
+    t->setEmitting(false);
+  }
+  run(straight, 6, 16);
+  run(saved, 6, 10);
+  EXPECT_EQ(saved.state().emissions, 4);  // instants 0, 2, 4, 6; 8 and 10 skipped
+  const std::string path = (dir / "tracer_state.bin").string();
+  writeTracerState(path, saved, 10);
+  StreakTracer restored = makeTracer();
+  EXPECT_TRUE(restored.emitting());
+  EXPECT_EQ(readTracerState(path, restored), 10);
+  EXPECT_FALSE(restored.emitting());
+  EXPECT_EQ(restored.state().lastEmissionStep, 6);
+  expectSameState(restored, saved);
+  run(restored, 10, 16);
+  expectSameState(restored, straight);
+  EXPECT_EQ(restored.particlesPerSource(), 4);
+  for (StreakTracer* t : {&straight, &restored}) {
+    t->setEmitting(true);
+    run(*t, 16, 25);
+  }
+  expectSameState(restored, straight);
+  EXPECT_EQ(restored.particlesPerSource(), 4 + 4);  // instants 18, 20, 22, 24
+  expectSameSnapshot(restored, straight);
+}
+
+TEST(TracerStateFile, ReadsVersionOneFilesAsNeverPaused) {
+  // A version 1 file is a version 2 file without the 9 bytes of the pause fields (after the
+  // particle count, at offset 88).
+  const fs::path dir = scratchDir("version1");
+  StreakTracer saved = makeTracer();
+  addSources(saved);
+  run(saved, 0, 11);
+  const std::string path = (dir / "tracer_state.bin").string();
+  writeTracerState(path, saved, 11);
+  std::vector<unsigned char> bytes = readBytes(path);
+  bytes.erase(bytes.begin() + 88, bytes.begin() + 88 + 9);
+  bytes[10] = 1;
+  resign(bytes);
+  writeBytes(path, bytes);
+  StreakTracer restored = makeTracer();
+  EXPECT_EQ(readTracerState(path, restored), 11);
+  expectSameState(restored, saved);  // youngest emission at step 10, emitting
 }
 
 TEST(TracerStateFile, BadFilesThrowAndLeaveTheTracerUnchanged) {
@@ -185,6 +245,10 @@ TEST(TracerStateFile, BadFilesThrowAndLeaveTheTracerUnchanged) {
   flag[bytes.size() - 8 - 12 * saved.state().positions.size() - 1] = 2;  // last outside flag
   resign(flag);
   expectRejected(flag, "bad-flag", "outside flag");
+  std::vector<unsigned char> emitting = bytes;
+  emitting[88 + 8] = 2;  // the emitting flag (offset 96) is 0 or 1
+  resign(emitting);
+  expectRejected(emitting, "bad-emitting", "emitting flag 2");
   EXPECT_THROW(readTracerState((dir / "nope.bin").string(), target), std::runtime_error);
   expectSameState(target, reference);
 
@@ -225,7 +289,8 @@ TEST(StreakTracerState, SetStateValidatesAndKeepsTheTracerOnError) {
   addSources(t);
   addSources(reference);
   StreakTracerState s = t.state();
-  s.steps = 4;  // period 2: 3 emissions expected, 1 held
+  s.steps = 4;
+  s.lastEmissionStep = 4;  // a row emitted at step 4, yet only the first row is held
   EXPECT_THROW(t.setState(s), std::invalid_argument);
   s = t.state();
   s.sources[1].position = glm::vec3(2.f);  // outside the unit domain

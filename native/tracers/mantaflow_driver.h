@@ -68,6 +68,9 @@ class MantaflowTracer {
   /// The streaklines now, positions in world space (§3.2, Figure 2).
   StreakFrame snapshot() const;
 
+  /// Pauses or resumes emission (StreakTracer::setEmitting, Figure 10's gap in the streaklines).
+  void setEmitting(bool emitting) { mTracer.setEmitting(emitting); }
+
   /// Thread-safe: a running advanceFrame() returns 0 before its next substep.
   void cancel() { mTracer.cancel(); }
 

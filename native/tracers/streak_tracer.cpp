@@ -93,10 +93,15 @@ void StreakTracer::checkPointSource(std::size_t n, glm::vec3 p, glm::vec3 veloci
 
 void StreakTracerState::validate(int emissionPeriod) const {
   if (emissionPeriod < 1) throw std::invalid_argument("emission_period must be >= 1");
-  if (steps < 0 || emissions < 1 || steps / emissionPeriod + 1 != emissions)
+  // Rows: the first, then at most one per emission instant up to the youngest row's step.
+  if (steps < 0 || emissions < 1 || lastEmissionStep < 0 || lastEmissionStep > steps ||
+      lastEmissionStep % emissionPeriod != 0 ||
+      (emissions == 1) != (lastEmissionStep == 0) ||
+      emissions - 1 > lastEmissionStep / emissionPeriod)
     throw std::invalid_argument("tracer state: " + std::to_string(emissions) +
-                                " emissions after " + std::to_string(steps) +
-                                " steps do not match emission period " +
+                                " emissions, the youngest at step " +
+                                std::to_string(lastEmissionStep) + ", after " +
+                                std::to_string(steps) + " steps do not match emission period " +
                                 std::to_string(emissionPeriod));
   const std::size_t m = sources.size() * std::size_t(emissions);
   if (sources.size() != 0 && m / sources.size() != std::size_t(emissions))
@@ -134,6 +139,7 @@ void StreakTracer::emit() {
     mState.exitVelocity.emplace_back(0.f);
   }
   ++mState.emissions;
+  mState.lastEmissionStep = mState.steps;
 }
 
 void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const ScalarGrid& density,
@@ -145,8 +151,8 @@ void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const Sca
   checkGrid(density.size(), mGrid.resolution, "density");
   const Interpolation scheme = mParams.interpolation;
   const int sources = sourceCount();
-  // Particles of the emission made at this step's start (instant steps) are newborn.
-  const std::size_t newborn = mState.steps % mParams.emissionPeriod == 0
+  // Particles of an emission made at this step's start are newborn (none after a paused instant).
+  const std::size_t newborn = mState.lastEmissionStep == mState.steps
                                   ? std::size_t(mState.emissions - 1) * std::size_t(sources)
                                   : mState.positions.size();
   const int count = int(mState.positions.size());
@@ -192,7 +198,7 @@ void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const Sca
     }
   });
   ++mState.steps;
-  if (mState.steps % mParams.emissionPeriod == 0) emit();
+  if (mState.steps % mParams.emissionPeriod == 0 && mState.emitting) emit();
   // Density at every particle still inside, at the end of the step (§3.2: stored every step).
   const int total = int(mState.positions.size());
   parallelFor(0, (total + kChunk - 1) / kChunk, [&](int chunk) {

@@ -6,7 +6,18 @@
 /// Timeline. Emission happens at the instants t = s·Δt with s = 0, P, 2P, … (P = emission
 /// period, s counts the steps this tracer has seen): the particle of instant 0 is emitted when the
 /// point sources are added, the others at the end of the step that reaches their instant. After S
-/// steps every source therefore holds floor(S / P) + 1 particles, the youngest at the source.
+/// steps every source therefore holds floor(S / P) + 1 particles, the youngest at the source,
+/// unless emission was paused.
+///
+/// Pausing (Figure 10: "particle emission was turned off" for frames 101-160). setEmitting(false)
+/// makes the emission instants reached while paused add no particle row, so the particles born
+/// on either side of the pause lie far apart along every streakline (the gap in the sheets);
+/// particles already emitted keep moving. The switch is per tracer, not per point source: h(α,β)
+/// (§3.3) pairs particles by index and the control nets are fixed, so every streakline keeps the
+/// same particle count. A caller with several sources pauses only when none of them emits (the
+/// add-on's Emit Particles switch); sources whose smoke is off but whose particles keep coming
+/// carry the field's (zero) density. The first particle of each source, emitted when it is added,
+/// is never skipped.
 ///
 /// Boundaries. A particle pushed through a closed side is clamped onto it and keeps moving; one
 /// carried through an open side is marked `outside`, its density becomes 0 (no smoke is
@@ -52,7 +63,7 @@ struct PointSource {
 /// Everything a StreakTracer accumulates while it runs (§3.2): its point sources and their
 /// particles, emission-major (particle e of source s at e * sources.size() + s), with the density
 /// sampled at each, the outside flag and exit velocity of particles that left through an open
-/// side, the emission instants reached and the steps seen. A checkpoint
+/// side, the particle rows emitted, the steps seen and the pause switch (Figure 10). A checkpoint
 /// (io/tracer_state_file.h) saves it so that a traced bake resumes bit for bit.
 struct StreakTracerState {
   std::vector<PointSource> sources;
@@ -60,8 +71,14 @@ struct StreakTracerState {
   std::vector<float> density;
   std::vector<std::uint8_t> outside;     ///< 0 or 1
   std::vector<glm::vec3> exitVelocity;   ///< velocity a particle left the domain with
-  int emissions = 1;                     ///< floor(steps / emission period) + 1
+  /// Particle rows emitted: floor(steps / emission period) + 1 less the instants skipped while
+  /// paused.
+  int emissions = 1;
   long long steps = 0;
+  /// Step count at which the youngest row was emitted (0: the row emitted with the sources); its
+  /// particles are newborn during the step after it.
+  long long lastEmissionStep = 0;
+  bool emitting = true;  ///< false: emission instants add no row (Figure 10's gap)
   /// Throws std::invalid_argument when the counters disagree with each other and with
   /// `emissionPeriod`, the particle arrays do not hold sources × emissions entries, a flag is
   /// not 0/1 or a value is not finite.
@@ -112,6 +129,12 @@ class StreakTracer {
   /// right after solver.step(dt), with `velocityBefore` copied just before that call.
   void observeStep(const SmokeSolver& solver, const MacGrid3& velocityBefore, float dt);
 
+  /// Pauses (false) or resumes (true) emission (Figure 10; see the file comment): while paused,
+  /// the emission instants step() reaches add no particles; the others keep moving. Takes effect
+  /// from the next emission instant.
+  void setEmitting(bool emitting) { mState.emitting = emitting; }
+  bool emitting() const { return mState.emitting; }
+
   /// Storage for the start-of-step velocity used by advanceFrameWithTracers (allocated once).
   MacGrid3& previousVelocity() { return mPrevious; }
 
@@ -119,7 +142,7 @@ class StreakTracer {
   StreakFrame snapshot() const;
 
   int sourceCount() const { return int(mState.sources.size()); }
-  /// Particles per source (equal for all sources).
+  /// Particles per source (equal for all sources): floor(steps / period) + 1 if never paused.
   int particlesPerSource() const { return mState.emissions; }
   /// Steps seen so far.
   long long steps() const { return mState.steps; }

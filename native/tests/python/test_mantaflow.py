@@ -46,6 +46,15 @@ def test_tracer_in_a_still_cache_keeps_particles_at_their_sources(tmp_path):
     s = _native.read_streak_file(path)
     np.testing.assert_array_equal(s["counts"], [2, 2])
     np.testing.assert_allclose(s["positions"], np.repeat(points, 2, axis=0), atol=1e-6)
+    # Figure 10: emission paused over instant 4, resumed for instant 6.
+    tracer.emitting = False
+    for _ in range(2):
+        tracer.advance_frame(empty, empty, 1 / 24)
+    assert not tracer.emitting and (tracer.steps, tracer.particles_per_source) == (4, 2)
+    tracer.emitting = True
+    for _ in range(2):
+        tracer.advance_frame(empty, empty, 1 / 24)
+    assert (tracer.steps, tracer.particles_per_source) == (6, 3)
     with pytest.raises(ValueError, match="frame_dt"):
         tracer.advance_frame(empty, empty, 0.0)
     with pytest.raises(ValueError, match="cfl"):

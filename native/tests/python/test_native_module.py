@@ -67,6 +67,7 @@ def test_version_and_enums():
     assert _native.__version__ == "0.1.0"
     assert _native.Advection.SEMI_LAGRANGIAN != _native.Advection.BFECC
     assert _native.Interpolation.LINEAR != _native.Interpolation.MONOTONIC_CUBIC
+    assert _native.Trace.MIDPOINT != _native.Trace.EULER
     assert _native.Boundary.OPEN != _native.Boundary.CLOSED
     assert _native.Slip.NO_SLIP != _native.Slip.FREE_SLIP
 
@@ -78,8 +79,8 @@ def test_params_defaults_and_fields():
     assert len(p.boundaries) == 6
     assert p.boundaries[4] == _native.Boundary.CLOSED
     for name in ["cell_size", "frame_dt", "substeps", "use_cfl", "cfl", "advection",
-                 "interpolation", "gravity", "alpha", "beta", "ambient_temperature", "wind",
-                 "wind_strength", "vorticity", "density_dissipation", "pressure_tolerance",
+                 "interpolation", "trace", "gravity", "alpha", "beta", "ambient_temperature",
+                 "wind", "wind_strength", "vorticity", "density_dissipation", "pressure_tolerance",
                  "max_pressure_iterations", "combustion", "burn_rate", "soot_yield", "heat_yield",
                  "conductivity", "cooling_rate", "max_temperature", "expansion", "seed",
                  "threads", "origin"]:
@@ -90,6 +91,8 @@ def test_params_defaults_and_fields():
     assert p.boundaries == [_native.Boundary.CLOSED] * 6
     q = _native.SmokeParams(cell_size=0.25, combustion=True)
     assert q.cell_size == 0.25 and q.combustion
+    assert p.trace == _native.Trace.MIDPOINT  # RK2 stays the default
+    assert _native.SmokeParams(trace=_native.Trace.EULER).trace == _native.Trace.EULER
 
 
 def test_params_validate_messages():

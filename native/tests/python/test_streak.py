@@ -185,6 +185,29 @@ def test_tracer_checkpoint_resumes_bit_for_bit_with_the_solver(tmp_path):
         tracer.save_state(tmp_path / "missing" / "t.bin", frame=1)
 
 
+def test_tracer_emission_pause_with_the_solver(tmp_path):
+    # Figure 10: emission off for some frames leaves a gap; the particles already out keep moving.
+    p = small_params()
+    solver, tracer, _ = streaking_solver(p)
+    assert tracer.emitting
+    assert _native.advance_frame_with_tracers(solver, tracer)
+    rows = tracer.particles_per_source
+    assert rows == tracer.steps + 1  # one row per step, and the first
+    tracer.emitting = False
+    before, steps = tracer.snapshot()["positions"], tracer.steps
+    assert _native.advance_frame_with_tracers(solver, tracer)
+    assert tracer.steps > steps and tracer.particles_per_source == rows
+    assert not np.array_equal(tracer.snapshot()["positions"], before)  # they moved
+    tracer.save_state(tmp_path / "paused.bin", frame=2)
+    _, restored, _ = streaking_solver(p)
+    restored.load_state(tmp_path / "paused.bin")
+    assert not restored.emitting  # the switch is part of the checkpoint
+    tracer.emitting = True
+    paused_steps = tracer.steps
+    assert _native.advance_frame_with_tracers(solver, tracer)
+    assert tracer.particles_per_source == rows + (tracer.steps - paused_steps)
+
+
 # --- streak files ----------------------------------------------------------------------------
 
 def test_streak_file_round_trip_and_errors(tmp_path):

@@ -1,0 +1,130 @@
+#include "core/sample_points.h"
+
+#include "core/linear_cells.h"
+
+namespace plume {
+namespace {
+
+#if defined(PLUME_LINEAR_CELLS_AVX2)
+#define PLUME_GATHER_DISPATCH 1
+
+__attribute__((target("avx2"))) void linear8(const float* data, const Neighbours& d,
+                                             const std::uint32_t* index, const float* tx,
+                                             const float* ty, const float* tz, float* out) {
+  _mm256_storeu_ps(out, lerpCells8(cornersOf8(data, d, index), tx, ty, tz));
+}
+
+__attribute__((target("avx2"))) void range8(const float* data, const Neighbours& d,
+                                            const std::uint32_t* index, float* lo, float* hi) {
+  __m256 l, h;
+  rangeCells8(cornersOf8(data, d, index), l, h);
+  _mm256_storeu_ps(lo, l);
+  _mm256_storeu_ps(hi, h);
+}
+
+const bool kHasAvx2 = hasAvx2();
+
+#endif
+
+}  // namespace
+
+void SamplePoints::reserve(std::size_t count) {
+  mIndex.reserve(count);
+  for (std::vector<float>& t : mT) t.reserve(count);
+}
+
+void SamplePoints::resize(glm::ivec3 gridSize, std::size_t count) {
+  mGridSize = gridSize;
+  mIndex.resize(count);
+  for (std::vector<float>& t : mT) t.resize(count);
+}
+
+void PointSink::set(int m, glm::vec3 p) {
+  const glm::ivec3 s = mGridSize;
+  int c[3];
+  for (int a = 0; a < 3; ++a) splitCoordinate(p[a], s[a], c[a], mT[a][m]);
+  const bool inside =
+      c[0] >= 1 && c[1] >= 1 && c[2] >= 1 && c[0] + 2 < s.x && c[1] + 2 < s.y && c[2] + 2 < s.z;
+  mIndex[m] = std::uint32_t(c[0] + s.x * (c[1] + s.y * c[2])) |
+              (inside ? 0u : SamplePoints::kNearSide);
+}
+
+#if defined(__SSE4_1__)
+void PointSink::set4(int m, __m128 x, __m128 y, __m128 z) {
+  const __m128 pos[3] = {x, y, z};
+  __m128i c[3], inside = _mm_set1_epi32(-1);
+  for (int a = 0; a < 3; ++a) {
+    __m128 t;
+    splitCoordinate4(pos[a], mGridSize[a], c[a], t);
+    _mm_storeu_ps(mT[a] + m, t);
+    // 1 <= c and c + 2 < size
+    inside = _mm_and_si128(inside, _mm_cmpgt_epi32(c[a], _mm_setzero_si128()));
+    inside = _mm_and_si128(inside, _mm_cmplt_epi32(c[a], _mm_set1_epi32(mGridSize[a] - 2)));
+  }
+  // Linear indices fit in 31 bits (SmokeParams caps the cell count).
+  const __m128i index = _mm_add_epi32(
+      c[0], _mm_mullo_epi32(_mm_set1_epi32(mGridSize.x),
+                            _mm_add_epi32(c[1], _mm_mullo_epi32(_mm_set1_epi32(mGridSize.y), c[2]))));
+  const __m128i near = _mm_andnot_si128(inside, _mm_set1_epi32(int(SamplePoints::kNearSide)));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(mIndex + m), _mm_or_si128(index, near));
+}
+#endif
+
+#if defined(PLUME_GATHER_DISPATCH)
+__attribute__((target("avx2"))) void PointSink::set8(int m, __m256 x, __m256 y, __m256 z) {
+  const __m256 pos[3] = {x, y, z};
+  __m256i c[3], inside = _mm256_set1_epi32(-1);
+  for (int a = 0; a < 3; ++a) {
+    __m256 t;
+    splitCoordinate8(pos[a], mGridSize[a], c[a], t);
+    _mm256_storeu_ps(mT[a] + m, t);
+    // 1 <= c and c + 2 < size
+    inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(c[a], _mm256_setzero_si256()));
+    inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(_mm256_set1_epi32(mGridSize[a] - 2), c[a]));
+  }
+  const __m256i index = _mm256_add_epi32(
+      c[0], _mm256_mullo_epi32(
+                _mm256_set1_epi32(mGridSize.x),
+                _mm256_add_epi32(c[1], _mm256_mullo_epi32(_mm256_set1_epi32(mGridSize.y), c[2]))));
+  const __m256i near = _mm256_andnot_si256(inside, _mm256_set1_epi32(int(SamplePoints::kNearSide)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(mIndex + m), _mm256_or_si256(index, near));
+}
+#endif
+
+glm::vec3 SamplePoints::position(std::size_t n) const {
+  // i + t is exact: t = x - i was computed exactly (Sterbenz), so the sum gives x back.
+  const std::uint32_t c = mIndex[n] & kIndexMask;
+  const std::uint32_t nx = std::uint32_t(mGridSize.x), ny = std::uint32_t(mGridSize.y);
+  const float i = float(c % nx), j = float((c / nx) % ny), k = float(c / (nx * ny));
+  return {i + mT[0][n], j + mT[1][n], k + mT[2][n]};
+}
+
+void sampleLinear(const ScalarGrid& g, const SamplePoints& points, std::size_t first, int count,
+                  float* out) {
+  const Neighbours d(g);
+  const std::uint32_t* index = points.index() + first;
+  const float *tx = points.tx() + first, *ty = points.ty() + first, *tz = points.tz() + first;
+  int m = 0;
+#if defined(PLUME_GATHER_DISPATCH)
+  if (kHasAvx2)
+    for (; m + 8 <= count; m += 8)
+      linear8(g.data(), d, index + m, tx + m, ty + m, tz + m, out + m);
+#endif
+  for (; m < count; ++m)
+    out[m] = lerpCell(g.data() + (index[m] & SamplePoints::kIndexMask), d, tx[m], ty[m], tz[m]);
+}
+
+void sampleRange(const ScalarGrid& g, const SamplePoints& points, std::size_t first, int count,
+                 float* lo, float* hi) {
+  const Neighbours d(g);
+  const std::uint32_t* index = points.index() + first;
+  int m = 0;
+#if defined(PLUME_GATHER_DISPATCH)
+  if (kHasAvx2)
+    for (; m + 8 <= count; m += 8) range8(g.data(), d, index + m, lo + m, hi + m);
+#endif
+  for (; m < count; ++m)
+    rangeCell(g.data() + (index[m] & SamplePoints::kIndexMask), d, lo[m], hi[m]);
+}
+
+}  // namespace plume

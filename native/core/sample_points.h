@@ -1,0 +1,138 @@
+#pragma once
+/// \file sample_points.h
+/// Points at which several grids of one shape are sampled (the back-traces of semi-Lagrangian
+/// advection, Stam 1999 §3.2), kept as what trilinear and monotonic cubic sampling read of a
+/// position: the cell it falls in and the fractions along each axis. Splitting a position costs
+/// about as much as the trilinear lerps; split once, the weights serve every field and every
+/// pass of BFECC / MacCormack. Structure of arrays: eight consecutive points load as one AVX2
+/// register per coordinate, and the trilinear kernels gather their corners eight at a time.
+
+#include "core/cpu_features.h"
+#include "core/grid3.h"
+
+#include <cstdint>
+#include <vector>
+
+#if defined(__SSE4_1__) || defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
+namespace plume {
+
+/// Cell i and fraction t of coordinate x on an axis of n samples: x clamped into [0, n-1], the
+/// last cell taken for x = n-1. Every trilinear and cubic sample of Plume splits this way.
+inline void splitCoordinate(float x, int n, int& i, float& t) {
+  const float hi = float(n - 1);
+  x = x < 0.f ? 0.f : (x > hi ? hi : x);
+  i = int(x);
+  if (i >= n - 1) i = n > 1 ? n - 2 : 0;
+  t = x - float(i);
+}
+
+#if defined(__SSE4_1__)
+/// splitCoordinate() on four lanes, with the same operations (the clamps select like the scalar
+/// form; lanes differ at most in the sign of a zero fraction, which no sample depends on).
+inline void splitCoordinate4(__m128 x, int n, __m128i& i, __m128& t) {
+  const __m128 zero = _mm_setzero_ps(), hi = _mm_set1_ps(float(n - 1));
+  x = _mm_blendv_ps(x, zero, _mm_cmplt_ps(x, zero));
+  x = _mm_blendv_ps(x, hi, _mm_cmpgt_ps(x, hi));
+  i = _mm_cvttps_epi32(x);
+  const __m128i last = _mm_cmpgt_epi32(i, _mm_set1_epi32(n - 2));  // i >= n - 1
+  i = _mm_blendv_epi8(i, _mm_set1_epi32(n > 1 ? n - 2 : 0), last);
+  t = _mm_sub_ps(x, _mm_cvtepi32_ps(i));
+}
+#endif
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(PLUME_NO_AVX2)
+/// splitCoordinate4() on eight lanes (AVX2; call only when hasAvx2()).
+__attribute__((target("avx2"))) inline void splitCoordinate8(__m256 x, int n, __m256i& i,
+                                                             __m256& t) {
+  const __m256 zero = _mm256_setzero_ps(), hi = _mm256_set1_ps(float(n - 1));
+  x = _mm256_blendv_ps(x, zero, _mm256_cmp_ps(x, zero, _CMP_LT_OQ));
+  x = _mm256_blendv_ps(x, hi, _mm256_cmp_ps(x, hi, _CMP_GT_OQ));
+  i = _mm256_cvttps_epi32(x);
+  const __m256i last = _mm256_cmpgt_epi32(i, _mm256_set1_epi32(n - 2));  // i >= n - 1
+  i = _mm256_blendv_epi8(i, _mm256_set1_epi32(n > 1 ? n - 2 : 0), last);
+  t = _mm256_sub_ps(x, _mm256_cvtepi32_ps(i));
+}
+#endif
+
+/// Where split points are written: set() and friends split a position and store it as point m
+/// (clamped into the grid, cell and fractions exactly as sampleLinear() and
+/// sampleMonotonicCubic() split it, core/sampling.cpp).
+class PointSink {
+ public:
+  PointSink(glm::ivec3 gridSize, std::uint32_t* index, float* tx, float* ty, float* tz)
+      : mGridSize(gridSize), mIndex(index), mT{tx, ty, tz} {}
+  void set(int m, glm::vec3 p);
+#if defined(__SSE4_1__)
+  /// set() of points m .. m+3 at the lanes of x, y, z (the same operations on four lanes).
+  void set4(int m, __m128 x, __m128 y, __m128 z);
+#endif
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(PLUME_NO_AVX2)
+  /// set() of points m .. m+7 (AVX2; call only when hasAvx2()).
+  __attribute__((target("avx2"))) void set8(int m, __m256 x, __m256 y, __m256 z);
+#endif
+
+ private:
+  glm::ivec3 mGridSize;
+  std::uint32_t* mIndex;
+  float* mT[3];
+};
+
+/// Split positions in the index space of grids of one size (sample (i,j,k) at p = (i,j,k)).
+class SamplePoints {
+ public:
+  /// Flag in index(): the point's 4×4×4 monotonic cubic stencil (i-1 .. i+2) leaves the grid.
+  static constexpr std::uint32_t kNearSide = 1u << 31;
+  /// The index without kNearSide.
+  static constexpr std::uint32_t kIndexMask = kNearSide - 1u;
+
+  /// Allocates room for `count` points; resize() within it never allocates.
+  void reserve(std::size_t count);
+  /// `count` points (values unset) in grids of `gridSize` samples.
+  void resize(glm::ivec3 gridSize, std::size_t count);
+
+  /// Writes points first, first+1, ... (PointSink's m counts from `first`).
+  PointSink sink(std::size_t first) {
+    return {mGridSize, mIndex.data() + first, mT[0].data() + first, mT[1].data() + first,
+            mT[2].data() + first};
+  }
+  /// Stores point n at p.
+  void set(std::size_t n, glm::vec3 p) { sink(n).set(0, p); }
+  /// The clamped position of point n: cell + fraction per axis, exactly what was split.
+  glm::vec3 position(std::size_t n) const;
+
+  glm::ivec3 gridSize() const { return mGridSize; }
+  std::size_t count() const { return mIndex.size(); }
+  /// Linear index of the lower corner of point n's trilinear cell, with kNearSide.
+  const std::uint32_t* index() const { return mIndex.data(); }
+  /// Fractions in [0, 1] along x, y, z.
+  const float* tx() const { return mT[0].data(); }
+  const float* ty() const { return mT[1].data(); }
+  const float* tz() const { return mT[2].data(); }
+
+ private:
+  glm::ivec3 mGridSize{0};
+  std::vector<std::uint32_t> mIndex;
+  std::vector<float> mT[3];
+};
+
+/// Trilinear samples of `grid` at points first .. first+count-1 into out[0 .. count-1]: the
+/// values sampleLinear() gives at their positions, bit for bit (AVX2 where the CPU has it).
+/// grid must have the points' grid size.
+void sampleLinear(const ScalarGrid& grid, const SamplePoints& points, std::size_t first,
+                  int count, float* out);
+
+/// sampleRange() of `grid` at points first .. first+count-1: smallest and largest of the 8
+/// samples of each trilinear cell (the clamp limiter of BFECC and MacCormack).
+void sampleRange(const ScalarGrid& grid, const SamplePoints& points, std::size_t first,
+                 int count, float* lo, float* hi);
+
+/// Monotonic cubic samples (Fedkiw 2001 eq. 12-13) at points first .. first+count-1, bit for
+/// bit sampleMonotonicCubic() at their positions (defined in core/sampling.cpp, next to the
+/// cubic kernels it shares).
+void sampleMonotonicCubic(const ScalarGrid& grid, const SamplePoints& points, std::size_t first,
+                          int count, float* out);
+
+}  // namespace plume

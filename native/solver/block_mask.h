@@ -1,0 +1,68 @@
+#pragma once
+/// \file block_mask.h
+/// Sparse work for advection (issue 3: "skip advection in blocks with no smoke"): blocks of
+/// 8³ samples that may hold something other than a field's background value, and the loop over
+/// the x-runs of a grid that lie in them.
+
+#include "core/grid3.h"
+#include "core/parallel.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace plume {
+
+/// Blocks of 8³ samples that may hold something other than a field's background value after
+/// advection: blocks holding such a value, dilated by two blocks (16 cells).
+class BlockMask {
+ public:
+  static constexpr int kBlock = 8;
+  static constexpr int kDilation = 2;  ///< blocks; covers 2 × (trace + stencil) of BFECC
+
+  /// Marks the blocks of `field` with a value != background, then dilates.
+  void build(const ScalarGrid& field, float background);
+  /// Union with another mask of the same grid.
+  void merge(const BlockMask& other);
+  /// Marks everything active.
+  void setAll(glm::ivec3 size);
+  bool active(int bi, int bj, int bk) const {
+    return mActive[std::size_t(bi) + std::size_t(mBlocks.x) * (std::size_t(bj) + std::size_t(mBlocks.y) * std::size_t(bk))] != 0;
+  }
+  glm::ivec3 blocks() const { return mBlocks; }
+  /// Share of active blocks, in [0, 1].
+  float fill() const;
+
+ private:
+  glm::ivec3 mBlocks{0};
+  std::vector<std::uint8_t> mActive, mRaw;
+};
+
+/// Calls run(setup(j, k), i0, i1, j, k) for the x-runs [i0, i1) of each row of a grid of n
+/// samples that lie in active blocks of `mask` (nullptr: all), and idle(i0, i1, j, k) for the
+/// others; setup(j, k) runs once per row, for what the runs of a row share. Runs are at most
+/// BlockMask::kBlock long and start at multiples of it; z-slices run in parallel.
+template <typename Setup, typename Run, typename Idle>
+void forEachRunOfRows(glm::ivec3 n, const BlockMask* mask, const Setup& setup, const Run& run,
+                      const Idle& idle) {
+  constexpr int B = BlockMask::kBlock;
+  parallelFor(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j) {
+      const auto row = setup(j, k);
+      for (int i0 = 0; i0 < n.x; i0 += B) {
+        const int i1 = std::min(n.x, i0 + B);
+        if (!mask || mask->active(i0 / B, j / B, k / B)) run(row, i0, i1, j, k);
+        else idle(i0, i1, j, k);
+      }
+    }
+  });
+}
+
+/// forEachRunOfRows() without a row setup: run(i0, i1, j, k).
+template <typename Run, typename Idle>
+void forEachRun(glm::ivec3 n, const BlockMask* mask, const Run& run, const Idle& idle) {
+  forEachRunOfRows(
+      n, mask, [](int, int) { return 0; },
+      [&](int, int i0, int i1, int j, int k) { run(i0, i1, j, k); }, idle);
+}
+
+}  // namespace plume
