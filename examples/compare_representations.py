@@ -110,9 +110,7 @@ def panels(out_dir, frames, resolution, point_sources, with_surfaces):
              render_only(scene, {particles_object(dom, frames)},
                          os.path.join(out_dir, f"particles_{resolution}.png"))]
     if with_surfaces:
-        incense.pick_threshold(dom)
-        if bpy.ops.plume.surfaces_build() != {'FINISHED'}:
-            sys.exit("compare_representations: Build Surfaces failed")
+        scene_kit.bake_surfaces(dom, "compare_representations")  # the bake is already done
         scene.frame_set(frames)
         sheets = {o for o in scene.objects if o.type == 'SURFACE'}
         paths.append(render_only(scene, sheets, os.path.join(out_dir, "surfaces_50.png")))

@@ -17,6 +17,9 @@ import time
 import addon_utils
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scene_kit  # noqa: E402
+
 RESOLUTION = 50
 DEFAULT_FRAMES = 60
 RESOLUTION_X, RESOLUTION_Y = 320, 240
@@ -42,14 +45,8 @@ def clear_scene():
 
 def make_domain(frames):
     # 2 m cube standing on the floor: 50 cells of 4 cm on every axis.
-    bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.0, 0.0, 1.0))
-    dom = bpy.context.active_object
-    dom.name = "PlumeDomain"
-    bpy.ops.plume.role_set(role='DOMAIN')
+    dom = scene_kit.domain_cube("PlumeDomain", 2.0, (0.0, 0.0, 1.0), RESOLUTION, frames)
     d = dom.plume.domain
-    d.resolution = RESOLUTION
-    d.frame_start, d.frame_end = 1, frames
-    d.cache_directory = "//plume_cache/"
     d.advection = 'BFECC'
     d.interpolation = 'MONOTONIC_CUBIC'
     d.vorticity = 0.4

@@ -21,7 +21,6 @@ import math
 import os
 import random
 import sys
-import time
 
 import bpy
 
@@ -36,14 +35,8 @@ SHOW = (0.4, 0.7, 1.0)     # rendered frames, as fractions of the shot
 
 
 def make_domain(frames, resolution=RESOLUTION, name="Incense"):
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 0.0, 0.5))
-    dom = bpy.context.active_object
-    dom.name = name
-    bpy.ops.plume.role_set(role='DOMAIN')
+    dom = scene_kit.domain_cube(name, 1.0, (0.0, 0.0, 0.5), resolution, frames)
     d = dom.plume.domain
-    d.resolution = resolution
-    d.frame_start, d.frame_end = 1, frames
-    d.cache_directory = "//plume_cache/"
     d.alpha, d.beta = 0.0, 0.3        # heat lifts the smoke, density is passive
     d.vorticity = 0.25                # ε: keeps the small curls a 50³ grid would smooth away
     d.density_dissipation = 0.5       # the smoke thins out as it mixes with the room's air
@@ -92,15 +85,6 @@ def make_source(frames, point_sources=POINT_SOURCES, vertex_sources=0):
     return src
 
 
-def pick_threshold(dom):
-    """h0 giving the most surfaces (the Most Surfaces button next to the threshold): the peak of
-    the (h0 -> surfaces) curve the panel shows live, the paper's Figure 4."""
-    bpy.context.view_layer.objects.active = dom
-    if bpy.ops.plume.surfaces_pick_threshold() != {'FINISHED'}:
-        sys.exit("the threshold could not be picked")
-    return dom.plume.domain.streak_threshold
-
-
 def main():
     out_dir, frames = scene_kit.parse_args(USAGE, DEFAULT_FRAMES)
     scene = scene_kit.new_scene()
@@ -112,31 +96,15 @@ def main():
     scene.frame_start, scene.frame_end = 1, frames
     scene_kit.save_blend(out_dir, "incense")
 
-    bpy.context.view_layer.objects.active = dom
-    t0 = time.perf_counter()
-    bpy.ops.plume.bake()
-    bake_s = time.perf_counter() - t0
-    h0 = pick_threshold(dom)
-    t0 = time.perf_counter()
-    bpy.ops.plume.surfaces_build()
-    build_s = time.perf_counter() - t0
-    surfaces = [o for o in bpy.data.objects if o.type == 'SURFACE']
-    smoke = bpy.data.objects.get(dom.plume.domain.volume_object)
-    if smoke is not None:
-        smoke.hide_render = True  # the sheets alone; compare_representations.py shows both
-    bpy.ops.wm.save_mainfile()
-
+    bake_s, build_s, h0, surfaces = scene_kit.bake_surfaces(dom, "incense")
     shown = sorted({max(1, min(frames, round(f * frames))) for f in SHOW})
-    t0 = time.perf_counter()
-    paths = scene_kit.render_frames(scene, shown, os.path.join(out_dir, "incense_%04d.png"))
-    render_s = (time.perf_counter() - t0) / len(shown)
-    scene_kit.strip(paths, os.path.join(out_dir, "incense_strip.png"))
+    render_s, strip = scene_kit.render_strip(scene, shown, out_dir, "incense")
     nets = ", ".join(f"{o.data.splines[0].point_count_u}x{o.data.splines[0].point_count_v}"
                      for o in surfaces)
     print(f"incense: {frames} frames at {RESOLUTION}^3, bake {bake_s:.1f} s "
           f"({bake_s / frames:.2f} s/frame), Build Surfaces {build_s:.1f} s -> "
           f"{len(surfaces)} surfaces at h0 = {h0:.3g} (control nets u x v: {nets}), render {render_s:.1f} s/frame "
-          f"-> {os.path.join(out_dir, 'incense_strip.png')}", flush=True)
+          f"-> {strip}", flush=True)
     if len(surfaces) < 2:
         sys.exit("incense: fewer than 2 surfaces were built")
 

@@ -126,3 +126,51 @@ def strip(paths, out_path, gap=4):
     img.save()
     bpy.data.images.remove(img)
     return out_path
+
+
+def domain_cube(name, size, location, resolution, frames):
+    """A cube mesh made a Plume domain: `resolution` cells on its longest axis, frames 1..frames,
+    cache in '//plume_cache/' (next to the saved .blend)."""
+    bpy.ops.mesh.primitive_cube_add(size=size, location=location)
+    dom = bpy.context.active_object
+    dom.name = name
+    bpy.ops.plume.role_set(role='DOMAIN')
+    d = dom.plume.domain
+    d.resolution = resolution
+    d.frame_start, d.frame_end = 1, frames
+    d.cache_directory = "//plume_cache/"
+    return dom
+
+
+def bake_surfaces(dom, tag):
+    """Bake, the Most Surfaces threshold (the peak of the Figure-4 curve the panel shows), Build
+    Surfaces; the Volume object is hidden from renders so the sheets show alone, and the .blend
+    is saved. Returns (bake seconds, build seconds, h0, surface objects); exits on failure."""
+    import time
+    bpy.context.view_layer.objects.active = dom
+    t0 = time.perf_counter()
+    if bpy.ops.plume.bake() != {'FINISHED'}:
+        sys.exit(f"{tag}: the bake failed")
+    bake_s = time.perf_counter() - t0
+    if bpy.ops.plume.surfaces_pick_threshold() != {'FINISHED'}:
+        sys.exit(f"{tag}: no threshold joins two streaklines")
+    t0 = time.perf_counter()
+    if bpy.ops.plume.surfaces_build() != {'FINISHED'}:
+        sys.exit(f"{tag}: Build Surfaces failed")
+    build_s = time.perf_counter() - t0
+    smoke = bpy.data.objects.get(dom.plume.domain.volume_object)
+    if smoke is not None:
+        smoke.hide_render = True
+    bpy.ops.wm.save_mainfile()
+    surfaces = [o for o in bpy.data.objects if o.type == 'SURFACE']
+    return bake_s, build_s, dom.plume.domain.streak_threshold, surfaces
+
+
+def render_strip(scene, frames, out_dir, prefix):
+    """Renders `frames` to OUT_DIR/PREFIX_####.png and puts them side by side in
+    OUT_DIR/PREFIX_strip.png; returns (seconds per frame, strip path)."""
+    import time
+    t0 = time.perf_counter()
+    paths = render_frames(scene, frames, os.path.join(out_dir, prefix + "_%04d.png"))
+    seconds = (time.perf_counter() - t0) / len(paths)
+    return seconds, strip(paths, os.path.join(out_dir, prefix + "_strip.png"))

@@ -18,12 +18,10 @@ the surfaces found. Needs the Plume add-on installed (README).
 import os
 import random
 import sys
-import time
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import incense  # noqa: E402
 import scene_kit  # noqa: E402
 
 USAGE = "usage: blender -b --factory-startup --python examples/sphere_collision.py -- OUT_DIR [FRAMES]"
@@ -36,14 +34,8 @@ SHOW = (96, 150, 250)      # frames of the strip, clamped to the shot
 
 
 def make_domain(frames):
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 0.0, 0.5))
-    dom = bpy.context.active_object
-    dom.name = "SphereCollision"
-    bpy.ops.plume.role_set(role='DOMAIN')
+    dom = scene_kit.domain_cube("SphereCollision", 1.0, (0.0, 0.0, 0.5), RESOLUTION, frames)
     d = dom.plume.domain
-    d.resolution = RESOLUTION
-    d.frame_start, d.frame_end = 1, frames
-    d.cache_directory = "//plume_cache/"
     d.alpha, d.beta = 0.0, 0.4
     d.vorticity = 0.2
     d.density_dissipation = 0.2
@@ -115,29 +107,12 @@ def main():
     scene.frame_start, scene.frame_end = 1, frames
     scene_kit.save_blend(out_dir, "sphere_collision")
 
-    bpy.context.view_layer.objects.active = dom
-    t0 = time.perf_counter()
-    if bpy.ops.plume.bake() != {'FINISHED'}:
-        sys.exit("sphere_collision: the bake failed")
-    bake_s = time.perf_counter() - t0
-    h0 = incense.pick_threshold(dom)
-    t0 = time.perf_counter()
-    if bpy.ops.plume.surfaces_build() != {'FINISHED'}:
-        sys.exit("sphere_collision: Build Surfaces failed")
-    build_s = time.perf_counter() - t0
-    smoke = bpy.data.objects.get(dom.plume.domain.volume_object)
-    if smoke is not None:
-        smoke.hide_render = True
-    bpy.ops.wm.save_mainfile()
-    surfaces = [o for o in bpy.data.objects if o.type == 'SURFACE']
+    bake_s, build_s, h0, surfaces = scene_kit.bake_surfaces(dom, "sphere_collision")
     shown = sorted({min(f, frames) for f in SHOW})
-    t0 = time.perf_counter()
-    paths = scene_kit.render_frames(scene, shown, os.path.join(out_dir, "sphere_%04d.png"))
-    render_s = (time.perf_counter() - t0) / len(shown)
-    scene_kit.strip(paths, os.path.join(out_dir, "sphere_strip.png"))
+    render_s, strip = scene_kit.render_strip(scene, shown, out_dir, "sphere")
     print(f"sphere_collision: {frames} frames at {RESOLUTION}^3, bake {bake_s:.1f} s, Build "
           f"Surfaces {build_s:.1f} s -> {len(surfaces)} surfaces at h0 = {h0:.3g}, render "
-          f"{render_s:.1f} s/frame -> {os.path.join(out_dir, 'sphere_strip.png')}", flush=True)
+          f"{render_s:.1f} s/frame -> {strip}", flush=True)
     if not surfaces:
         sys.exit("sphere_collision: no surface was built")
 
