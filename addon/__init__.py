@@ -40,6 +40,7 @@ import bpy  # noqa: E402  (after the checks above)
 
 from . import operators, properties, ui  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
+from .build import toon_points as _toon_points  # noqa: E402
 
 _classes = operators.classes + ui.classes
 
@@ -49,9 +50,11 @@ def register():
     for cls in _classes:
         bpy.utils.register_class(cls)
     _surfaces.register()  # persistent frame_change_pre handler of the streak surfaces
+    _toon_points.register()  # persistent frame_change_pre handler of the toon points
 
 
 def unregister():
+    _toon_points.unregister()
     _surfaces.unregister()
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)

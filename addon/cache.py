@@ -7,6 +7,7 @@
                                                           same frame as state.bin)
                                     streaks_<frame:04d>.bin   (streak surfaces on: tracers, §3.2)
                                     surface_<n>.npz, sheet_<n>_<frame:04d>.exr  (plume.surfaces_build)
+                                    toon_<frame:04d>.bin, stencil_<kind>.png   (plume.toon_build)
 """
 
 import json
@@ -24,6 +25,8 @@ _VOLUME_RE = re.compile(r"^volume_(-?\d+)\.vdb$")
 _STREAK_RE = re.compile(r"^streaks_(-?\d+)\.bin$")
 #: Files of plume.surfaces_build (per-surface control points and density map images).
 _SURFACE_RE = re.compile(r"^(surface_\d+\.npz|sheet_\d+_-?\d+\.exr)$")
+#: Files of plume.toon_build (toon particles per frame, generated stencils).
+_TOON_RE = re.compile(r"^(toon_-?\d+\.bin|stencil_(circle|puffy|hairy)\.png)$")
 
 
 def _frame_of(name):
@@ -141,7 +144,7 @@ def plume_files(folder):
         if not os.path.isfile(path):
             continue
         if (name in (MANIFEST_NAME, STATE_NAME, TRACER_STATE_NAME) or _frame_of(name) is not None
-                or _SURFACE_RE.match(name) or name.endswith(".tmp")):
+                or _SURFACE_RE.match(name) or _TOON_RE.match(name) or name.endswith(".tmp")):
             own.append(path)
     return own
 

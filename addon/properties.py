@@ -7,6 +7,8 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from .toon_properties import PlumeToonSettings
+
 ROLE_ITEMS = (
     ('NONE', "None", "Not part of a Plume simulation", 'X', 0),
     ('DOMAIN', "Domain", "Box holding the smoke simulation grid", 'MESH_CUBE', 1),
@@ -193,6 +195,8 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                                   description="Name of the Volume object showing this domain's bake")
     frames_baked: IntProperty(name="Frames Baked", default=0, min=0,
                               description="Frames of the last bake available in the cache")
+    # --- Toon smoke (cartoon_smoke.txt, plume.toon_build) ---
+    toon: PointerProperty(type=PlumeToonSettings, name="Toon Smoke")
 
 
 class PlumeSourceSettings(bpy.types.PropertyGroup):
@@ -249,7 +253,8 @@ class PlumeObjectSettings(bpy.types.PropertyGroup):
     obstacle: PointerProperty(type=PlumeObstacleSettings)
 
 
-classes = (PlumeDomainSettings, PlumeSourceSettings, PlumeObstacleSettings, PlumeObjectSettings)
+classes = (PlumeToonSettings, PlumeDomainSettings, PlumeSourceSettings, PlumeObstacleSettings,
+           PlumeObjectSettings)
 
 
 def register():

@@ -214,6 +214,44 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
             row.operator("plume.surfaces_export_mesh", icon='MESH_GRID')
 
 
+class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Toon Smoke"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        ob = context.object
+        t = ob.plume.domain.toon
+        col = layout.column(heading="Particles")
+        for name in ("emission_count", "birth_density", "death_density", "max_count",
+                     "integration", "cfl", "seed"):
+            col.prop(t, name)
+        col = layout.column(heading="Size Ramp", align=True)
+        for name in ("ramp_density_low", "ramp_density_high", "size_low", "size_high",
+                     "max_size_change"):
+            col.prop(t, name)
+        layout.prop(t, "stretch_factor")
+        col = layout.column(heading="Colour", align=True)
+        for name in ("color_driver", "color_low", "color_high", "ramp_color_low",
+                     "ramp_color_high"):
+            col.prop(t, name)
+        layout.prop(t, "stencil")
+        sub = layout.column()
+        sub.active = t.stencil == 'IMAGE'
+        sub.prop(t, "stencil_image")
+        col = layout.column(heading="Outlines")
+        col.prop(t, "depth_threshold")
+        col.prop(t, "outline_color")
+        col.prop(t, "ignore_background")
+        col.prop(t, "use_freestyle")
+        row = layout.row()
+        row.enabled = not is_baking(ob)
+        row.operator("plume.toon_build", icon='MOD_PARTICLES')
+        if t.object_name:
+            layout.label(text=f"Toon: {t.object_name}", icon='OUTLINER_OB_POINTCLOUD')
+
+
 class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
     bl_label = "Source"
     bl_parent_id = "PHYSICS_PT_plume"
@@ -269,6 +307,7 @@ classes = (
     PHYSICS_PT_plume_combustion,
     PHYSICS_PT_plume_cache,
     PHYSICS_PT_plume_streaks,
+    PHYSICS_PT_plume_toon,
     PHYSICS_PT_plume_source,
     PHYSICS_PT_plume_obstacle,
 )

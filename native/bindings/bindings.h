@@ -20,10 +20,21 @@ void bindNurbs(pybind11::module_& m);
 void bindStreak(pybind11::module_& m);
 /// Mantaflow cache frames, volumes and the tracer driven by them (bind_mantaflow.cpp).
 void bindMantaflow(pybind11::module_& m);
+/// Toon smoke: particles, billboards, depth differences, toon files (bind_toon.cpp).
+void bindToon(pybind11::module_& m);
 
 /// A path argument given as str or os.PathLike, as a std::string (needs the GIL).
 inline std::string pathArg(const pybind11::object& path) {
   return pybind11::str(pybind11::module_::import("os").attr("fspath")(path)).cast<std::string>();
+}
+
+/// fn(path) with the GIL released (file reads and writes), for a path given as str or
+/// os.PathLike; returns what fn returns (a C++ value: no Python object is touched without the GIL).
+template <typename Fn>
+auto withPath(const pybind11::object& path, const Fn& fn) {
+  const std::string p = pathArg(path);
+  pybind11::gil_scoped_release release;
+  return fn(p);
 }
 
 }  // namespace plume::bindings

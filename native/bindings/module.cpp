@@ -43,4 +43,5 @@ PYBIND11_MODULE(_native, m) {
   plume::bindings::bindNurbs(m);
   plume::bindings::bindStreak(m);
   plume::bindings::bindMantaflow(m);
+  plume::bindings::bindToon(m);
 }

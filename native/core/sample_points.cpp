@@ -51,22 +51,12 @@ void PointSink::set(int m, glm::vec3 p) {
 
 #if defined(__SSE4_1__)
 void PointSink::set4(int m, __m128 x, __m128 y, __m128 z) {
-  const __m128 pos[3] = {x, y, z};
-  __m128i c[3], inside = _mm_set1_epi32(-1);
-  for (int a = 0; a < 3; ++a) {
-    __m128 t;
-    splitCoordinate4(pos[a], mGridSize[a], c[a], t);
-    _mm_storeu_ps(mT[a] + m, t);
-    // 1 <= c and c + 2 < size
-    inside = _mm_and_si128(inside, _mm_cmpgt_epi32(c[a], _mm_setzero_si128()));
-    inside = _mm_and_si128(inside, _mm_cmplt_epi32(c[a], _mm_set1_epi32(mGridSize[a] - 2)));
-  }
-  // Linear indices fit in 31 bits (SmokeParams caps the cell count).
-  const __m128i index = _mm_add_epi32(
-      c[0], _mm_mullo_epi32(_mm_set1_epi32(mGridSize.x),
-                            _mm_add_epi32(c[1], _mm_mullo_epi32(_mm_set1_epi32(mGridSize.y), c[2]))));
-  const __m128i near = _mm_andnot_si128(inside, _mm_set1_epi32(int(SamplePoints::kNearSide)));
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(mIndex + m), _mm_or_si128(index, near));
+  // Lane by lane: set4 only serves CPUs without AVX2 and the odd tail of a run.
+  alignas(16) float c[3][4];
+  _mm_store_ps(c[0], x);
+  _mm_store_ps(c[1], y);
+  _mm_store_ps(c[2], z);
+  for (int l = 0; l < 4; ++l) set(m + l, {c[0][l], c[1][l], c[2][l]});
 }
 #endif
 

@@ -66,7 +66,7 @@ class PointSink {
       : mGridSize(gridSize), mIndex(index), mT{tx, ty, tz} {}
   void set(int m, glm::vec3 p);
 #if defined(__SSE4_1__)
-  /// set() of points m .. m+3 at the lanes of x, y, z (the same operations on four lanes).
+  /// set() of points m .. m+3 at the lanes of x, y, z.
   void set4(int m, __m128 x, __m128 y, __m128 z);
 #endif
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(PLUME_NO_AVX2)

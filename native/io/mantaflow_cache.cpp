@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/parallel.h"
+#include "io/mac_faces.h"
 #include "io/vdb_grids.h"
 
 namespace plume {
@@ -119,26 +120,6 @@ std::size_t cellIndex(glm::ivec3 p, glm::ivec3 n) {
          std::size_t(n.x) * (std::size_t(p.y) + std::size_t(n.y) * std::size_t(p.z));
 }
 
-/// Calls face(f, below, a) for every face f of every component a of a MAC grid, where
-/// `below` is the cell under the face on axis a (f itself is the cell above), and stores the
-/// result.
-template <typename Face>
-void fillFaces(MacGrid3& mac, const Face& face) {
-  for (int a = 0; a < 3; ++a) {
-    ScalarGrid& c = mac.component(a);
-    const glm::ivec3 s = c.size();
-    glm::ivec3 step(0);
-    step[a] = 1;
-    parallelFor(0, s.z, [&](int k) {
-      for (int j = 0; j < s.y; ++j)
-        for (int i = 0; i < s.x; ++i) {
-          const glm::ivec3 f(i, j, k);
-          c(i, j, k) = face(f, f - step, a);
-        }
-    });
-  }
-}
-
 /// Face velocities from a staggered grid: face (i,j,k) of component a is voxel (i,j,k)'s
 /// component a. A face missing from the file (voxel clipped or beyond the grid) whose lower cell
 /// is stored takes that cell's lower face: constant extrapolation over one face.
@@ -155,16 +136,9 @@ void facesFromStaggered(const std::vector<openvdb::Vec3s>& v, const std::vector<
 /// two cells beside the face, or the one of them the file holds.
 void facesFromCentred(const std::vector<openvdb::Vec3s>& v, const std::vector<std::uint8_t>& on,
                       glm::ivec3 n, MacGrid3& mac) {
-  fillFaces(mac, [&](glm::ivec3 f, glm::ivec3 below, int a) {
-    float sum = 0.f;
-    int count = 0;
-    for (const glm::ivec3 p : {below, f})
-      if (p[a] >= 0 && p[a] < n[a] && on[cellIndex(p, n)]) {
-        sum += v[cellIndex(p, n)][a];
-        ++count;
-      }
-    return count ? sum / float(count) : 0.f;
-  });
+  facesFromCentres(
+      mac, n, [&](glm::ivec3 p) { return on[cellIndex(p, n)] != 0; },
+      [&](glm::ivec3 p, int a) { return v[cellIndex(p, n)][a]; });
 }
 
 }  // namespace

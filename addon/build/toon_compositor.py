@@ -1,0 +1,138 @@
+"""Depth-difference outlines in Blender's compositor (cartoon_smoke.txt §2.2, after Deussen &
+Strothotte 2000): the node group "Plume Depth Differences" draws a pixel in the outline colour
+when any of its four one-sided depth differences divided by the pixel size exceeds γ:
+
+    |z(i+1,j) - z(i,j)| / Δx > γ  or  |z(i,j) - z(i-1,j)| / Δx > γ  or
+    |z(i,j+1) - z(i,j)| / Δy > γ  or  |z(i,j) - z(i,j-1)| / Δy > γ,
+
+the same test as _native.depth_differences (neighbours outside the image are skipped; with
+Ignore Background, pixels with depth >= Far are never outlined). Each neighbour is the Depth
+translated by one pixel. The pixels a translation uncovers read outside the image: Blender 3.4's
+Render Layers Depth answers 10e10 there (RenderLayersDepthProg; the background is 1e10), other
+compositors answer 0; no rendered depth is either, so 0 < neighbour < OUTSIDE_DEPTH skips them.
+Also: scene wiring with the Z pass, and the optional Freestyle style."""
+
+import bpy
+
+from .toon_nodes import link_math
+
+GROUP = "Plume Depth Differences"
+NODE = "Plume Depth Differences"
+LINESET = "Plume Toon"
+#: Depth read outside the image (10e10 in Blender 3.4) is above this; Cycles' background (1e10)
+#: and every surface depth are below it.
+OUTSIDE_DEPTH = 5.0e10
+
+#: Group inputs: (name, socket type, default).
+INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
+          ("Depth", 'NodeSocketFloat', 0.0),
+          ("Gamma", 'NodeSocketFloat', 0.1),
+          ("Outline Color", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
+          ("Ignore Background", 'NodeSocketFloat', 0.0),
+          ("Far", 'NodeSocketFloat', 1.0e9),
+          ("Pixel Width", 'NodeSocketFloat', 1.0),
+          ("Pixel Height", 'NodeSocketFloat', 1.0))
+
+
+def depth_group():
+    """The compositor node group (rebuilt in place when it exists). Outputs: Image (outline
+    pixels in Outline Color, others from Image) and Outline (1 on outline pixels, else 0)."""
+    ng = bpy.data.node_groups.get(GROUP)
+    if ng is None or ng.bl_idname != 'CompositorNodeTree':
+        ng = bpy.data.node_groups.new(GROUP, 'CompositorNodeTree')
+    ng.nodes.clear()
+    for sockets in (ng.inputs, ng.outputs):
+        sockets.clear()
+    for name, kind, default in INPUTS:
+        ng.inputs.new(kind, name).default_value = default
+    ng.inputs["Gamma"].min_value = 0.0
+    ng.inputs["Ignore Background"].min_value, ng.inputs["Ignore Background"].max_value = 0.0, 1.0
+    ng.outputs.new('NodeSocketColor', "Image")
+    ng.outputs.new('NodeSocketFloat', "Outline")
+    N, L = ng.nodes.new, ng.links.new
+    gin, gout = N('NodeGroupInput'), N('NodeGroupOutput')
+    gin.location, gout.location = (-1200, 0), (1100, 0)
+    z = gin.outputs["Depth"]
+
+    def math(op, a, b, x, y):
+        return link_math(ng, op, a, b, (x, y), kind='CompositorNodeMath')
+
+    conditions = []
+    for n, (dx, dy, size) in enumerate(((1, 0, "Pixel Width"), (-1, 0, "Pixel Width"),
+                                        (0, 1, "Pixel Height"), (0, -1, "Pixel Height"))):
+        y = 600 - n * 300
+        t = N('CompositorNodeTranslate')
+        t.location, t.wrap_axis, t.use_relative = (-1000, y), 'NONE', False
+        t.inputs["X"].default_value, t.inputs["Y"].default_value = float(dx), float(dy)
+        L(z, t.inputs["Image"])
+        sep = N('CompositorNodeSepRGBA')  # the neighbour's depth exactly (no colour->BW mix)
+        sep.location = (-850, y)
+        L(t.outputs["Image"], sep.inputs["Image"])
+        neighbour = sep.outputs["R"]
+        diff = math('ABSOLUTE', math('SUBTRACT', neighbour, z, -700, y), None, -550, y)
+        over = math('GREATER_THAN', math('DIVIDE', diff, gin.outputs[size], -400, y),
+                    gin.outputs["Gamma"], -250, y)
+        inside = math('MULTIPLY', math('GREATER_THAN', neighbour, 0.0, -550, y - 120),
+                      math('LESS_THAN', neighbour, OUTSIDE_DEPTH, -550, y - 240), -400, y - 120)
+        conditions.append(math('MULTIPLY', over, inside, -100, y))
+    any_ = math('MAXIMUM', math('MAXIMUM', conditions[0], conditions[1], 50, 450),
+                math('MAXIMUM', conditions[2], conditions[3], 50, 0), 200, 250)
+    # Ignore Background: background = depth not < Far; keep = 1 - ignore * background.
+    background = math('SUBTRACT', 1.0, math('LESS_THAN', z, gin.outputs["Far"], 50, -300),
+                      200, -300)
+    keep = math('SUBTRACT', 1.0, math('MULTIPLY', gin.outputs["Ignore Background"], background,
+                                      350, -300), 500, -300)
+    outline = math('MULTIPLY', any_, keep, 650, 100)
+    mix = N('CompositorNodeMixRGB')
+    mix.location = (850, 100)
+    L(outline, mix.inputs["Fac"])
+    L(gin.outputs["Image"], mix.inputs[1])
+    L(gin.outputs["Outline Color"], mix.inputs[2])
+    L(mix.outputs["Image"], gout.inputs["Image"])
+    L(outline, gout.inputs["Outline"])
+    return ng
+
+
+def wire_scene(scene, view_layer, settings, far):
+    """Render Layers (Z pass on) -> "Plume Depth Differences" -> Composite in the scene's
+    compositor, the group node's inputs set from the toon settings. Returns the group node."""
+    view_layer.use_pass_z = True
+    scene.use_nodes = True
+    nt = scene.node_tree
+    group = depth_group()
+    rl = next((n for n in nt.nodes if n.type == 'R_LAYERS'), None) or nt.nodes.new(
+        'CompositorNodeRLayers')
+    comp = next((n for n in nt.nodes if n.type == 'COMPOSITE'), None) or nt.nodes.new(
+        'CompositorNodeComposite')
+    node = nt.nodes.get(NODE)
+    if node is None or node.type != 'GROUP':
+        node = nt.nodes.new('CompositorNodeGroup')
+        node.name = node.label = NODE
+    node.node_tree = group
+    node.location = (rl.location.x + 300, rl.location.y)
+    comp.location = (node.location.x + 300, node.location.y)
+    node.inputs["Gamma"].default_value = float(settings.depth_threshold)
+    node.inputs["Outline Color"].default_value = tuple(settings.outline_color)
+    node.inputs["Ignore Background"].default_value = 1.0 if settings.ignore_background else 0.0
+    node.inputs["Far"].default_value = float(far)
+    nt.links.new(rl.outputs["Image"], node.inputs["Image"])
+    nt.links.new(rl.outputs["Depth"], node.inputs["Depth"])
+    nt.links.new(node.outputs["Image"], comp.inputs["Image"])
+    return node
+
+
+def set_freestyle(scene, view_layer, enabled, color, collection=None):
+    """Optional style: Freestyle silhouette + border lines from a "Plume Toon" line set (on the
+    billboard geometry, not the stencil shapes; §2.2's depth differences stay the default)."""
+    if not enabled:
+        return  # the artist's own Freestyle setting stays as it is
+    scene.render.use_freestyle = True
+    fs = view_layer.freestyle_settings
+    ls = fs.linesets.get(LINESET) or fs.linesets.new(LINESET)
+    ls.select_by_visibility = ls.select_by_edge_types = True
+    ls.select_silhouette = ls.select_border = True
+    ls.select_crease = False
+    if collection is not None:
+        ls.select_by_collection = True
+        ls.collection = collection
+    ls.linestyle.color = tuple(color)[:3]

@@ -1,0 +1,183 @@
+"""Toon smoke rendering in Blender (cartoon_smoke.txt §2.2-2.3): the geometry-nodes group
+"Plume Toon Billboards" (one camera-facing quad per point, rotated in the image plane by the
+point's `angle`, scaled by `size` and stretched along x by `stretch`, Figure 4) and the flat toon
+material whose stencil alpha is a hard cut-out (alpha CLIP), so that the Depth pass is written
+only where the stencil is opaque (with the view layer's pass_alpha_threshold)."""
+
+import bpy
+
+GROUP = "Plume Toon Billboards"
+#: Alpha above which a stencil pixel is opaque (material cut-out and Cycles pass threshold).
+ALPHA_THRESHOLD = 0.5
+#: Point attribute of the billboards holding the stencil coordinates (u, v, 0).
+UV_ATTRIBUTE = "plume_uv"
+
+
+def link_math(nt, op, a, b=None, location=(0, 0), kind="ShaderNodeMath"):
+    """A math node of `kind` (shader, vector or compositor math) computing `op`(a, b), whose
+    inputs are sockets or numbers; returns its output."""
+    m = nt.nodes.new(kind)
+    m.operation, m.location = op, location
+    for k, v in ((0, a), (1, b)):
+        if isinstance(v, (int, float)):
+            m.inputs[k].default_value = v
+        elif v is not None:
+            nt.links.new(v, m.inputs[k])
+    return m.outputs[0]
+
+
+def billboard_group():
+    """The "Plume Toon Billboards" geometry-nodes group (rebuilt in place when it exists).
+    Inputs: Geometry (points with size/angle/stretch attributes), Camera (object), Material."""
+    ng = bpy.data.node_groups.get(GROUP)
+    if ng is None or ng.bl_idname != 'GeometryNodeTree':
+        ng = bpy.data.node_groups.new(GROUP, 'GeometryNodeTree')
+    ng.nodes.clear()
+    for sockets in (ng.inputs, ng.outputs):
+        sockets.clear()
+    ng.inputs.new('NodeSocketGeometry', "Geometry")
+    ng.inputs.new('NodeSocketObject', "Camera")
+    ng.inputs.new('NodeSocketMaterial', "Material")
+    ng.outputs.new('NodeSocketGeometry', "Geometry")
+    N, L = ng.nodes.new, ng.links.new
+    gin, gout = N('NodeGroupInput'), N('NodeGroupOutput')
+    gin.location, gout.location = (-1400, 0), (900, 0)
+
+    def attribute(name, y):
+        a = N('GeometryNodeInputNamedAttribute')
+        a.data_type, a.location = 'FLOAT', (-1200, y)
+        a.inputs["Name"].default_value = name
+        return next(o for o in a.outputs if o.enabled)  # one output per type, FLOAT's shown
+
+    size, angle = attribute("size", -300), attribute("angle", -450)
+    stretch = attribute("stretch", -600)
+
+    # The camera's world rotation: the quad's local z is the view axis, so it faces the camera.
+    cam = N('GeometryNodeObjectInfo')
+    cam.transform_space, cam.location = 'ORIGINAL', (-1200, 300)
+    L(gin.outputs["Camera"], cam.inputs["Object"])
+
+    def camera_axis(vec, y):
+        r = N('ShaderNodeVectorRotate')
+        r.rotation_type, r.location = 'EULER_XYZ', (-1000, y)
+        r.inputs["Vector"].default_value = vec
+        L(cam.outputs["Rotation"], r.inputs["Rotation"])
+        return r.outputs["Vector"]
+
+    right, up = camera_axis((1.0, 0.0, 0.0), 200), camera_axis((0.0, 1.0, 0.0), 50)
+    # Stretch axis in the image plane: cos(angle) right + sin(angle) up (Figure 4).
+    cos_a = link_math(ng, 'COSINE', angle, location=(-1000, -400))
+    sin_a = link_math(ng, 'SINE', angle, location=(-1000, -550))
+    def scaled(vec, factor, y):
+        v = N('ShaderNodeVectorMath')
+        v.operation, v.location = 'SCALE', (-800, y)
+        L(vec, v.inputs[0])
+        L(factor, v.inputs["Scale"])
+        return v.outputs["Vector"]
+
+    axis = link_math(ng, 'ADD', scaled(right, cos_a, 150), scaled(up, sin_a, 0), (-600, 100),
+                      "ShaderNodeVectorMath")
+    # Rotate about the view axis (pivot z) until local x lies along the stretch axis.
+    align = N('FunctionNodeAlignEulerToVector')
+    align.axis, align.pivot_axis, align.location = 'X', 'Z', (-400, 200)
+    L(cam.outputs["Rotation"], align.inputs["Rotation"])
+    L(axis, align.inputs["Vector"])
+    # Scale (size stretch, size, 1): the quad is 1 m wide, so `size` is the stencil diameter.
+    xyz = N('ShaderNodeCombineXYZ')
+    xyz.location = (-400, -300)
+    L(link_math(ng, 'MULTIPLY', size, stretch, (-600, -350)), xyz.inputs["X"])
+    L(size, xyz.inputs["Y"])
+    xyz.inputs["Z"].default_value = 1.0
+
+    quad = N('GeometryNodeMeshGrid')  # 1x1 m, 2x2 vertices, with its "uv_map" in [0, 1]²
+    quad.location = (-400, -550)
+    quad.inputs["Size X"].default_value = quad.inputs["Size Y"].default_value = 1.0
+    quad.inputs["Vertices X"].default_value = quad.inputs["Vertices Y"].default_value = 2
+    # Stencil coordinates in [0, 1]² as a 3-D point attribute (Cycles 3.4 does not read the
+    # grid's 2-D "uv_map" through an Attribute node): position + 0.5 on the 1 m quad.
+    pos = N('GeometryNodeInputPosition')
+    pos.location = (-400, -750)
+    uv = N('GeometryNodeStoreNamedAttribute')
+    uv.data_type, uv.domain, uv.location = 'FLOAT_VECTOR', 'POINT', (-200, -550)
+    uv.inputs["Name"].default_value = UV_ATTRIBUTE
+    L(quad.outputs["Mesh"], uv.inputs["Geometry"])
+    L(link_math(ng, 'ADD', pos.outputs["Position"], None, (-300, -750), "ShaderNodeVectorMath"),
+      uv.inputs["Value"])
+    uv.inputs["Value"].links[0].from_node.inputs[1].default_value = (0.5, 0.5, 0.0)
+    setmat = N('GeometryNodeSetMaterial')
+    setmat.location = (0, -550)
+    L(uv.outputs["Geometry"], setmat.inputs["Geometry"])
+    L(gin.outputs["Material"], setmat.inputs["Material"])
+
+    inst = N('GeometryNodeInstanceOnPoints')
+    inst.location = (300, 0)
+    L(gin.outputs["Geometry"], inst.inputs["Points"])
+    L(setmat.outputs["Geometry"], inst.inputs["Instance"])
+    L(align.outputs["Rotation"], inst.inputs["Rotation"])
+    L(xyz.outputs["Vector"], inst.inputs["Scale"])
+    # Realized, so the shader reads the points' attributes (color) as plain mesh attributes.
+    real = N('GeometryNodeRealizeInstances')
+    real.location = (600, 0)
+    L(inst.outputs["Instances"], real.inputs["Geometry"])
+    L(real.outputs["Geometry"], gout.inputs["Geometry"])
+    return ng
+
+
+def apply_billboards(ob, camera, material):
+    """Adds (or updates) the object's "Plume Toon Billboards" modifier."""
+    ng = billboard_group()
+    mod = ob.modifiers.get(GROUP)
+    if mod is None or mod.type != 'NODES':
+        mod = ob.modifiers.new(GROUP, 'NODES')
+    mod.node_group = ng
+    ids = {s.name: s.identifier for s in ng.inputs}
+    mod[ids["Camera"]] = camera
+    mod[ids["Material"]] = material
+    ob.data.update()
+    return mod
+
+
+def toon_material(name, stencil_path, settings):
+    """Flat toon shading (§2.2): Emission coloured by the ramp of the point's `color`, cut out by
+    the stencil's alpha > ALPHA_THRESHOLD (mixed with Transparent, so 0 or 1, never blended)."""
+    mat = bpy.data.materials.get(name) or bpy.data.materials.new(name)
+    mat.use_nodes = True
+    mat.blend_method = 'CLIP'
+    mat.alpha_threshold = ALPHA_THRESHOLD
+    mat.shadow_method = 'CLIP'
+    mat.use_backface_culling = False
+    nt = mat.node_tree
+    nt.nodes.clear()
+    N, L = nt.nodes.new, nt.links.new
+    uv = N('ShaderNodeAttribute')
+    uv.attribute_type, uv.attribute_name, uv.location = 'GEOMETRY', UV_ATTRIBUTE, (-900, 200)
+    tex = N('ShaderNodeTexImage')
+    tex.location, tex.extension, tex.interpolation = (-700, 200), 'CLIP', 'Linear'
+    img = bpy.data.images.load(stencil_path, check_existing=True)
+    img.reload()  # a regenerated stencil file replaces what Blender had loaded
+    tex.image = img
+    L(uv.outputs["Vector"], tex.inputs["Vector"])
+    opaque = link_math(nt, 'GREATER_THAN', tex.outputs["Alpha"], ALPHA_THRESHOLD, (-450, 200))
+
+    col = N('ShaderNodeAttribute')
+    col.attribute_type, col.attribute_name, col.location = 'GEOMETRY', "color", (-900, -150)
+    ramp = N('ShaderNodeValToRGB')
+    ramp.location = (-650, -150)
+    els = ramp.color_ramp.elements
+    els[0].color, els[1].color = tuple(settings.ramp_color_low), tuple(settings.ramp_color_high)
+    L(col.outputs["Fac"], ramp.inputs["Fac"])
+    em = N('ShaderNodeEmission')
+    em.location = (-300, -150)
+    em.inputs["Strength"].default_value = 1.0
+    L(ramp.outputs["Color"], em.inputs["Color"])
+    tr = N('ShaderNodeBsdfTransparent')
+    tr.location = (-300, 50)
+    mix = N('ShaderNodeMixShader')
+    mix.location = (-50, 50)
+    L(opaque, mix.inputs["Fac"])
+    L(tr.outputs[0], mix.inputs[1])
+    L(em.outputs[0], mix.inputs[2])
+    out = N('ShaderNodeOutputMaterial')
+    out.location = (150, 50)
+    L(mix.outputs[0], out.inputs["Surface"])
+    return mat

@@ -1,0 +1,222 @@
+"""Toon smoke from a baked cache, no ``bpy`` (cartoon_smoke.txt §2.1-2.3): settings and their
+validation, the native ToonParams they map to, and the runner that walks the bake's
+volume_####.vdb frames with _native.ToonParticles and writes one toon_####.bin per frame.
+
+    s = ToonSettings(...); validate(s, "Domain")
+    m = toon_manifest(folder, "Domain")                 # BakeError when there is no bake
+    result = ToonRunner(native, folder, m, s).run()     # toon_<frame>.bin, atomically
+"""
+
+import math
+import os
+import re
+from dataclasses import dataclass, fields
+from typing import Callable, Optional, Tuple
+
+from . import cache
+from .settings import BakeError
+
+#: Stencils (Figure 3); IMAGE uses the artist's image file.
+STENCILS = ('CIRCLE', 'PUFFY', 'HAIRY', 'IMAGE')
+COLOR_DRIVERS = ('DENSITY', 'TEMPERATURE', 'SPEED')
+INTEGRATIONS = ('EULER', 'MIDPOINT')
+
+_TOON_RE = re.compile(r"^toon_(-?\d+)\.bin$")
+
+
+def toon_path(folder, frame):
+    return os.path.join(folder, f"toon_{frame:04d}.bin")
+
+
+def toon_frames(folder):
+    """Frame numbers of the toon_*.bin files present, sorted."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(int(m.group(1)) for m in map(_TOON_RE.match, names) if m)
+
+
+@dataclass
+class ToonSettings:
+    """Everything plume.toon_build reads from obj.plume.domain.toon (names as ToonParams)."""
+
+    # Particles (§2.1, §2.3) -> _native.ToonParams
+    emission_count: int = 10
+    birth_density: float = 0.5      # ρ_birth
+    death_density: float = 0.05     # ρ_death
+    ramp_density_low: float = 0.0   # d0
+    ramp_density_high: float = 1.0  # d1
+    size_low: float = 0.02          # s0 (m)
+    size_high: float = 0.1          # s1 (m)
+    max_size_change: float = 0.1
+    max_count: int = 200000
+    integration: str = 'EULER'
+    cfl: float = 1.0
+    seed: int = 0
+    stretch_factor: float = 0.5     # k
+    color_driver: str = 'DENSITY'
+    color_low: float = 0.0
+    color_high: float = 1.0
+    threads: int = 0
+    # Rendering (§2.2), used by the Blender side only
+    depth_threshold: float = 0.1    # γ
+    stencil: str = 'PUFFY'
+    stencil_image: str = ""         # absolute path when stencil == 'IMAGE'
+    ignore_background: bool = False
+
+
+#: ToonSettings fields copied one to one into _native.ToonParams (enums converted by name).
+PARAM_FIELDS = ('emission_count', 'birth_density', 'death_density', 'ramp_density_low',
+                'ramp_density_high', 'size_low', 'size_high', 'max_size_change', 'max_count',
+                'integration', 'cfl', 'seed', 'stretch_factor', 'color_driver', 'color_low',
+                'color_high', 'threads')
+
+
+def _finite(name, value, where):
+    if not math.isfinite(value):
+        raise BakeError(f"Plume: {where}toon {name} must be a finite number (got {value})")
+
+
+def validate(s: ToonSettings, domain_name=""):
+    """BakeError naming the setting and its accepted range; the native validate() covers the
+    rest of the particle settings (see to_params)."""
+    where = f"domain '{domain_name}': " if domain_name else ""
+    for f in fields(s):
+        v = getattr(s, f.name)
+        if isinstance(v, float):
+            _finite(f.name, v, where)
+    if s.depth_threshold < 0.0:
+        raise BakeError(f"Plume: {where}toon depth_threshold (γ) must be >= 0 (depth difference "
+                        "per pixel above which a pixel is outlined, §2.2; got "
+                        f"{s.depth_threshold})")
+    if s.death_density < 0.0 or s.birth_density <= s.death_density:
+        raise BakeError(f"Plume: {where}toon densities need 0 <= death_density (ρ_death) < "
+                        f"birth_density (ρ_birth) (got ρ_death = {s.death_density}, ρ_birth = "
+                        f"{s.birth_density})")
+    if s.ramp_density_high <= s.ramp_density_low:
+        raise BakeError(f"Plume: {where}toon size ramp needs ramp_density_low (d0) < "
+                        f"ramp_density_high (d1) (got {s.ramp_density_low}, "
+                        f"{s.ramp_density_high})")
+    if s.size_low < 0.0 or s.size_high < 0.0 or max(s.size_low, s.size_high) <= 0.0:
+        raise BakeError(f"Plume: {where}toon sizes s0, s1 must be >= 0 and not both 0 (m; got "
+                        f"{s.size_low}, {s.size_high})")
+    if s.color_high <= s.color_low:
+        raise BakeError(f"Plume: {where}toon colour ramp needs color_low < color_high (got "
+                        f"{s.color_low}, {s.color_high})")
+    if s.stencil not in STENCILS:
+        raise BakeError(f"Plume: {where}toon stencil must be one of {', '.join(STENCILS)} "
+                        f"(got {s.stencil!r})")
+    if s.stencil == 'IMAGE':
+        if not s.stencil_image:
+            raise BakeError(f"Plume: {where}toon stencil is IMAGE but no stencil_image is set: "
+                            "pick an image file (its alpha is the cut-out)")
+        if not os.path.isfile(s.stencil_image):
+            raise BakeError(f"Plume: {where}toon stencil_image {s.stencil_image} does not exist")
+    if s.color_driver not in COLOR_DRIVERS:
+        raise BakeError(f"Plume: {where}toon color_driver must be one of "
+                        f"{', '.join(COLOR_DRIVERS)} (got {s.color_driver!r})")
+    if s.integration not in INTEGRATIONS:
+        raise BakeError(f"Plume: {where}toon integration must be one of "
+                        f"{', '.join(INTEGRATIONS)} (got {s.integration!r})")
+
+
+def to_params(native, s: ToonSettings, domain_name=""):
+    """_native.ToonParams of the settings, validated (BakeError with the native message)."""
+    p = native.ToonParams()
+    for name in PARAM_FIELDS:
+        v = getattr(s, name)
+        if name == 'integration':
+            v = getattr(native.ToonIntegration, v)
+        elif name == 'color_driver':
+            v = getattr(native.ToonColorDriver, v)
+        try:
+            setattr(p, name, v)
+        except TypeError as e:  # e.g. a negative seed into an unsigned field
+            raise BakeError(f"Plume: domain '{domain_name}': toon {name}: {e}") from None
+    try:
+        p.validate()
+    except ValueError as e:
+        raise BakeError(f"Plume: domain '{domain_name}': toon {e}") from None
+    return p
+
+
+def toon_manifest(folder, domain_name):
+    """The bake's manifest; BakeError when the domain has no complete frame to read."""
+    m = cache.read_manifest(folder)
+    if m is None or m.get("last_complete_frame", -1) < m.get("frame_start", 0):
+        raise BakeError(f"Plume: domain '{domain_name}' has no bake yet: bake it first "
+                        "(plume.bake), then build the toon smoke")
+    first = cache.volume_path(folder, int(m["frame_start"]))
+    if not os.path.isfile(first):
+        raise BakeError(f"Plume: volume file {first} is missing: bake the domain again")
+    return m
+
+
+def frame_dt(manifest):
+    """Seconds per frame of the bake (time scale / fps, as the solver used)."""
+    dt = manifest.get("settings", {}).get("solver", {}).get("frame_dt")
+    if dt is None or not math.isfinite(float(dt)) or float(dt) <= 0.0:
+        raise BakeError("Plume: the bake's manifest has no frame_dt: bake the domain again")
+    return float(dt)
+
+
+@dataclass
+class ToonResult:
+    frame_start: int
+    last_frame: int          # last toon frame written (frame_start - 1 when none)
+    cancelled: bool = False
+    count: int = 0           # particles at the last frame written
+    max_count_seen: int = 0  # most particles at any frame
+
+
+class ToonRunner:
+    """Walks the bake frame by frame: frame_start advances from its own fields (birth only),
+    each next frame from the previous volume to its own (§2.1 advection, §2.3 evolution), and
+    writes toon_<frame>.bin after each. progress(frames_done, frames_total) and cancel() are
+    optional callables; a cancelled run keeps the frames written so far."""
+
+    def __init__(self, native, folder, manifest, settings: ToonSettings, domain_name="",
+                 progress: Optional[Callable[[int, int], None]] = None,
+                 cancel: Optional[Callable[[], bool]] = None):
+        self.native = native
+        self.folder = folder
+        self.manifest = manifest
+        self.params = to_params(native, settings, domain_name)
+        self.progress = progress
+        self.cancel = cancel
+        self.frame_start = int(manifest["frame_start"])
+        self.last_frame = int(manifest["last_complete_frame"])
+        self.dt = frame_dt(manifest)
+        self.grid: Tuple = (tuple(int(v) for v in manifest["resolution"]),
+                            tuple(float(v) for v in manifest["origin"]),
+                            float(manifest["cell_size"]))
+
+    def run(self) -> ToonResult:
+        native, folder = self.native, self.folder
+        try:
+            particles = native.ToonParticles(self.params, *self.grid)
+        except ValueError as e:
+            raise BakeError(f"Plume: toon particles: {e}") from None
+        result = ToonResult(frame_start=self.frame_start, last_frame=self.frame_start - 1)
+        total = self.last_frame - self.frame_start + 1
+        # Frames of an older build would mix with this one (a cancel keeps a prefix): remove them.
+        for f in toon_frames(folder):
+            os.remove(toon_path(folder, f))
+        for frame in range(self.frame_start, self.last_frame + 1):
+            if self.cancel is not None and self.cancel():
+                result.cancelled = True
+                break
+            before = cache.volume_path(folder, max(frame - 1, self.frame_start))
+            after = cache.volume_path(folder, frame)
+            try:
+                particles.advance_frame_from_vdb(before, after, self.dt)
+                particles.write(toon_path(folder, frame))
+            except (RuntimeError, ValueError) as e:
+                raise BakeError(f"Plume: toon frame {frame}: {e} (bake the domain again)") from None
+            result.last_frame = frame
+            result.count = int(particles.count)
+            result.max_count_seen = max(result.max_count_seen, result.count)
+            if self.progress is not None:
+                self.progress(frame - self.frame_start + 1, total)
+        return result

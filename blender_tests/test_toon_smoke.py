@@ -1,0 +1,254 @@
+"""Toon smoke end to end (cartoon_smoke.txt §2, issue 5): a small bake (24³, 20 frames), then
+plume.toon_build makes a point object that follows toon_####.bin on frame changes, billboards
+with a stencil cut-out, and the "Plume Depth Differences" compositor group. A 320x240 Cycles
+render saves the Depth pass and the group's outline as 32-bit EXR: the outline equals
+_native.depth_differences on the same depth in >= 99.9% of the pixels, outline pixels exist and
+the interior is flat-coloured. Bad input (no cache, γ < 0, missing stencil image, no camera)
+gives a clear error and changes nothing.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_toon_smoke.py
+"""
+
+import os
+import sys
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (OUT_DIR, add_domain, add_sphere_source, assert_reports_error,  # noqa: E402
+                     image_pixels, native, reset_scene, rmtree, run, select_only, temp_dir,
+                     tree_listing)
+
+RESOLUTION = 24
+FRAMES = 20
+RENDER_FRAME = 16
+GAMMA = 0.05
+LOW, HIGH = (0.1, 0.3, 0.8, 1.0), (0.9, 0.6, 0.1, 1.0)  # linear ramp colours (distinct from bg)
+WORLD = (0.02, 0.02, 0.02, 1.0)
+
+
+def build_scene(cache_dir, camera=True):
+    src = add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.4))
+    src.plume.source.velocity = (0.0, 0.0, 1.0)
+    src.plume.source.density = 2.0
+    dom = add_domain(resolution=RESOLUTION, frame_end=FRAMES, cache_directory=cache_dir + "/")
+    t = dom.plume.domain.toon
+    t.birth_density, t.death_density = 0.3, 0.05
+    t.size_low, t.size_high = 0.08, 0.2
+    t.max_size_change = 0.5
+    t.depth_threshold = GAMMA
+    t.stencil = 'PUFFY'
+    t.ramp_color_low, t.ramp_color_high = LOW, HIGH
+    scn = bpy.context.scene
+    if camera:
+        cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+        scn.collection.objects.link(cam)
+        cam.location = (0.0, -3.2, 1.0)
+        cam.rotation_euler = (np.pi / 2, 0.0, 0.0)
+        scn.camera = cam
+    scn.frame_start, scn.frame_end = 1, FRAMES
+    select_only(dom)
+    return dom
+
+
+def state(folder):
+    """Everything plume.toon_build may change: datablocks, scene settings, cache files."""
+    scn = bpy.context.scene
+    return (len(bpy.data.objects), len(bpy.data.meshes), len(bpy.data.materials),
+            len(bpy.data.images), len(bpy.data.node_groups), scn.use_nodes,
+            bpy.context.view_layer.use_pass_z, scn.render.use_lock_interface,
+            tuple(tree_listing(folder)))
+
+
+def file_output(nt, out_dir, name, socket):
+    """A 32-bit float EXR File Output of `socket` (frame number appended to `name`)."""
+    fo = nt.nodes.new('CompositorNodeOutputFile')
+    fo.base_path = out_dir
+    fo.format.file_format = 'OPEN_EXR'
+    fo.format.color_depth = '32'
+    fo.format.exr_codec = 'ZIP'
+    fo.file_slots[0].path = name
+    nt.links.new(socket, fo.inputs[0])
+
+
+class ToonSmokeTest(unittest.TestCase):
+    """One bake shared by the tests; each test starts from a fresh scene on the same cache."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = temp_dir("plume_toon_")
+        cls.cache = os.path.join(cls.tmp, "cache")
+        cls.folder = os.path.join(cls.cache, "Domain")
+
+    @classmethod
+    def tearDownClass(cls):
+        rmtree(cls.tmp)
+
+    def scene(self, camera=True, bake=True):
+        reset_scene()
+        dom = build_scene(self.cache, camera=camera)
+        if bake:
+            t0 = time.perf_counter()
+            self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})  # same settings: reused
+            print(f"  bake: {time.perf_counter() - t0:.1f} s")
+            select_only(dom)
+        return dom
+
+    def build(self):
+        t0 = time.perf_counter()
+        self.assertEqual(bpy.ops.plume.toon_build(), {'FINISHED'})
+        print(f"  toon_build: {time.perf_counter() - t0:.2f} s")
+        return bpy.data.objects["Domain_toon"]
+
+    def test_1_points_follow_cache(self):
+        dom = self.scene()
+        ob = self.build()
+        for f in range(1, FRAMES + 1):
+            self.assertTrue(os.path.isfile(os.path.join(self.folder, f"toon_{f:04d}.bin")), f)
+        from plume.build import toon_points
+        scn = bpy.context.scene
+        for f in (5, RENDER_FRAME):
+            scn.frame_set(f)
+            self.assertEqual(len(toon_points.last_update_seconds), 1)
+            snap = native().read_toon_file(os.path.join(self.folder, f"toon_{f:04d}.bin"))
+            n = len(snap["ids"])
+            self.assertGreater(n, 10, f)
+            me = ob.data
+            self.assertEqual(len(me.vertices), n)
+            co = np.empty(3 * n, np.float32)
+            me.vertices.foreach_get("co", co)
+            np.testing.assert_array_equal(co.reshape(n, 3), snap["positions"])
+            size = np.empty(n, np.float32)
+            me.attributes["size"].data.foreach_get("value", size)
+            np.testing.assert_array_equal(size, snap["size"])
+            for name in ("angle", "stretch", "color", "id"):
+                self.assertIn(name, me.attributes)
+            # angle/stretch: Figure 4 for the scene camera, as the native computes it.
+            b = native().toon_billboards(np.array(scn.camera.matrix_world), True,
+                                         snap["positions"], snap["velocities"], 0.5)
+            angle = np.empty(n, np.float32)
+            me.attributes["angle"].data.foreach_get("value", angle)
+            np.testing.assert_array_equal(angle, b["angle"])
+            # Billboards: one realized quad (4 vertices) per point, as wide as `size`.
+            ev = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+            self.assertEqual(len(ev.vertices), 4 * n)
+        print(f"  handler update: {toon_points.last_update_seconds[0] * 1e3:.2f} ms "
+              f"for {n} points")
+        self.assertEqual(ob.modifiers[0].node_group.name, "Plume Toon Billboards")
+        mat = bpy.data.materials["Plume Toon Domain"]
+        self.assertEqual(mat.blend_method, 'CLIP')
+        self.assertEqual(bpy.context.view_layer.pass_alpha_threshold, 0.5)
+        # The generated stencil is deterministic: a second build writes the same bytes.
+        path = os.path.join(self.folder, "stencil_puffy.png")
+        first = open(path, "rb").read()
+        dom.plume.domain.toon.use_freestyle = True  # the optional Freestyle style
+        self.build()
+        self.assertEqual(open(path, "rb").read(), first)
+        self.assertTrue(scn.render.use_freestyle)
+        self.assertIn("Plume Toon", bpy.context.view_layer.freestyle_settings.linesets)
+        # plume.cache_free removes the toon files with the rest of the bake.
+        self.assertEqual(bpy.ops.plume.cache_free(), {'FINISHED'})
+        self.assertFalse(os.path.exists(self.folder))
+
+    def test_2_render_outlines_match_native(self):
+        self.scene()
+        self.build()
+        scn = bpy.context.scene
+        scn.render.engine = 'CYCLES'
+        scn.cycles.device = 'CPU'
+        scn.cycles.samples = 4
+        scn.cycles.use_denoising = False
+        scn.render.resolution_x, scn.render.resolution_y = 320, 240
+        scn.render.resolution_percentage = 100
+        scn.view_settings.view_transform = 'Standard'
+        if scn.world is None:
+            scn.world = bpy.data.worlds.new("World")
+        scn.world.use_nodes = True
+        scn.world.node_tree.nodes["Background"].inputs["Color"].default_value = WORLD
+        bpy.data.objects["Domain"].hide_render = True
+        bpy.data.objects.get("Domain_smoke") and setattr(
+            bpy.data.objects["Domain_smoke"], "hide_render", True)
+        nt = scn.node_tree
+        group = nt.nodes["Plume Depth Differences"]
+        self.assertEqual(group.node_tree.name, "Plume Depth Differences")
+        rl = next(n for n in nt.nodes if n.type == 'R_LAYERS')
+        out = os.path.join(OUT_DIR, "toon")
+        os.makedirs(out, exist_ok=True)
+        file_output(nt, out, "depth", rl.outputs["Depth"])
+        file_output(nt, out, "outline", group.outputs["Outline"])
+        file_output(nt, out, "image", group.outputs["Image"])
+        scn.frame_set(RENDER_FRAME)
+        scn.render.filepath = os.path.join(out, "toon.png")
+        t0 = time.perf_counter()
+        bpy.ops.render.render(write_still=True)
+        print(f"  render 320x240: {time.perf_counter() - t0:.1f} s")
+        depth = image_pixels(os.path.join(out, f"depth{RENDER_FRAME:04d}.exr"))[..., 0]
+        outline = image_pixels(os.path.join(out, f"outline{RENDER_FRAME:04d}.exr"))[..., 0]
+        image = image_pixels(os.path.join(out, f"image{RENDER_FRAME:04d}.exr"))[..., :3]
+        far = scn.camera.data.clip_end
+        smoke = depth < far
+        self.assertGreater(smoke.mean(), 0.01)  # billboards cover part of the frame
+        ref = native().depth_differences(np.ascontiguousarray(depth), GAMMA)
+        agree = float(np.mean((outline > 0.5) == (ref == 1)))
+        print(f"  outline pixels: {int((outline > 0.5).sum())} compositor, {int(ref.sum())} "
+              f"native, agreement {agree * 100:.3f}%; smoke pixels {int(smoke.sum())}")
+        self.assertGreaterEqual(agree, 0.999)
+        self.assertGreater(int(ref.sum()), 50)
+        # Outline pixels carry the outline colour (black).
+        self.assertLess(float(np.abs(image[outline > 0.5]).max()), 1e-6)
+        # Interior (smoke, >= 2 px from any outline): flat colours on the ramp low..high; the
+        # only mixing is the pixel filter across two stencils, which stays on the ramp segment.
+        edge = outline > 0.5
+        near = edge.copy()
+        for dy in range(-2, 3):
+            for dx in range(-2, 3):
+                near |= np.roll(np.roll(edge, dy, 0), dx, 1)
+        interior = smoke & ~near
+        self.assertGreater(int(interior.sum()), 100)
+        lo, hi = np.array(LOW[:3]), np.array(HIGH[:3])
+        d = hi - lo
+        px = image[interior]
+        t = np.clip((px - lo) @ d / (d @ d), 0.0, 1.0)
+        dist = np.linalg.norm(px - (lo + t[:, None] * d), axis=1)
+        print(f"  interior pixels {len(px)}: max distance to the ramp {dist.max():.4f}")
+        self.assertLess(float(np.percentile(dist, 99)), 0.02)
+
+    def test_3_bad_input_changes_nothing(self):
+        dom = self.scene(bake=False)
+        d = dom.plume.domain
+        empty = os.path.join(self.tmp, "empty")
+        d.cache_directory = empty + "/"
+        op = bpy.ops.plume.toon_build
+        assert_reports_error(self, op, "has no bake yet", lambda: state(empty))
+        self.assertFalse(os.path.exists(empty))
+        d.cache_directory = self.cache + "/"
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        select_only(dom)
+        d.toon.depth_threshold = -0.1
+        assert_reports_error(self, op, r"depth_threshold \(γ\) must be >= 0",
+                             lambda: state(self.folder))
+        d.toon.depth_threshold = GAMMA
+        d.toon.stencil = 'IMAGE'
+        d.toon.stencil_image = os.path.join(self.tmp, "no_such_stencil.png")
+        assert_reports_error(self, op, "stencil_image .* does not exist",
+                             lambda: state(self.folder))
+        d.toon.stencil_image = ""
+        assert_reports_error(self, op, "no stencil_image is set", lambda: state(self.folder))
+        d.toon.stencil = 'CIRCLE'
+        d.toon.birth_density = 0.01
+        assert_reports_error(self, op, "death_density", lambda: state(self.folder))
+        d.toon.birth_density = 0.3
+        cam = bpy.context.scene.camera
+        bpy.context.scene.camera = None
+        assert_reports_error(self, op, "has no camera", lambda: state(self.folder))
+        bpy.context.scene.camera = cam
+        self.assertEqual(op(), {'FINISHED'})  # and with good input it builds
+
+
+if __name__ == "__main__":
+    run(ToonSmokeTest)
