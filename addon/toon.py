@@ -13,6 +13,8 @@ import re
 from dataclasses import dataclass, fields
 from typing import Callable, Optional, Tuple
 
+import numpy as np
+
 from . import cache
 from .settings import BakeError
 
@@ -153,6 +155,31 @@ def toon_manifest(folder, domain_name):
     return m
 
 
+def source_cells(native, manifest, emitters):
+    """(N, 3) int32 cells (i, j, k) of the Source emitters (snapshots) voxelized on the bake's
+    grid at its first frame, where §2.1 introduces the marker particles; None when there are
+    none. BakeError naming a source whose mesh cannot be voxelized."""
+    params = native.SmokeParams()
+    params.resolution = tuple(int(v) for v in manifest["resolution"])
+    params.cell_size = float(manifest["cell_size"])
+    params.origin = tuple(float(v) for v in manifest["origin"])
+    nx, ny, _nz = params.resolution
+    cells = []
+    for e in emitters:
+        if e.role != "SOURCE":
+            continue
+        try:
+            linear, _motion = native.source_cells(e.vertices, e.triangles, e.matrix_at(0),
+                                                  e.matrix_at(1), params, e.name)
+        except ValueError as err:
+            raise BakeError(f"Plume: source '{e.name}': {err}") from None
+        linear = np.asarray(linear, dtype=np.int64)
+        cells.append(np.stack([linear % nx, (linear // nx) % ny, linear // (nx * ny)], axis=1))
+    if not cells or sum(len(c) for c in cells) == 0:
+        return None
+    return np.ascontiguousarray(np.concatenate(cells), dtype=np.int32)
+
+
 def frame_dt(manifest):
     """Seconds per frame of the bake (time scale / fps, as the solver used)."""
     dt = manifest.get("settings", {}).get("solver", {}).get("frame_dt")
@@ -178,13 +205,15 @@ class ToonRunner:
 
     def __init__(self, native, folder, manifest, settings: ToonSettings, domain_name="",
                  progress: Optional[Callable[[int, int], None]] = None,
-                 cancel: Optional[Callable[[], bool]] = None):
+                 cancel: Optional[Callable[[], bool]] = None, source_cells=None):
         self.native = native
         self.folder = folder
         self.manifest = manifest
         self.params = to_params(native, settings, domain_name)
         self.progress = progress
         self.cancel = cancel
+        #: (N, 3) int cells of the domain's Sources: emission_count particles per frame (§2.1)
+        self.source_cells = source_cells
         self.frame_start = int(manifest["frame_start"])
         self.last_frame = int(manifest["last_complete_frame"])
         self.dt = frame_dt(manifest)
@@ -210,7 +239,8 @@ class ToonRunner:
             before = cache.volume_path(folder, max(frame - 1, self.frame_start))
             after = cache.volume_path(folder, frame)
             try:
-                particles.advance_frame_from_vdb(before, after, self.dt)
+                particles.advance_frame_from_vdb(before, after, self.dt,
+                                                 source_cells=self.source_cells)
                 particles.write(toon_path(folder, frame))
             except (RuntimeError, ValueError) as e:
                 raise BakeError(f"Plume: toon frame {frame}: {e} (bake the domain again)") from None

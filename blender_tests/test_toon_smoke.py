@@ -105,6 +105,22 @@ class ToonSmokeTest(unittest.TestCase):
         print(f"  toon_build: {time.perf_counter() - t0:.2f} s")
         return bpy.data.objects["Domain_toon"]
 
+    def test_0_source_cells(self):
+        """§2.1: particles are introduced at the source: the cells handed to the runner are the
+        source sphere's cells of the bake grid (centres inside radius + half a cell diagonal)."""
+        dom = self.scene()
+        from plume import cache, toon
+        from plume.snapshot import emitter_snapshots
+        m = cache.read_manifest(self.folder)
+        cells = toon.source_cells(native(), m, emitter_snapshots(bpy.context, dom, 1, 1))
+        self.assertIsNotNone(cells)
+        self.assertGreater(len(cells), 4)
+        h = float(m["cell_size"])
+        centres = np.asarray(m["origin"]) + (cells + 0.5) * h
+        dist = np.linalg.norm(centres - np.array([0.0, 0.0, 0.4]), axis=1)
+        self.assertLessEqual(dist.max(), 0.25 + 0.87 * h)
+        self.assertTrue(np.all(cells >= 0) and np.all(cells < np.asarray(m["resolution"])))
+
     def test_1_points_follow_cache(self):
         dom = self.scene()
         ob = self.build()

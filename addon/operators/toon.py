@@ -10,7 +10,7 @@ import bpy
 from .. import _native, toon
 from ..build import toon_compositor, toon_nodes, toon_points
 from ..settings import BakeError
-from ..snapshot import active_domain, cache_folder_of
+from ..snapshot import active_domain, cache_folder_of, emitter_snapshots
 from ..toon_stencils import write_stencil
 
 
@@ -48,8 +48,11 @@ class PLUME_OT_toon_build(bpy.types.Operator):
                 raise BakeError(f"Plume: scene '{scene.name}' has no camera: the billboards face "
                                 "the scene camera and the outlines need its Depth pass; set "
                                 "scene.camera")
+            frame_start = int(manifest["frame_start"])
+            emitters = emitter_snapshots(context, domain, frame_start, frame_start)
             runner = toon.ToonRunner(_native, folder, manifest, settings, domain.name,
-                                     progress=self._progress(context))
+                                     progress=self._progress(context),
+                                     source_cells=toon.source_cells(_native, manifest, emitters))
         except BakeError as e:
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
