@@ -10,7 +10,7 @@ import time
 import bpy
 import numpy as np
 
-from . import surface_edits
+from . import frame_handlers, surface_edits
 
 #: Custom properties of a surface object: its control-point cache and the domain it came from.
 CACHE_KEY = "plume_surface_cache"
@@ -98,13 +98,11 @@ def frame_change_pre(scene, *_args):
 
 
 def register():
-    if frame_change_pre not in bpy.app.handlers.frame_change_pre:
-        bpy.app.handlers.frame_change_pre.append(frame_change_pre)
+    frame_handlers.add(frame_change_pre)
 
 
 def unregister():
-    while frame_change_pre in bpy.app.handlers.frame_change_pre:
-        bpy.app.handlers.frame_change_pre.remove(frame_change_pre)
+    frame_handlers.remove(frame_change_pre)
     _loaded.clear()
 
 

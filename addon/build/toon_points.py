@@ -9,6 +9,7 @@ import time
 import bpy
 import numpy as np
 
+from . import frame_handlers
 from .surfaces import _file_path  # //-relative when the .blend is saved
 
 #: Custom properties of a toon object: its cache folder, the domain, the bake's frame range and
@@ -124,13 +125,11 @@ def frame_change_pre(scene, *_args):
 
 
 def register():
-    if frame_change_pre not in bpy.app.handlers.frame_change_pre:
-        bpy.app.handlers.frame_change_pre.append(frame_change_pre)
+    frame_handlers.add(frame_change_pre)
 
 
 def unregister():
-    while frame_change_pre in bpy.app.handlers.frame_change_pre:
-        bpy.app.handlers.frame_change_pre.remove(frame_change_pre)
+    frame_handlers.remove(frame_change_pre)
     _loaded.clear()
 
 
