@@ -2,6 +2,8 @@
 /// \file grid3.h
 /// Dense 3-D arrays of the solver (cell-centred scalars, flags) with x varying fastest.
 
+#include "core/huge_pages.h"
+
 #include <glm/glm.hpp>
 
 #include <cstddef>
@@ -21,15 +23,22 @@ class Grid3 {
 
   void resize(glm::ivec3 size, T value = T(0)) {
     mSize = size;
-    mData.assign(std::size_t(size.x) * std::size_t(size.y) * std::size_t(size.z), value);
+    const std::size_t count = std::size_t(size.x) * std::size_t(size.y) * std::size_t(size.z);
+    if (mData.capacity() < count) {
+      mData.clear();
+      reserveHugePages(mData, count);
+    }
+    mData.assign(count, value);
   }
   /// Changes the shape without initialising values; never reallocates when the new count fits in
   /// what was reserved before (scratch grids reuse one buffer for u, v and w shapes).
   void reshape(glm::ivec3 size) {
     mSize = size;
-    mData.resize(std::size_t(size.x) * std::size_t(size.y) * std::size_t(size.z));
+    const std::size_t count = std::size_t(size.x) * std::size_t(size.y) * std::size_t(size.z);
+    reserveHugePages(mData, count);
+    mData.resize(count);
   }
-  void reserve(std::size_t count) { mData.reserve(count); }
+  void reserve(std::size_t count) { reserveHugePages(mData, count); }
   void fill(T value) { std::fill(mData.begin(), mData.end(), value); }
 
   glm::ivec3 size() const { return mSize; }

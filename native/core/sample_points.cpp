@@ -1,5 +1,6 @@
 #include "core/sample_points.h"
 
+#include "core/huge_pages.h"
 #include "core/linear_cells.h"
 
 namespace plume {
@@ -29,8 +30,8 @@ const bool kHasAvx2 = hasAvx2();
 }  // namespace
 
 void SamplePoints::reserve(std::size_t count) {
-  mIndex.reserve(count);
-  for (std::vector<float>& t : mT) t.reserve(count);
+  reserveHugePages(mIndex, count);
+  for (std::vector<float>& t : mT) reserveHugePages(t, count);
 }
 
 void SamplePoints::resize(glm::ivec3 gridSize, std::size_t count) {

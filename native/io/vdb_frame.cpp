@@ -3,6 +3,7 @@
 
 #include "io/vdb_frame.h"
 
+#include "core/huge_pages.h"
 #include "core/parallel.h"
 #include "io/vdb_grids.h"
 
@@ -41,8 +42,18 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
   const std::size_t slab = std::size_t(n.x) * std::size_t(n.y);
 
   openvdb::GridPtrVec grids;
+  // The dense staging arrays (33 MB at 128³) are kept from frame to frame: allocated anew, their
+  // pages were faulted in again on every frame, which cost more than writing the file (Blender's
+  // allocator returns large blocks to the system).
+  // Per calling thread (two bakes may write at once); the tasks below use the caller's arrays
+  // through these references (a thread_local named in a task would be the worker's own).
+  thread_local std::vector<float> densityStage;
+  thread_local std::vector<openvdb::Vec3s> velocityStage;
+  std::vector<float>& density = densityStage;
+  std::vector<openvdb::Vec3s>& velocity = velocityStage;
   // Blender's Principled Volume reads `density`: what it shows is smoke plus soot.
-  std::vector<float> density(solver.density().count());
+  reserveHugePages(density, solver.density().count());
+  density.resize(solver.density().count());
   {
     const float* d = solver.density().data();
     const float* s = solver.soot().data();
@@ -57,7 +68,8 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
     // Cell-centred velocity (the mean of each cell's two faces per axis), stored only where
     // there is smoke or flame: the projection leaves tiny velocities in the whole domain, which
     // would make every frame a dense grid (270 MB for ten frames at 128³) for motion blur only.
-    std::vector<openvdb::Vec3s> velocity(solver.density().count());
+    reserveHugePages(velocity, solver.density().count());
+    velocity.resize(solver.density().count());
     const MacGrid3& mac = solver.velocity();
     const float* flame = solver.flame().data();
     const bool burning = p.combustion;

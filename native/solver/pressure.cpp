@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "core/cpu_features.h"
+#include "core/huge_pages.h"
 #include "core/parallel.h"
 #include "solver/band_solver.h"
 #include "solver/multigrid_level.h"
@@ -443,7 +444,10 @@ void PressureSolver::setup(const FlagGrid& cellTypes, const std::array<Boundary,
   // are never written, so they stay 0.
   m.levels.resize(sizes.size());
   auto fit = [](auto& v, std::size_t count) {
-    if (v.size() != count) v.assign(count, 0);
+    if (v.size() == count) return;
+    v.clear();
+    reserveHugePages(v, count);
+    v.assign(count, 0);
   };
   for (std::size_t l = 0; l < sizes.size(); ++l) {
     Level& L = m.levels[l];
