@@ -174,6 +174,7 @@ class ToonSmokeTest(unittest.TestCase):
     def test_2_render_outlines_match_native(self):
         self.scene()
         self.build()
+        self.build()  # an artist's rebuild: the compositor group must stay wired (it did not)
         scn = bpy.context.scene
         scn.render.engine = 'CYCLES'
         scn.cycles.device = 'CPU'

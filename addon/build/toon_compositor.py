@@ -104,10 +104,13 @@ def wire_scene(scene, view_layer, settings, far):
         'CompositorNodeRLayers')
     comp = next((n for n in nt.nodes if n.type == 'COMPOSITE'), None) or nt.nodes.new(
         'CompositorNodeComposite')
-    node = nt.nodes.get(NODE)
-    if node is None or node.type != 'GROUP':
-        node = nt.nodes.new('CompositorNodeGroup')
-        node.name = node.label = NODE
+    # A new group node each time: the group's sockets were just rebuilt, and a node kept from an
+    # earlier build would hold (and link to) its stale sockets - the second build lost the outline.
+    old = nt.nodes.get(NODE)
+    if old is not None:
+        nt.nodes.remove(old)
+    node = nt.nodes.new('CompositorNodeGroup')
+    node.name = node.label = NODE
     node.node_tree = group
     node.location = (rl.location.x + 300, rl.location.y)
     comp.location = (node.location.x + 300, node.location.y)
