@@ -298,6 +298,11 @@ class StreakBadInputTest(unittest.TestCase):
     def test_no_bake_yet(self):
         build_scene(self.cache, frame_end=3)
         self.assert_error(r"has no bake yet")
+        # The Most Surfaces button needs the bake too, and leaves h0 as it was.
+        h0 = bpy.data.objects["Domain"].plume.domain.streak_threshold
+        assert_reports_error(self, bpy.ops.plume.surfaces_pick_threshold, r"has no bake yet",
+                             counts)
+        self.assertEqual(bpy.data.objects["Domain"].plume.domain.streak_threshold, h0)
 
     def test_baked_without_streaks(self):
         build_scene(self.cache, frame_end=2, streaks=False)
