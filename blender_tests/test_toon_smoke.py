@@ -142,7 +142,7 @@ class ToonSmokeTest(unittest.TestCase):
             size = np.empty(n, np.float32)
             me.attributes["size"].data.foreach_get("value", size)
             np.testing.assert_array_equal(size, snap["size"])
-            for name in ("angle", "stretch", "color", "id"):
+            for name in ("angle", "stretch", "plume_color", "id"):
                 self.assertIn(name, me.attributes)
             # angle/stretch: Figure 4 for the scene camera, as the native computes it.
             b = native().toon_billboards(np.array(scn.camera.matrix_world), True,
@@ -232,8 +232,17 @@ class ToonSmokeTest(unittest.TestCase):
         px = image[interior]
         t = np.clip((px - lo) @ d / (d @ d), 0.0, 1.0)
         dist = np.linalg.norm(px - (lo + t[:, None] * d), axis=1)
-        print(f"  interior pixels {len(px)}: max distance to the ramp {dist.max():.4f}")
+        print(f"  interior pixels {len(px)}: max distance to the ramp {dist.max():.4f}, ramp "
+              f"position percentiles 5/50/95: {np.percentile(t, [5, 50, 95]).round(3)}")
         self.assertLess(float(np.percentile(dist, 99)), 0.02)
+        # The ramp is driven by the particles' values (density here), not stuck at one end:
+        # the visible colours span much of the range the particles' ramp coordinates span.
+        ob = bpy.data.objects["Domain_toon"]
+        c = np.empty(len(ob.data.vertices), np.float32)
+        ob.data.attributes["plume_color"].data.foreach_get("value", c)
+        spread = float(np.percentile(t, 95) - np.percentile(t, 5))
+        print(f"  particle ramp coordinates {c.min():.3f}..{c.max():.3f}, pixel spread {spread:.3f}")
+        self.assertGreater(spread, 0.25 * float(c.max() - c.min()))
 
     def test_3_bad_input_changes_nothing(self):
         dom = self.scene(bake=False)

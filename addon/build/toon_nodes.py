@@ -11,6 +11,10 @@ GROUP = "Plume Toon Billboards"
 ALPHA_THRESHOLD = 0.5
 #: Point attribute of the billboards holding the stencil coordinates (u, v, 0).
 UV_ATTRIBUTE = "plume_uv"
+#: Point attribute with the colour-ramp coordinate in [0, 1] (written by toon_points). Not
+#: "color": Cycles maps that name to its standard volume colour, and a mesh attribute of that
+#: name reads as 0 in the shader.
+COLOR_ATTRIBUTE = "plume_color"
 
 
 def link_math(nt, op, a, b=None, location=(0, 0), kind="ShaderNodeMath"):
@@ -115,7 +119,7 @@ def billboard_group():
     L(setmat.outputs["Geometry"], inst.inputs["Instance"])
     L(align.outputs["Rotation"], inst.inputs["Rotation"])
     L(xyz.outputs["Vector"], inst.inputs["Scale"])
-    # Realized, so the shader reads the points' attributes (color) as plain mesh attributes.
+    # Realized, so the shader reads the points' attributes (colour) as plain mesh attributes.
     real = N('GeometryNodeRealizeInstances')
     real.location = (600, 0)
     L(inst.outputs["Instances"], real.inputs["Geometry"])
@@ -138,8 +142,8 @@ def apply_billboards(ob, camera, material):
 
 
 def toon_material(name, stencil_path, settings):
-    """Flat toon shading (§2.2): Emission coloured by the ramp of the point's `color`, cut out by
-    the stencil's alpha > ALPHA_THRESHOLD (mixed with Transparent, so 0 or 1, never blended)."""
+    """Flat toon shading (§2.2): Emission coloured by the ramp of the point's COLOR_ATTRIBUTE, cut
+    out by the stencil's alpha > ALPHA_THRESHOLD (mixed with Transparent, so 0 or 1, never blended)."""
     mat = bpy.data.materials.get(name) or bpy.data.materials.new(name)
     mat.use_nodes = True
     mat.blend_method = 'CLIP'
@@ -160,7 +164,8 @@ def toon_material(name, stencil_path, settings):
     opaque = link_math(nt, 'GREATER_THAN', tex.outputs["Alpha"], ALPHA_THRESHOLD, (-450, 200))
 
     col = N('ShaderNodeAttribute')
-    col.attribute_type, col.attribute_name, col.location = 'GEOMETRY', "color", (-900, -150)
+    col.attribute_type, col.location = 'GEOMETRY', (-900, -150)
+    col.attribute_name = COLOR_ATTRIBUTE
     ramp = N('ShaderNodeValToRGB')
     ramp.location = (-650, -150)
     els = ramp.color_ramp.elements

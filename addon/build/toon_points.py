@@ -10,6 +10,7 @@ import bpy
 import numpy as np
 
 from . import frame_handlers
+from .toon_nodes import COLOR_ATTRIBUTE
 from .surfaces import _file_path  # //-relative when the .blend is saved
 
 #: Custom properties of a toon object: its cache folder, the domain, the bake's frame range and
@@ -20,7 +21,7 @@ RANGE_KEY = "plume_toon_frames"
 STRETCH_KEY = "plume_toon_stretch"
 
 #: Point attributes written on every frame (FLOAT unless listed in INT_ATTRIBUTES).
-ATTRIBUTES = ("size", "angle", "stretch", "color", "id")
+ATTRIBUTES = ("size", "angle", "stretch", COLOR_ATTRIBUTE, "id")
 INT_ATTRIBUTES = ("id",)
 
 # path -> (mtime, snapshot dict) of the last toon file read per object
@@ -80,7 +81,7 @@ def write_points(mesh, snap, angle, stretch):
     mesh.vertices.add(n)
     mesh.vertices.foreach_set("co", np.ascontiguousarray(snap["positions"], np.float32).ravel())
     values = {"size": np.asarray(snap["size"], np.float32), "angle": angle, "stretch": stretch,
-              "color": np.asarray(snap["color"], np.float32),
+              COLOR_ATTRIBUTE: np.asarray(snap["color"], np.float32),
               # ids never repeat; int32 wraps only after 2^31 births (GN's stable "id")
               "id": (np.asarray(snap["ids"], np.uint64) & np.uint64(0x7FFFFFFF)).astype(np.int32)}
     for name in ATTRIBUTES:
