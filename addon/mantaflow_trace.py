@@ -5,10 +5,10 @@ smoke_surfaces.txt §3.2: particles "advected by the velocity field"), no ``bpy`
     runner.prepare()   # raises BakeError on bad input; writes nothing, changes nothing
     result = runner.run()   # blocking; may run on a worker thread (native calls drop the GIL)
 
-Same interface and cache files as bake_runner.BakeRunner with streak surfaces on, so Build
-Surfaces and the density maps work unchanged: streaks_####.bin (world positions), volume_####.vdb
-(the Mantaflow density and cell-centred velocity, placed in world space) and manifest.json with
-"streaks": true and "motion_source": "mantaflow". Frame f of the cache = the tracers after the
+Same interface and cache files as bake_runner.BakeRunner, so Build Surfaces, the density maps
+and Build Toon Smoke work unchanged: streaks_####.bin (world positions; with streak surfaces
+on), volume_####.vdb (the Mantaflow density and cell-centred velocity, placed in world space) and
+manifest.json with "motion_source": "mantaflow". Frame f of the cache = the tracers after the
 frames frame_start..f, the particles born at the start of frame_start from still point sources in
 the Plume Source objects' cells. The velocity between two cached frames is linear in time (see
 native/tracers/mantaflow_driver.h). A trace is cheap, so it always starts over (no resume).
@@ -53,6 +53,7 @@ class MantaflowTraceRunner(BakeRunner):
         self._grid = None
         self._start = None  # fields at the start of frame_start
         self._first = None  # fields at the end of frame_start
+        self._tracer = None  # native.MantaflowTracer; None with streak surfaces off
 
     # ---------------------------------------------------------------- validation
     def prepare(self):
@@ -62,16 +63,30 @@ class MantaflowTraceRunner(BakeRunner):
         owner = f"Plume: domain '{snap.domain_name}'"
         validate_python_side(snap.domain_name, snap.resolution, snap.frame_start, snap.frame_end,
                              snap.solver)
-        if not snap.streaks.enabled:
-            raise BakeError(f"{owner}: motion_source MANTAFLOW traces streak surfaces: turn on "
-                            "Streak Surfaces (streaks) or set motion_source to PLUME")
         validate_streaks(snap.domain_name, snap.streaks, snap.emitters)
         plan = check_source(snap.mantaflow, snap.frame_start, snap.frame_end)
-        closed = [native.Boundary.CLOSED if c else native.Boundary.OPEN
-                  for c in snap.mantaflow.borders_closed]
         try:
             self._grid = native.MantaflowGrid(plan.resolution, plan.origin, plan.cell_size,
                                               TIME_UNITS_PER_SECOND)
+        except ValueError as e:
+            raise BakeError(f"{owner}: {e}") from None
+        if snap.streaks.enabled:  # without streaks: the frames only, for the toon smoke
+            self._prepare_tracer(plan, owner)
+        self._frames = plan
+        self._start = (self._read(plan.start_file) if plan.start_file
+                       else native.MantaflowFrame.empty(plan.resolution))
+        self._first = self._read(plan.files[0])
+        error = cache.check_writable(snap.cache_folder)
+        if error is not None:
+            raise BakeError(f"Plume: cache_directory '{snap.cache_directory}' is not writable "
+                            f"({snap.cache_folder}: {error})")
+
+    def _prepare_tracer(self, plan, owner):
+        """The streak tracer on the Mantaflow grid with the Sources' point sources."""
+        snap, native = self.snapshot, self._native
+        closed = [native.Boundary.CLOSED if c else native.Boundary.OPEN
+                  for c in snap.mantaflow.borders_closed]
+        try:
             self._tracer = native.MantaflowTracer(
                 self._grid, emission_period=snap.streaks.emission_period,
                 interpolation=getattr(native.Interpolation, snap.solver.interpolation),
@@ -86,14 +101,6 @@ class MantaflowTraceRunner(BakeRunner):
             self._tracer.add_point_sources(points, groups)
         except ValueError as e:
             raise BakeError(f"{owner}: point sources: {e}") from None
-        self._frames = plan
-        self._start = (self._read(plan.start_file) if plan.start_file
-                       else native.MantaflowFrame.empty(plan.resolution))
-        self._first = self._read(plan.files[0])
-        error = cache.check_writable(snap.cache_folder)
-        if error is not None:
-            raise BakeError(f"Plume: cache_directory '{snap.cache_directory}' is not writable "
-                            f"({snap.cache_folder}: {error})")
 
     def _read(self, path):
         try:
@@ -120,13 +127,15 @@ class MantaflowTraceRunner(BakeRunner):
                     result.cancelled = True
                     break
                 fields = self._first if n == 0 else self._read(plan.files[n])
-                self._tracer.emitting = emits_during(self._emitting_sources, n)  # Figure 10
-                if self._tracer.advance_frame(previous, fields, plan.frame_dts[n]) == 0:
-                    result.cancelled = True
-                    break
+                if self._tracer is not None:
+                    self._tracer.emitting = emits_during(self._emitting_sources, n)  # Figure 10
+                    if self._tracer.advance_frame(previous, fields, plan.frame_dts[n]) == 0:
+                        result.cancelled = True
+                        break
                 native.write_mantaflow_volume(cache.volume_path(folder, frame), fields,
                                               self._grid, frame)
-                self._tracer.write_snapshot(cache.streak_path(folder, frame))
+                if self._tracer is not None:
+                    self._tracer.write_snapshot(cache.streak_path(folder, frame))
                 previous = fields
                 self._frame_done(folder, manifest, result, frame, t0)
         finally:
@@ -144,6 +153,7 @@ class MantaflowTraceRunner(BakeRunner):
         longest = int(np.argmax(np.asarray(plan.resolution) * np.asarray(plan.cell_size)))
         m.update(motion_source="mantaflow", mantaflow_domain=snap.mantaflow.object_name,
                  resolution=list(plan.resolution), cell_size=float(plan.cell_size[longest]),
-                 cell_size_xyz=list(plan.cell_size), origin=list(plan.origin), streaks=True,
+                 cell_size_xyz=list(plan.cell_size), origin=list(plan.origin),
+                 streaks=snap.streaks.enabled,
                  last_run={"resumed": False, "computed_frames": [], "cancelled": False})
         return m

@@ -152,9 +152,11 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         items=(('PLUME', "Plume Simulation", "Simulate the smoke with Plume and trace its velocity"),
                ('MANTAFLOW', "Mantaflow Cache",
                 "Trace the velocity of an existing Blender Mantaflow gas bake (OpenVDB cache) "
-                "instead of simulating; the volume frames hold the Mantaflow density")),
-        description="What moves the streak particles (smoke_surfaces.txt §3.2: particles "
-                    "\"advected by the velocity field\")")
+                "instead of simulating; the volume frames hold the Mantaflow density, and "
+                "the streak surfaces and toon smoke follow its velocity")),
+        description="What moves the streak and toon particles (smoke_surfaces.txt §3.2: "
+                    "particles \"advected by the velocity field\"; cartoon_smoke.txt §2.1: "
+                    "\"we require only the output of a smoke simulator\")")
     mantaflow_domain: PointerProperty(
         name="Mantaflow Domain", type=bpy.types.Object, poll=lambda _self, ob: is_gas_domain(ob),
         description="Blender fluid domain (type Gas, adaptive domain off) whose OpenVDB cache, "

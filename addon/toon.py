@@ -155,14 +155,48 @@ def toon_manifest(folder, domain_name):
     return m
 
 
-def source_cells(native, manifest, emitters):
-    """(N, 3) int32 cells (i, j, k) of the Source emitters (snapshots) voxelized on the bake's
-    grid at its first frame, where §2.1 introduces the marker particles; None when there are
-    none. BakeError naming a source whose mesh cannot be voxelized."""
+@dataclass(frozen=True)
+class ToonGrid:
+    """The cubic grid the toon particles live on. A Plume bake's own grid; for a traced Mantaflow
+    bake, whose cells are not cubic ("cell_size_xyz" in its manifest), cubic cells of its
+    smallest cell size over its box, onto which its volume frames are interpolated (resample)."""
+    resolution: Tuple[int, int, int]
+    origin: Tuple[float, float, float]
+    cell_size: float
+    resample: bool = False
+
+    def args(self):
+        """(resolution, origin, cell_size, resample) as _native.ToonParticles takes them."""
+        return self.resolution, self.origin, self.cell_size, self.resample
+
+
+def toon_grid(manifest):
+    res = tuple(int(v) for v in manifest["resolution"])
+    origin = tuple(float(v) for v in manifest["origin"])
+    cells = manifest.get("cell_size_xyz")
+    if cells is None or max(cells) - min(cells) <= 1e-6 * max(cells):
+        return ToonGrid(res, origin, float(manifest["cell_size"]))
+    h = float(min(cells))
+    size = np.asarray(res, np.float64) * np.asarray(cells, np.float64)
+    return ToonGrid(tuple(max(1, int(math.ceil(s / h - 1e-4))) for s in size), origin, h, True)
+
+
+def check_bake(settings: ToonSettings, manifest, domain_name=""):
+    """BakeError when the settings need a field the bake does not carry: a traced Mantaflow bake
+    holds density and velocity only (no temperature to drive the colour ramp)."""
+    if manifest.get("motion_source") == "mantaflow" and settings.color_driver == 'TEMPERATURE':
+        raise BakeError(f"Plume: domain '{domain_name}' traces a Mantaflow cache, which carries "
+                        "density and velocity only: set the toon color_driver to DENSITY or SPEED")
+
+
+def source_cells(native, grid, emitters):
+    """(N, 3) int32 cells (i, j, k) of the Source emitters (snapshots) voxelized on the toon
+    grid at the bake's first frame, where §2.1 introduces the marker particles; None when there
+    are none. BakeError naming a source whose mesh cannot be voxelized."""
     params = native.SmokeParams()
-    params.resolution = tuple(int(v) for v in manifest["resolution"])
-    params.cell_size = float(manifest["cell_size"])
-    params.origin = tuple(float(v) for v in manifest["origin"])
+    params.resolution = grid.resolution
+    params.cell_size = grid.cell_size
+    params.origin = grid.origin
     nx, ny, _nz = params.resolution
     cells = []
     for e in emitters:
@@ -217,14 +251,12 @@ class ToonRunner:
         self.frame_start = int(manifest["frame_start"])
         self.last_frame = int(manifest["last_complete_frame"])
         self.dt = frame_dt(manifest)
-        self.grid: Tuple = (tuple(int(v) for v in manifest["resolution"]),
-                            tuple(float(v) for v in manifest["origin"]),
-                            float(manifest["cell_size"]))
+        self.grid = toon_grid(manifest)
 
     def run(self) -> ToonResult:
         native, folder = self.native, self.folder
         try:
-            particles = native.ToonParticles(self.params, *self.grid)
+            particles = native.ToonParticles(self.params, *self.grid.args())
         except ValueError as e:
             raise BakeError(f"Plume: toon particles: {e}") from None
         result = ToonResult(frame_start=self.frame_start, last_frame=self.frame_start - 1)

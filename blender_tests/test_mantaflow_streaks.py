@@ -1,7 +1,7 @@
 """Streak surfaces driven by a Blender Mantaflow cache (issue 4; smoke_surfaces.txt §3.2): a
 Quick Smoke domain (resolution 32, 20 frames, OpenVDB) is baked once by Mantaflow; a Plume domain
 with motion_source 'MANTAFLOW' traces it (no Plume simulation) and plume.surfaces_build makes
-surfaces from the result. The particles rise with the Mantaflow smoke and stay in it, checked
+surfaces from the result; plume.toon_build makes toon smoke from it (issue 5). The particles rise with the Mantaflow smoke and stay in it, checked
 against Blender's own reading of the cache. Bad input (no Mantaflow domain set, a domain not
 baked, a cache in another format) gives a clear error and writes nothing.
 
@@ -19,8 +19,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (add_domain, native, reset_scene, rmtree, run, select_only,  # noqa: E402
-                     temp_dir, tree_listing)
+from helpers import (add_domain, assert_reports_error, native, reset_scene,  # noqa: E402
+                     rmtree, run, select_only, temp_dir, tree_listing)
 
 FRAMES = 20
 EMITTER_AT = (0.0, 0.0, 0.3)
@@ -204,10 +204,56 @@ class MantaflowStreaksTest(unittest.TestCase):
         dom = plume_domain("UniFormat", self.tmp, gas)
         self.expect_error(dom, "cache_data_format is UNI", "OpenVDB")
 
-    def test_motion_source_needs_streaks_and_a_still_unrotated_domain(self):
-        dom = plume_domain("NoStreaks", self.tmp, self.manta)
-        dom.plume.domain.streaks = False
-        self.expect_error(dom, "turn on Streak Surfaces")
+    def test_toon_smoke_follows_the_mantaflow_smoke(self):
+        """Issue 5: toon smoke from a Mantaflow cache. With streak surfaces off the bake only
+        places the Mantaflow frames; plume.toon_build resamples them onto cubic cells (the
+        Mantaflow cells are not cubic) and its particles sit in Mantaflow's smoke."""
+        dom = plume_domain("ToonTraced", self.tmp, self.manta)
+        d = dom.plume.domain
+        d.streaks = False
+        t = d.toon
+        t.birth_density, t.death_density = 0.2, 0.02
+        t.color_driver = 'TEMPERATURE'
+        scn = bpy.context.scene
+        cam = bpy.data.objects.new("ToonCam", bpy.data.cameras.new("ToonCam"))
+        scn.collection.objects.link(cam)
+        cam.location, cam.rotation_euler = (0.0, -4.0, 1.0), (np.pi / 2, 0.0, 0.0)
+        scn.camera = cam
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        folder = os.path.join(self.tmp, "ToonTraced")
+        with open(os.path.join(folder, "manifest.json"), encoding="utf-8") as f:
+            m = json.load(f)
+        self.assertFalse(m["streaks"])
+        files = set(os.listdir(folder))
+        self.assertFalse(any(name.startswith("streaks_") for name in files))
+        self.assertIn(f"volume_{FRAMES:04d}.vdb", files)
+        from plume import toon
+        grid = toon.toon_grid(m)
+        print(f"  Mantaflow cells {m['cell_size_xyz']} -> toon grid {grid}")
+        select_only(dom)
+        # No temperature in a traced cache: the TEMPERATURE colour driver is refused.
+        assert_reports_error(self, bpy.ops.plume.toon_build, "carries density and velocity "
+                             "only.*DENSITY or SPEED",
+                             lambda: (datablock_counts(), tree_listing(folder)))
+        t.color_driver = 'DENSITY'
+        self.assertEqual(bpy.ops.plume.toon_build(), {'FINISHED'})
+        for f in (10, FRAMES):
+            density, cell_of, _centre0 = self.blender_density(f)
+            snap = native().read_toon_file(os.path.join(folder, f"toon_{f:04d}.bin"))
+            self.assertGreater(len(snap["ids"]), 20, f)
+            cells = cell_of(np.asarray(snap["positions"], np.float64))
+            inside = np.all((cells >= 0) & (cells < density.shape), axis=1)
+            self.assertTrue(inside.all())
+            in_smoke = density[cells[:, 0], cells[:, 1], cells[:, 2]] > 0.0
+            # Born where the resampled density > ρ_birth and moved with the Mantaflow flow;
+            # the particles' own density (sampled from the resampled field) is > 0.
+            print(f"  frame {f}: {len(cells)} toon particles, {in_smoke.mean() * 100:.1f}% in "
+                  "Mantaflow smoke cells")
+            self.assertGreaterEqual(in_smoke.mean(), 0.95, f"frame {f}")
+        ob = bpy.data.objects["ToonTraced_toon"]
+        self.assertEqual(len(ob.data.vertices), len(snap["ids"]))  # the frame is FRAMES now
+
+    def test_motion_source_needs_a_still_unrotated_domain(self):
         adaptive = unbaked_gas_domain(os.path.join(self.tmp, "adaptive"), "Adaptive Gas")
         adaptive.modifiers["Fluid"].domain_settings.use_adaptive_domain = True
         dom = plume_domain("Adaptive", self.tmp, adaptive)

@@ -112,7 +112,8 @@ class ToonSmokeTest(unittest.TestCase):
         from plume import cache, toon
         from plume.snapshot import emitter_snapshots
         m = cache.read_manifest(self.folder)
-        cells = toon.source_cells(native(), m, emitter_snapshots(bpy.context, dom, 1, 1))
+        cells = toon.source_cells(native(), toon.toon_grid(m),
+                                  emitter_snapshots(bpy.context, dom, 1, 1))
         self.assertIsNotNone(cells)
         self.assertGreater(len(cells), 4)
         h = float(m["cell_size"])

@@ -44,6 +44,7 @@ class PLUME_OT_toon_build(bpy.types.Operator):
             toon.validate(settings, domain.name)
             folder = cache_folder_of(domain)
             manifest = toon.toon_manifest(folder, domain.name)
+            toon.check_bake(settings, manifest, domain.name)
             if scene.camera is None:
                 raise BakeError(f"Plume: scene '{scene.name}' has no camera: the billboards face "
                                 "the scene camera and the outlines need its Depth pass; set "
@@ -52,7 +53,8 @@ class PLUME_OT_toon_build(bpy.types.Operator):
             emitters = emitter_snapshots(context, domain, frame_start, frame_start)
             runner = toon.ToonRunner(_native, folder, manifest, settings, domain.name,
                                      progress=self._progress(context),
-                                     source_cells=toon.source_cells(_native, manifest, emitters))
+                                     source_cells=toon.source_cells(
+                                         _native, toon.toon_grid(manifest), emitters))
         except BakeError as e:
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}

@@ -152,6 +152,10 @@ class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
         layout.use_property_split = True
         ob = context.object
         d = ob.plume.domain
+        layout.prop(d, "motion_source")
+        sub = layout.column()
+        sub.active = d.motion_source == 'MANTAFLOW'  # its cache moves the smoke, no simulation
+        sub.prop(d, "mantaflow_domain")
         layout.prop(d, "cache_directory", text="Directory")
         baking = is_baking(ob)
         row = layout.row(align=True)
@@ -180,10 +184,6 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         col = layout.column()
         col.active = d.streaks
         col.prop(d, "emission_period")
-        col.prop(d, "motion_source")
-        sub = col.column()
-        sub.active = d.motion_source == 'MANTAFLOW'  # its cache moves the particles, no simulation
-        sub.prop(d, "mantaflow_domain")
         row = col.row(align=True)
         row.prop(d, "streak_threshold")
         row.operator("plume.surfaces_pick_threshold", text="", icon='SORTSIZE')

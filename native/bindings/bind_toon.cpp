@@ -191,13 +191,17 @@ void bindFields(py::module_& m) {
   f.def_static(
       "from_vdb",
       [](const py::object& path, const std::array<int, 3>& res, const std::array<float, 3>& origin,
-         float cell) {
+         float cell, bool resample) {
         const GridFrame g = gridArg(res, origin, cell);
-        return withPath(path, [&](const std::string& p) { return readToonFields(p, g); });
+        return withPath(path, [&](const std::string& p) {
+          return resample ? resampleToonFields(p, g) : readToonFields(p, g);
+        });
       },
       py::arg("path"), py::arg("resolution"), py::arg("origin"), py::arg("cell_size"),
+      py::arg("resample") = false,
       "Reads a Plume volume_####.vdb onto the bake's grid (RuntimeError naming the file when it "
-      "is missing, unreadable or of another domain).");
+      "is missing, unreadable or of another domain). resample: interpolate a volume whose "
+      "voxels are not the grid's cells (a traced Mantaflow bake) onto the grid.");
   f.def_property_readonly("resolution", [](const ToonFields& x) {
     const glm::ivec3 n = x.density.size();
     return py::make_tuple(n.x, n.y, n.z);
@@ -215,12 +219,15 @@ void bindParticles(py::module_& m) {
       "source and born (size 0) in every empty cell denser than birth_density, up to max_count. "
       "Same settings and seed give the same particles at any thread count; ids never repeat.");
   c.def(py::init([](const ToonParams& p, const std::array<int, 3>& res,
-                    const std::array<float, 3>& origin, float cell) {
+                    const std::array<float, 3>& origin, float cell, bool resample) {
           const GridFrame g = gridArg(res, origin, cell);
-          return ToonSession{ToonParticles(p, g), ToonVolumeCache(g)};
+          return ToonSession{ToonParticles(p, g), ToonVolumeCache(g, resample)};
         }),
         py::arg("params"), py::arg("resolution"), py::arg("origin"), py::arg("cell_size"),
-        "On the bake's grid (resolution, world origin of cell (0,0,0)'s corner, cell size in m). "
+        py::arg("resample") = false,
+        "On the bake's grid (resolution, world origin of cell (0,0,0)'s corner, cell size in m; "
+        "resample: the volume frames are interpolated onto it, for a traced Mantaflow bake "
+        "whose cells are not cubic). "
         "ValueError on bad params or grid.");
   c.def(
       "advance_frame",

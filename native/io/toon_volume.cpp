@@ -77,7 +77,82 @@ void faceVelocities(const DenseGrid& g, glm::ivec3 n, MacGrid3& mac) {
       [&](glm::ivec3 p, int a) { return boxValue(g, p, a); });
 }
 
+/// The file's voxel coordinates of world position w.
+glm::vec3 voxelOf(const DenseGrid& g, glm::vec3 w) { return (w - g.worldOfVoxelZero) / g.voxelSizes; }
+
+/// Trilinear interpolation of component c at voxel coordinates q over the voxels for which
+/// use(voxel) holds, the weights renormalised over them; 0 when none is used.
+template <typename Use>
+float trilinear(const DenseGrid& g, glm::vec3 q, int c, const Use& use) {
+  const glm::vec3 fl = glm::floor(q);
+  const glm::ivec3 p0(fl);
+  const glm::vec3 t = q - fl;
+  float sum = 0.f, weight = 0.f;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::ivec3 d(corner & 1, (corner >> 1) & 1, corner >> 2);
+    const glm::ivec3 p = p0 + d;
+    if (!use(p)) continue;
+    const float w = (d.x ? t.x : 1.f - t.x) * (d.y ? t.y : 1.f - t.y) * (d.z ? t.z : 1.f - t.z);
+    sum += w * boxValue(g, p, c);
+    weight += w;
+  }
+  return weight > 0.f ? sum / weight : 0.f;
+}
+
+/// Checks that a grid to be resampled is axis-aligned, finite and inside `grid`'s box.
+void checkResampled(const DenseGrid& g, const GridFrame& grid, const std::string& path) {
+  if (!g.axisAligned || !(glm::all(glm::greaterThan(g.voxelSizes, glm::vec3(0.f)))))
+    fail(path, "grid '" + g.name + "' is not an axis-aligned grid of positive voxel sizes");
+  for (float v : g.values)
+    if (!std::isfinite(v)) fail(path, "grid '" + g.name + "' holds a non-finite value");
+  if (g.size == glm::ivec3(0)) return;
+  const glm::vec3 lo = g.worldOfVoxelZero + glm::vec3(g.min) * g.voxelSizes;
+  const glm::vec3 hi = g.worldOfVoxelZero + glm::vec3(g.min + g.size - 1) * g.voxelSizes;
+  const glm::vec3 box0 = grid.origin - 0.5f * grid.cellSize;
+  const glm::vec3 box1 = grid.origin + (glm::vec3(grid.resolution) + 0.5f) * grid.cellSize;
+  if (glm::any(glm::lessThan(lo, box0)) || glm::any(glm::greaterThan(hi, box1)))
+    fail(path, "grid '" + g.name + "' has voxels outside the domain's box (was the domain "
+                                   "moved or resized after the bake?)");
+}
+
+void resampleScalar(const DenseGrid& g, const GridFrame& grid, ScalarGrid& out) {
+  const glm::ivec3 n = grid.resolution;
+  out.resize(n, 0.f);
+  const auto all = [](glm::ivec3) { return true; };
+  parallelFor(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i)
+        out(i, j, k) = trilinear(g, voxelOf(g, grid.origin + (glm::vec3(i, j, k) + 0.5f) * grid.cellSize), 0, all);
+  });
+}
+
 }  // namespace
+
+ToonFields resampleToonFields(const std::string& path, const GridFrame& grid) {
+  validateToonGrid(grid);
+  const std::vector<std::string> names = vdbGridNames(path);
+  ToonFields f;
+  for (const char* name : {"density", "temperature"}) {
+    if (std::string(name) == "temperature" &&
+        std::find(names.begin(), names.end(), name) == names.end())
+      continue;
+    const DenseGrid d = readVdbGrid(path, name);
+    if (d.components != 1) fail(path, std::string("grid '") + name + "' must be a float grid");
+    checkResampled(d, grid, path);
+    resampleScalar(d, grid, name == std::string("density") ? f.density : f.temperature);
+  }
+  const DenseGrid v = readVdbGrid(path, "velocity");
+  if (v.components != 3) fail(path, "grid 'velocity' must be a vec3 grid");
+  checkResampled(v, grid, path);
+  f.velocity.resize(grid.resolution);
+  const auto held = [&](glm::ivec3 p) { return holdsVelocity(v, p); };
+  fillFaces(f.velocity, [&](glm::ivec3 face, glm::ivec3, int a) {
+    glm::vec3 centre = (glm::vec3(face) + 0.5f) * grid.cellSize;
+    centre[a] -= 0.5f * grid.cellSize;  // the face below cell `face` on axis a
+    return trilinear(v, voxelOf(v, grid.origin + centre), a, held);
+  });
+  return f;
+}
 
 ToonFields readToonFields(const std::string& path, const GridFrame& grid) {
   validateToonGrid(grid);
@@ -117,7 +192,7 @@ const ToonFields& ToonVolumeCache::fields(const std::string& path) {
     }
   Entry& slot = mEntries[1 - mRecent];
   slot.path.clear();  // stays empty if the read throws
-  slot.fields = readToonFields(path, mGrid);
+  slot.fields = mResample ? resampleToonFields(path, mGrid) : readToonFields(path, mGrid);
   slot.path = path;
   slot.size = size;
   slot.time = time;

@@ -153,7 +153,11 @@ DenseGrid readVdbGrid(const std::string& path, const std::string& name) {
   if (!found || !base) fail(path, "has no grid named '" + name + "'");
   DenseGrid out;
   out.name = name;
-  out.voxelSize = float(base->voxelSize()[0]);
+  const openvdb::Vec3d voxel = base->voxelSize();
+  out.voxelSize = float(voxel[0]);
+  out.voxelSizes = glm::vec3(float(voxel[0]), float(voxel[1]), float(voxel[2]));
+  out.axisAligned = base->transform().isLinear() &&
+                    base->transform().baseMap()->getAffineMap()->isScaleTranslate();
   const openvdb::Vec3d w0 = base->indexToWorld(openvdb::Vec3d(0.0));
   out.worldOfVoxelZero = glm::vec3(float(w0[0]), float(w0[1]), float(w0[2]));
   if (auto g = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) {

@@ -23,7 +23,9 @@ struct DenseGrid {
   glm::ivec3 min{0};   ///< index of the first voxel of the dense box
   glm::ivec3 size{0};  ///< box size in voxels (0 when the grid is empty)
   int components = 1;  ///< 1 for float grids, 3 for vec3 grids
-  float voxelSize = 1.f;
+  float voxelSize = 1.f;                ///< along x (Plume's own grids are cubic)
+  glm::vec3 voxelSizes{1.f};            ///< per axis (a Mantaflow domain's cells are not cubic)
+  bool axisAligned = true;              ///< the index-to-world map is a diagonal scale + shift
   glm::vec3 worldOfVoxelZero{0.f};  ///< world position of voxel (0,0,0)'s centre
   std::vector<float> values;        ///< x fastest, components interleaved
 };

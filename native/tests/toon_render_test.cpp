@@ -197,5 +197,46 @@ TEST(ToonVolume, ReadsAPlumeVolumeFrameOntoTheGrid) {
   EXPECT_THROW(readToonFields(path + ".missing", g), std::runtime_error);
 }
 
+TEST(ToonVolume, ResamplesNonCubicMantaflowCellsOntoACubicGrid) {
+  // A traced Mantaflow frame: 8x5x4 cells of 0.1 x 0.16 x 0.2 m (not cubic) holding a density
+  // linear in world position and a uniform velocity; read onto cubic cells of 0.1 m over the
+  // same 0.8 x 0.8 x 0.8 m box. Trilinear interpolation is exact for a linear field, so cells
+  // whose centre lies between voxel centres get the linear value to float rounding.
+  const MantaflowGrid mg{glm::ivec3(8, 5, 4), glm::vec3(-1.f, 0.5f, 2.f), glm::vec3(0.1f, 0.16f, 0.2f)};
+  const auto linear = [&](glm::vec3 w) { return 1.f + 0.5f * (w.x - mg.origin.x) + 2.f * (w.y - mg.origin.y) +
+                                                 0.25f * (w.z - mg.origin.z); };
+  MantaflowFrame frame = MantaflowFrame::empty(mg.resolution);
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 8; ++i) frame.density(i, j, k) = linear(mg.indexToWorld(glm::vec3(i, j, k) + 0.5f));
+  frame.velocity.u().fill(0.5f);
+  frame.velocity.w().fill(-0.25f);
+  const std::string path = (std::filesystem::temp_directory_path() / "plume_toon_resample.vdb").string();
+  writeMantaflowVolume(path, frame, mg, 1);
+  const GridFrame g{glm::ivec3(8), 0.1f, mg.origin, 1.f / 24.f};
+  EXPECT_THROW(readToonFields(path, g), std::runtime_error);  // the exact reader refuses them
+  const ToonFields f = resampleToonFields(path, g);
+  ASSERT_EQ(f.density.size(), g.resolution);
+  int checked = 0;
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 8; ++j)
+      for (int i = 0; i < 8; ++i) {
+        const glm::vec3 w = mg.origin + (glm::vec3(i, j, k) + 0.5f) * 0.1f;
+        const glm::vec3 q = mg.worldToIndex(w) - 0.5f;  // voxel coordinates in the file
+        if (glm::any(glm::lessThan(q, glm::vec3(0.f))) ||
+            glm::any(glm::greaterThan(q, glm::vec3(mg.resolution - 1))))
+          continue;
+        EXPECT_NEAR(f.density(i, j, k), linear(w), 1e-5f) << i << " " << j << " " << k;
+        // Every voxel holds the uniform velocity: interior faces read it exactly.
+        EXPECT_NEAR(f.velocity.u()(i, j, k), 0.5f, 1e-6f);
+        EXPECT_NEAR(f.velocity.w()(i, j, k), -0.25f, 1e-6f);
+        EXPECT_NEAR(f.velocity.v()(i, j, k), 0.f, 1e-6f);
+        ++checked;
+      }
+  EXPECT_GT(checked, 100);
+  // The same frame on a grid that does not contain its voxels is refused.
+  EXPECT_THROW(resampleToonFields(path, GridFrame{glm::ivec3(4), 0.1f, mg.origin, 1.f}), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace plume
