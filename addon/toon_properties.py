@@ -1,5 +1,6 @@
 """``obj.plume.domain.toon``: the toon smoke settings of a domain (cartoon_smoke.txt §2.1-2.3),
-read by plume.toon_build. Soft limits only: the operator validates with messages naming the
+read by plume.toon_build; the look settings (stretch, colours, γ, outline) update a built toon
+smoke at once (build/toon_look.py). Soft limits only: the operator validates with messages naming the
 setting and its range (toon.validate and the native ToonParams.validate)."""
 
 import bpy
@@ -20,9 +21,16 @@ COLOR_DRIVER_ITEMS = (
 )
 
 
+def _look_changed(self, context):
+    """A look setting changed: update the built toon smoke now (no rebuild needed)."""
+    from .build.toon_look import apply_look
+    if isinstance(self.id_data, bpy.types.Object):
+        apply_look(context.scene if context else None, self.id_data)
+
+
 def _color(name, default, description):
     return FloatVectorProperty(name=name, size=4, subtype='COLOR', default=default, min=0.0,
-                               max=1.0, description=description)
+                               max=1.0, description=description, update=_look_changed)
 
 
 class PlumeToonSettings(bpy.types.PropertyGroup):
@@ -70,7 +78,8 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
     stretch_factor: FloatProperty(
         name="Stretch (k)", default=0.5, soft_min=0.0, soft_max=5.0,
         description="k in stretch = 1 + k |v_screen| (s/m): squash and stretch along the "
-                    "velocity (Figure 4), >= 0")
+                    "velocity (Figure 4), >= 0",
+        update=_look_changed)
     # --- Colour (§2.3) ---
     color_driver: EnumProperty(name="Colour Driver", items=COLOR_DRIVER_ITEMS, default='DENSITY',
                                description="What drives the colour ramp (§2.3)")
@@ -93,13 +102,15 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
     depth_threshold: FloatProperty(
         name="Depth Threshold (γ)", default=0.1, soft_min=0.0, soft_max=10.0, precision=4,
         description="γ: a pixel is outlined when any of its four one-sided depth differences "
-                    "divided by the pixel size exceeds γ (§2.2); >= 0")
+                    "divided by the pixel size exceeds γ (§2.2); >= 0",
+        update=_look_changed)
     outline_color: _color("Outline Colour", (0.0, 0.0, 0.0, 1.0),
                           "Silhouette colour of the outline pixels (§2.2: e.g. black)")
     ignore_background: BoolProperty(
         name="Ignore Background", default=False,
         description="Never outline background pixels: the silhouette is drawn on the smoke side "
-                    "only")
+                    "only",
+        update=_look_changed)
     use_freestyle: BoolProperty(
         name="Freestyle Lines", default=False,
         description="Also draw Freestyle silhouette lines (render.use_freestyle with a Plume line "

@@ -76,6 +76,31 @@ def file_output(nt, out_dir, name, socket):
     nt.links.new(socket, fo.inputs[0])
 
 
+def assert_billboards_follow_camera(test, ob, snap, stretch_factor):
+    """The evaluated billboards are Figure 4 for the scene camera as it is at the current frame:
+    quad n (vertices 4n..4n+3 of a 2x2 grid, realized in point order) has its local x edge
+    (vertex 4n+2 - 4n) along _native.toon_billboards' axis with length size * stretch, and its
+    y edge size long. Float32 nodes against the float64 reference: 1e-4 relative."""
+    scn = bpy.context.scene
+    n = len(snap["ids"])
+    b = native().toon_billboards(np.array(scn.camera.matrix_world), True, snap["positions"],
+                                 snap["velocities"], stretch_factor)
+    ev = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    test.assertEqual(len(ev.vertices), 4 * n)  # one realized quad per point
+    co = np.empty(3 * len(ev.vertices), np.float32)
+    ev.vertices.foreach_get("co", co)
+    quads = co.reshape(n, 4, 3).astype(np.float64)
+    ex, ey = quads[:, 2] - quads[:, 0], quads[:, 1] - quads[:, 0]
+    size = np.asarray(snap["size"], np.float64)
+    grown = size > 1e-3  # a particle being born or dying has a degenerate quad
+    test.assertGreater(int(grown.sum()), 10)
+    lx, ly = np.linalg.norm(ex, axis=1), np.linalg.norm(ey, axis=1)
+    np.testing.assert_allclose(lx[grown], (size * np.asarray(b["stretch"]))[grown], rtol=1e-4)
+    np.testing.assert_allclose(ly[grown], size[grown], rtol=1e-4)
+    cosine = np.sum(ex[grown] * np.asarray(b["axis"], np.float64)[grown], axis=1) / lx[grown]
+    test.assertGreater(float(cosine.min()), 1.0 - 1e-4)
+
+
 class ToonSmokeTest(unittest.TestCase):
     """One bake shared by the tests; each test starts from a fresh scene on the same cache."""
 
@@ -143,19 +168,35 @@ class ToonSmokeTest(unittest.TestCase):
             size = np.empty(n, np.float32)
             me.attributes["size"].data.foreach_get("value", size)
             np.testing.assert_array_equal(size, snap["size"])
-            for name in ("angle", "stretch", "plume_color", "id"):
+            for name in ("plume_velocity", "plume_color", "id"):
                 self.assertIn(name, me.attributes)
-            # angle/stretch: Figure 4 for the scene camera, as the native computes it.
-            b = native().toon_billboards(np.array(scn.camera.matrix_world), True,
-                                         snap["positions"], snap["velocities"], 0.5)
-            angle = np.empty(n, np.float32)
-            me.attributes["angle"].data.foreach_get("value", angle)
-            np.testing.assert_array_equal(angle, b["angle"])
-            # Billboards: one realized quad (4 vertices) per point, as wide as `size`.
-            ev = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
-            self.assertEqual(len(ev.vertices), 4 * n)
+            assert_billboards_follow_camera(self, ob, snap, 0.5)
         print(f"  handler update: {toon_points.last_update_seconds[0] * 1e3:.2f} ms "
               f"for {n} points")
+        # An animated camera: the billboards follow the camera of the frame drawn (the handler
+        # runs before the frame's camera is evaluated, so the group reads the camera itself).
+        cam = scn.camera
+        for f, x, yaw in ((4, -1.0, -0.4), (6, 1.2, 0.5)):
+            cam.location.x, cam.rotation_euler.z = x, yaw
+            cam.keyframe_insert("location", frame=f)
+            cam.keyframe_insert("rotation_euler", frame=f)
+        for f in (4, 5, 6):
+            scn.frame_set(f)
+            snap = native().read_toon_file(os.path.join(self.folder, f"toon_{f:04d}.bin"))
+            assert_billboards_follow_camera(self, ob, snap, 0.5)
+        # Look settings update the built smoke at once, without a rebuild.
+        t = dom.plume.domain.toon
+        t.stretch_factor = 1.5
+        t.depth_threshold = 0.25
+        t.ramp_color_high = (0.2, 0.9, 0.3, 1.0)
+        assert_billboards_follow_camera(self, ob, snap, 1.5)
+        group = scn.node_tree.nodes["Plume Depth Differences"]
+        self.assertAlmostEqual(group.inputs["Gamma"].default_value, 0.25, places=6)
+        ramp = next(n for n in bpy.data.materials["Plume Toon Domain"].node_tree.nodes
+                    if n.type == 'VALTORGB')
+        np.testing.assert_allclose(tuple(ramp.color_ramp.elements[-1].color), (0.2, 0.9, 0.3, 1.0),
+                                   atol=1e-6)
+        t.stretch_factor, t.depth_threshold = 0.5, GAMMA
         self.assertEqual(ob.modifiers[0].node_group.name, "Plume Toon Billboards")
         mat = bpy.data.materials["Plume Toon Domain"]
         self.assertEqual(mat.blend_method, 'CLIP')

@@ -93,6 +93,19 @@ def depth_group():
     return ng
 
 
+def set_outline(node, settings):
+    """The group node's γ, outline colour and background switch from the toon settings."""
+    node.inputs["Gamma"].default_value = float(settings.depth_threshold)
+    node.inputs["Outline Color"].default_value = tuple(settings.outline_color)
+    node.inputs["Ignore Background"].default_value = 1.0 if settings.ignore_background else 0.0
+
+
+def scene_node(scene):
+    """The scene's "Plume Depth Differences" node, or None."""
+    nt = scene.node_tree if scene.use_nodes else None
+    return nt.nodes.get(NODE) if nt is not None else None
+
+
 def wire_scene(scene, view_layer, settings, far):
     """Render Layers (Z pass on) -> "Plume Depth Differences" -> Composite in the scene's
     compositor, the group node's inputs set from the toon settings. Returns the group node."""
@@ -114,9 +127,7 @@ def wire_scene(scene, view_layer, settings, far):
     node.node_tree = group
     node.location = (rl.location.x + 300, rl.location.y)
     comp.location = (node.location.x + 300, node.location.y)
-    node.inputs["Gamma"].default_value = float(settings.depth_threshold)
-    node.inputs["Outline Color"].default_value = tuple(settings.outline_color)
-    node.inputs["Ignore Background"].default_value = 1.0 if settings.ignore_background else 0.0
+    set_outline(node, settings)
     node.inputs["Far"].default_value = float(far)
     nt.links.new(rl.outputs["Image"], node.inputs["Image"])
     nt.links.new(rl.outputs["Depth"], node.inputs["Depth"])

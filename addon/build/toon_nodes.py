@@ -1,7 +1,7 @@
 """Toon smoke rendering in Blender (cartoon_smoke.txt §2.2-2.3): the geometry-nodes group
-"Plume Toon Billboards" (one camera-facing quad per point, rotated in the image plane by the
-point's `angle`, scaled by `size` and stretched along x by `stretch`, Figure 4) and the flat toon
-material whose stencil alpha is a hard cut-out (alpha CLIP), so that the Depth pass is written
+"Plume Toon Billboards" (one camera-facing quad per point, `size` wide, rotated in the image
+plane along the point's projected velocity and stretched in proportion to its speed, Figure 4)
+and the flat toon material whose stencil alpha is a hard cut-out (alpha CLIP), so that the Depth pass is written
 only where the stencil is opaque (with the view layer's pass_alpha_threshold)."""
 
 import bpy
@@ -11,6 +11,8 @@ GROUP = "Plume Toon Billboards"
 ALPHA_THRESHOLD = 0.5
 #: Point attribute of the billboards holding the stencil coordinates (u, v, 0).
 UV_ATTRIBUTE = "plume_uv"
+#: Point attribute with the particle velocity (m/s), which orients and stretches its stencil.
+VELOCITY_ATTRIBUTE = "plume_velocity"
 #: Point attribute with the colour-ramp coordinate in [0, 1] (written by toon_points). Not
 #: "color": Cycles maps that name to its standard volume colour, and a mesh attribute of that
 #: name reads as 0 in the shader.
@@ -32,7 +34,9 @@ def link_math(nt, op, a, b=None, location=(0, 0), kind="ShaderNodeMath"):
 
 def billboard_group():
     """The "Plume Toon Billboards" geometry-nodes group (rebuilt in place when it exists).
-    Inputs: Geometry (points with size/angle/stretch attributes), Camera (object), Material."""
+    Inputs: Geometry (points with size and velocity attributes), Camera (object), Material,
+    Stretch Factor (k), Perspective. The orientation is computed here, from the camera as the
+    depsgraph evaluates it for the frame drawn, so an animated camera never lags a frame."""
     ng = bpy.data.node_groups.get(GROUP)
     if ng is None or ng.bl_idname != 'GeometryNodeTree':
         ng = bpy.data.node_groups.new(GROUP, 'GeometryNodeTree')
@@ -42,54 +46,97 @@ def billboard_group():
     ng.inputs.new('NodeSocketGeometry', "Geometry")
     ng.inputs.new('NodeSocketObject', "Camera")
     ng.inputs.new('NodeSocketMaterial', "Material")
+    k = ng.inputs.new('NodeSocketFloat', "Stretch Factor")
+    k.min_value, k.default_value = 0.0, 0.5
+    k.description = "k: the stencil stretches to 1 + k |v_screen| along the motion (Figure 4)"
+    persp = ng.inputs.new('NodeSocketBool', "Perspective")
+    persp.default_value = True
     ng.outputs.new('NodeSocketGeometry', "Geometry")
     N, L = ng.nodes.new, ng.links.new
     gin, gout = N('NodeGroupInput'), N('NodeGroupOutput')
-    gin.location, gout.location = (-1400, 0), (900, 0)
+    gin.location, gout.location = (-1800, 0), (900, 0)
 
-    def attribute(name, y):
+    def attribute(name, kind, y):
         a = N('GeometryNodeInputNamedAttribute')
-        a.data_type, a.location = 'FLOAT', (-1200, y)
+        a.data_type, a.location = kind, (-1600, y)
         a.inputs["Name"].default_value = name
-        return next(o for o in a.outputs if o.enabled)  # one output per type, FLOAT's shown
+        return next(o for o in a.outputs if o.enabled)  # one output per type, the type's shown
 
-    size, angle = attribute("size", -300), attribute("angle", -450)
-    stretch = attribute("stretch", -600)
+    size = attribute("size", 'FLOAT', -300)
+    velocity = attribute(VELOCITY_ATTRIBUTE, 'FLOAT_VECTOR', -450)
 
-    # The camera's world rotation: the quad's local z is the view axis, so it faces the camera.
+    # The camera's world frame: the quad's local z is the view axis, so it faces the camera.
     cam = N('GeometryNodeObjectInfo')
-    cam.transform_space, cam.location = 'ORIGINAL', (-1200, 300)
+    cam.transform_space, cam.location = 'ORIGINAL', (-1600, 300)
     L(gin.outputs["Camera"], cam.inputs["Object"])
 
     def camera_axis(vec, y):
         r = N('ShaderNodeVectorRotate')
-        r.rotation_type, r.location = 'EULER_XYZ', (-1000, y)
+        r.rotation_type, r.location = 'EULER_XYZ', (-1400, y)
         r.inputs["Vector"].default_value = vec
         L(cam.outputs["Rotation"], r.inputs["Rotation"])
         return r.outputs["Vector"]
 
-    right, up = camera_axis((1.0, 0.0, 0.0), 200), camera_axis((0.0, 1.0, 0.0), 50)
+    right, up = camera_axis((1.0, 0.0, 0.0), 300), camera_axis((0.0, 1.0, 0.0), 150)
+    back = camera_axis((0.0, 0.0, 1.0), 0)
+
+    def vmath(op, a, b, y, x=-1200):
+        return link_math(ng, op, a, b, (x, y), "ShaderNodeVectorMath")
+
+    def dot(a, b, y):
+        d = N('ShaderNodeVectorMath')
+        d.operation, d.location = 'DOT_PRODUCT', (-1000, y)
+        L(a, d.inputs[0])
+        L(b, d.inputs[1])
+        return d.outputs["Value"]
+
+    # Figure 4, as _native.toon_billboards: position p and velocity v in the camera frame; the
+    # image-plane velocity s = v_xy, minus p_xy v_z / p_z in front of a perspective camera
+    # (d/dt of the projection, times the depth).
+    pos = N('GeometryNodeInputPosition')
+    pos.location = (-1600, -150)
+    rel = vmath('SUBTRACT', pos.outputs["Position"], cam.outputs["Location"], -150)
+    px, py, pz = dot(rel, right, -100), dot(rel, up, -200), dot(rel, back, -300)
+    vx, vy, vz = dot(velocity, right, -400), dot(velocity, up, -500), dot(velocity, back, -600)
+    in_front = link_math(ng, 'MULTIPLY', link_math(ng, 'LESS_THAN', pz, 0.0, (-800, -300)),
+                         gin.outputs["Perspective"], (-650, -300))
+    f = link_math(ng, 'MULTIPLY', link_math(ng, 'DIVIDE', vz, pz, (-800, -500)), in_front,
+                  (-650, -500))  # DIVIDE gives 0 for p_z = 0
+    sx = link_math(ng, 'SUBTRACT', vx, link_math(ng, 'MULTIPLY', px, f, (-500, -350)), (-350, -350))
+    sy = link_math(ng, 'SUBTRACT', vy, link_math(ng, 'MULTIPLY', py, f, (-500, -450)), (-350, -450))
+    angle = link_math(ng, 'ARCTAN2', sy, sx, (-200, -400))
+    s_xy = N('ShaderNodeCombineXYZ')
+    s_xy.location = (-200, -550)
+    L(sx, s_xy.inputs["X"])
+    L(sy, s_xy.inputs["Y"])
+    speed = N('ShaderNodeVectorMath')
+    speed.operation, speed.location = 'LENGTH', (-50, -550)
+    L(s_xy.outputs["Vector"], speed.inputs[0])
+    stretch = link_math(ng, 'MULTIPLY_ADD', speed.outputs["Value"], gin.outputs["Stretch Factor"],
+                        (100, -550))
+    stretch.node.inputs[2].default_value = 1.0  # 1 + k |s|
+
     # Stretch axis in the image plane: cos(angle) right + sin(angle) up (Figure 4).
-    cos_a = link_math(ng, 'COSINE', angle, location=(-1000, -400))
-    sin_a = link_math(ng, 'SINE', angle, location=(-1000, -550))
+    cos_a = link_math(ng, 'COSINE', angle, location=(-50, -250))
+    sin_a = link_math(ng, 'SINE', angle, location=(-50, -400))
+
     def scaled(vec, factor, y):
         v = N('ShaderNodeVectorMath')
-        v.operation, v.location = 'SCALE', (-800, y)
+        v.operation, v.location = 'SCALE', (100, y)
         L(vec, v.inputs[0])
         L(factor, v.inputs["Scale"])
         return v.outputs["Vector"]
 
-    axis = link_math(ng, 'ADD', scaled(right, cos_a, 150), scaled(up, sin_a, 0), (-600, 100),
-                      "ShaderNodeVectorMath")
+    axis = vmath('ADD', scaled(right, cos_a, 150), scaled(up, sin_a, 0), 100, x=250)
     # Rotate about the view axis (pivot z) until local x lies along the stretch axis.
     align = N('FunctionNodeAlignEulerToVector')
-    align.axis, align.pivot_axis, align.location = 'X', 'Z', (-400, 200)
+    align.axis, align.pivot_axis, align.location = 'X', 'Z', (400, 200)
     L(cam.outputs["Rotation"], align.inputs["Rotation"])
     L(axis, align.inputs["Vector"])
     # Scale (size stretch, size, 1): the quad is 1 m wide, so `size` is the stencil diameter.
     xyz = N('ShaderNodeCombineXYZ')
-    xyz.location = (-400, -300)
-    L(link_math(ng, 'MULTIPLY', size, stretch, (-600, -350)), xyz.inputs["X"])
+    xyz.location = (400, -300)
+    L(link_math(ng, 'MULTIPLY', size, stretch, (250, -350)), xyz.inputs["X"])
     L(size, xyz.inputs["Y"])
     xyz.inputs["Z"].default_value = 1.0
 
@@ -127,7 +174,28 @@ def billboard_group():
     return ng
 
 
-def apply_billboards(ob, camera, material):
+def is_perspective(camera):
+    return camera.type != 'CAMERA' or camera.data.type != 'ORTHO'
+
+
+def set_camera(mod, camera):
+    """Points the billboards at `camera` (perspective or not). False when nothing changed."""
+    ids = {s.name: s.identifier for s in mod.node_group.inputs}
+    persp = is_perspective(camera)
+    if mod[ids["Camera"]] == camera and bool(mod[ids["Perspective"]]) == persp:
+        return False
+    mod[ids["Camera"]] = camera
+    mod[ids["Perspective"]] = persp
+    return True
+
+
+def billboard_modifier(ob):
+    """The object's "Plume Toon Billboards" modifier, or None."""
+    mod = ob.modifiers.get(GROUP)
+    return mod if mod is not None and mod.type == 'NODES' and mod.node_group else None
+
+
+def apply_billboards(ob, camera, material, stretch_factor):
     """Adds (or updates) the object's "Plume Toon Billboards" modifier."""
     ng = billboard_group()
     mod = ob.modifiers.get(GROUP)
@@ -135,10 +203,31 @@ def apply_billboards(ob, camera, material):
         mod = ob.modifiers.new(GROUP, 'NODES')
     mod.node_group = ng
     ids = {s.name: s.identifier for s in ng.inputs}
-    mod[ids["Camera"]] = camera
+    set_camera(mod, camera)
     mod[ids["Material"]] = material
+    set_stretch(mod, stretch_factor)
     ob.data.update()
     return mod
+
+
+def material_name(domain):
+    return f"Plume Toon {domain.name}"
+
+
+def set_ramp(mat, settings):
+    """The material's colour ramp ends from the toon settings (False without a ramp node)."""
+    ramp = next((n for n in mat.node_tree.nodes if n.type == 'VALTORGB'), None) if mat.node_tree \
+        else None
+    if ramp is None:
+        return False
+    els = ramp.color_ramp.elements
+    els[0].color, els[-1].color = tuple(settings.ramp_color_low), tuple(settings.ramp_color_high)
+    return True
+
+
+def set_stretch(mod, stretch_factor):
+    ids = {s.name: s.identifier for s in mod.node_group.inputs}
+    mod[ids["Stretch Factor"]] = float(stretch_factor)
 
 
 def toon_material(name, stencil_path, settings):
@@ -168,8 +257,6 @@ def toon_material(name, stencil_path, settings):
     col.attribute_name = COLOR_ATTRIBUTE
     ramp = N('ShaderNodeValToRGB')
     ramp.location = (-650, -150)
-    els = ramp.color_ramp.elements
-    els[0].color, els[1].color = tuple(settings.ramp_color_low), tuple(settings.ramp_color_high)
     L(col.outputs["Fac"], ramp.inputs["Fac"])
     em = N('ShaderNodeEmission')
     em.location = (-300, -150)
@@ -185,4 +272,5 @@ def toon_material(name, stencil_path, settings):
     out = N('ShaderNodeOutputMaterial')
     out.location = (150, 50)
     L(mix.outputs[0], out.inputs["Surface"])
+    set_ramp(mat, settings)
     return mat

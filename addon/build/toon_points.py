@@ -1,7 +1,8 @@
 """Toon particles -> a point-cloud MESH object "<domain>_toon" (cartoon_smoke.txt §2.1-2.3):
-its vertices and point attributes (size, angle, stretch, color, id) follow toon_####.bin on every
-frame through a persistent frame_change_pre handler with bulk foreach_set updates. angle and
-stretch depend on the scene camera (Figure 4) and are computed here by _native.toon_billboards."""
+its vertices and point attributes (size, velocity, colour, id) follow toon_####.bin on every
+frame through a persistent frame_change_pre handler with bulk foreach_set updates. The
+camera-dependent orientation and stretch (Figure 4) are computed by the billboard node group from
+the velocity; the handler only keeps the group pointed at the scene camera."""
 
 import os
 import time
@@ -10,19 +11,18 @@ import bpy
 import numpy as np
 
 from . import frame_handlers
-from .toon_nodes import COLOR_ATTRIBUTE
+from .toon_nodes import (COLOR_ATTRIBUTE, VELOCITY_ATTRIBUTE, billboard_modifier,
+                         set_camera)
 from .surfaces import _file_path  # //-relative when the .blend is saved
 
-#: Custom properties of a toon object: its cache folder, the domain, the bake's frame range and
-#: the stretch factor k.
+#: Custom properties of a toon object: its cache folder, the domain and the bake's frame range.
 FOLDER_KEY = "plume_toon_cache"
 DOMAIN_KEY = "plume_toon_domain"
 RANGE_KEY = "plume_toon_frames"
-STRETCH_KEY = "plume_toon_stretch"
 
-#: Point attributes written on every frame (FLOAT unless listed in INT_ATTRIBUTES).
-ATTRIBUTES = ("size", "angle", "stretch", COLOR_ATTRIBUTE, "id")
-INT_ATTRIBUTES = ("id",)
+#: Point attributes written on every frame and their types.
+ATTRIBUTES = {"size": 'FLOAT', VELOCITY_ATTRIBUTE: 'FLOAT_VECTOR', COLOR_ATTRIBUTE: 'FLOAT',
+              "id": 'INT'}
 
 # path -> (mtime, snapshot dict) of the last toon file read per object
 _loaded = {}
@@ -61,43 +61,31 @@ def _read(path):
     return snap
 
 
-def camera_billboards(scene, snap, stretch_factor):
-    """(angle, stretch) per particle for the scene camera (Figure 4); zeros/ones without one."""
-    n = len(snap["ids"])
-    cam = scene.camera
-    if cam is None or n == 0:
-        return np.zeros(n, np.float32), np.ones(n, np.float32)
-    m = np.array(cam.matrix_world, dtype=np.float64)
-    persp = cam.type != 'CAMERA' or cam.data.type != 'ORTHO'
-    b = _native().toon_billboards(m, persp, snap["positions"], snap["velocities"],
-                                  float(stretch_factor))
-    return np.asarray(b["angle"], np.float32), np.asarray(b["stretch"], np.float32)
-
-
-def write_points(mesh, snap, angle, stretch):
+def write_points(mesh, snap):
     """Replaces the mesh's vertices and point attributes with the particles' (bulk updates)."""
     n = len(snap["ids"])
     mesh.clear_geometry()
     mesh.vertices.add(n)
     mesh.vertices.foreach_set("co", np.ascontiguousarray(snap["positions"], np.float32).ravel())
-    values = {"size": np.asarray(snap["size"], np.float32), "angle": angle, "stretch": stretch,
+    values = {"size": np.asarray(snap["size"], np.float32),
+              VELOCITY_ATTRIBUTE: np.ascontiguousarray(snap["velocities"], np.float32).ravel(),
               COLOR_ATTRIBUTE: np.asarray(snap["color"], np.float32),
               # ids never repeat; int32 wraps only after 2^31 births (GN's stable "id")
               "id": (np.asarray(snap["ids"], np.uint64) & np.uint64(0x7FFFFFFF)).astype(np.int32)}
-    for name in ATTRIBUTES:
+    for name, kind in ATTRIBUTES.items():
         attr = mesh.attributes.get(name)
-        kind = 'INT' if name in INT_ATTRIBUTES else 'FLOAT'
         if attr is None or attr.data_type != kind or attr.domain != 'POINT':
             if attr is not None:
                 mesh.attributes.remove(attr)
             attr = mesh.attributes.new(name, kind, 'POINT')
         if n:
-            attr.data.foreach_set("value", values[name])
+            attr.data.foreach_set("vector" if kind == 'FLOAT_VECTOR' else "value", values[name])
     mesh.update()
 
 
 def update_object(ob, scene, frame):
-    """Sets the toon object's points of `frame` (clamped to the built range). True if set."""
+    """Sets the toon object's points of `frame` (clamped to the built range) and points its
+    billboards at the scene camera (which markers may switch). True if set."""
     folder = ob.get(FOLDER_KEY)
     frames = ob.get(RANGE_KEY)
     if not folder or frames is None or ob.type != 'MESH':
@@ -106,8 +94,10 @@ def update_object(ob, scene, frame):
     snap = _read(_toon_path(bpy.path.abspath(folder), min(max(frame, first), last)))
     if snap is None:
         return False
-    angle, stretch = camera_billboards(scene, snap, float(ob.get(STRETCH_KEY, 0.0)))
-    write_points(ob.data, snap, angle, stretch)
+    mod = billboard_modifier(ob)
+    if mod is not None and scene.camera is not None:
+        set_camera(mod, scene.camera)
+    write_points(ob.data, snap)
     return True
 
 
@@ -134,7 +124,7 @@ def unregister():
     _loaded.clear()
 
 
-def build_object(scene, domain, folder, frame_start, last_frame, stretch_factor):
+def build_object(scene, domain, folder, frame_start, last_frame):
     """Creates (or reuses) "<domain>_toon" linked to the scene, keyed to the cache folder, with
     the points of the current frame. The object stays at the world origin: points are in world
     space."""
@@ -151,7 +141,6 @@ def build_object(scene, domain, folder, frame_start, last_frame, stretch_factor)
     ob[FOLDER_KEY] = _file_path(folder)
     ob[DOMAIN_KEY] = domain.name
     ob[RANGE_KEY] = [int(frame_start), int(last_frame)]
-    ob[STRETCH_KEY] = float(stretch_factor)
     _loaded.clear()
     update_object(ob, scene, scene.frame_current)
     return ob

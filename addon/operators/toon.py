@@ -88,10 +88,9 @@ class PLUME_OT_toon_build(bpy.types.Operator):
     def _build(context, domain, folder, result, stencil, settings):
         scene, view_layer = context.scene, context.view_layer
         t = domain.plume.domain.toon
-        ob = toon_points.build_object(scene, domain, folder, result.frame_start, result.last_frame,
-                                      settings.stretch_factor)
-        mat = toon_nodes.toon_material(f"Plume Toon {domain.name}", stencil, t)
-        toon_nodes.apply_billboards(ob, scene.camera, mat)
+        ob = toon_points.build_object(scene, domain, folder, result.frame_start, result.last_frame)
+        mat = toon_nodes.toon_material(toon_nodes.material_name(domain), stencil, t)
+        toon_nodes.apply_billboards(ob, scene.camera, mat, settings.stretch_factor)
         # Depth only where the stencil is opaque (the material's cut-out is 0 or 1).
         view_layer.pass_alpha_threshold = toon_nodes.ALPHA_THRESHOLD
         # The handler rewrites the points while rendering frames: lock the interface.
