@@ -15,6 +15,8 @@ import time
 from dataclasses import dataclass, field
 from typing import List, Optional
 
+import numpy as np
+
 from . import cache
 from .point_sources import domain_point_sources, emits_during
 
@@ -23,7 +25,8 @@ from .point_sources import domain_point_sources, emits_during
 #: small grids, every few seconds at 128³ (75 MB), never more than ~10% of the bake time.
 CHECKPOINT_COST_RATIO = 10.0
 from .settings import (BakeError, to_native_params, to_native_source,
-                       validate_python_side, validate_source, validate_streaks)
+                       validate_pathlines, validate_python_side, validate_source,
+                       validate_streaks)
 
 
 @dataclass
@@ -74,6 +77,8 @@ class BakeRunner:
         self._manifest = None
         self._emitter_inputs = None  # EmitterSnapshot.solver_inputs of the loaded emitters
         self._tracer = None  # StreakTracer when streak surfaces are on
+        self._recorder = None  # PathlineRecorder while a bake with pathlines runs
+        self._fuel_cells = None  # linear cells of the fuel Sources (pathline seeds, §4.2)
         self._emitting_sources = []  # Sources with point sources (their emit_particles count)
         self._params = None  # the validated native SmokeParams
 
@@ -93,6 +98,8 @@ class BakeRunner:
             if emitter.role == "SOURCE":
                 validate_source(emitter, snap.frame_start)
         validate_streaks(snap.domain_name, snap.streaks, snap.emitters)
+        validate_pathlines(snap.domain_name, snap.pathlines, snap.solver, snap.streaks,
+                           snap.emitters, snap.frame_count)
         try:
             self._solver = self._native.SmokeSolver(params)
         except ValueError as e:
@@ -105,6 +112,8 @@ class BakeRunner:
         self._load_emitters(0)
         if snap.streaks.enabled:
             self._tracer = self._make_tracer(params)
+        if snap.pathlines.enabled:
+            self._fuel_cells = self._fuel_cells_of(params)
         error = cache.check_writable(snap.cache_folder)
         if error is not None:
             raise BakeError(f"Plume: cache_directory '{snap.cache_directory}' is not writable "
@@ -153,6 +162,38 @@ class BakeRunner:
             raise BakeError(f"Plume: domain '{snap.domain_name}': point sources: {e}") from None
         return tracer
 
+    def _fuel_cells_of(self, params):
+        """Linear indices of the cells where the Sources with fuel inject it at the first frame:
+        the fuel-injection region Ω where pathlines are seeded (graph_fire_synthesis.txt §4.2)."""
+        snap, native = self.snapshot, self._native
+        cells = []
+        for e in snap.emitters:
+            if e.role != "SOURCE" or e.source_at(0).fuel <= 0.0:
+                continue
+            try:
+                linear, _motion = native.source_cells(e.vertices, e.triangles, e.matrix_at(0),
+                                                      e.matrix_at(1), params, e.name)
+            except ValueError as err:
+                raise BakeError(f"Plume: source '{e.name}': {err}") from None
+            cells.append(np.asarray(linear, dtype=np.uint32))
+        merged = np.unique(np.concatenate(cells)) if cells else np.empty(0, np.uint32)
+        if len(merged) == 0:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': the fuel Sources cover no cell "
+                            "of the grid, so no pathline can be seeded: enlarge them or raise "
+                            "the resolution")
+        return merged
+
+    def _pathline_recorder(self, folder):
+        """A PathlineRecorder writing <folder>/pathlines.bin(.partial) for this bake."""
+        snap, native = self.snapshot, self._native
+        p = snap.pathlines
+        try:
+            return native.PathlineRecorder(
+                native.PathlineParams(nodes_per_frame=p.nodes_per_frame, lifetime=p.lifetime),
+                self._params, self._fuel_cells, cache.pathlines_path(folder), float16=p.float16)
+        except (ValueError, RuntimeError) as e:
+            raise BakeError(f"Plume: domain '{snap.domain_name}': pathlines: {e}") from None
+
     def _plan(self):
         """Fresh bake, resume from the checkpoint, or nothing to compute (already complete)."""
         snap = self.snapshot
@@ -179,6 +220,10 @@ class BakeRunner:
             streaks = set(cache.streak_frames(snap.cache_folder))
             if any(f not in streaks for f in range(snap.frame_start, upto + 1)):
                 return
+        if snap.pathlines.enabled and (last < snap.frame_end or m.get("frame_end") !=
+                                       snap.frame_end or not os.path.isfile(
+                                           cache.pathlines_path(snap.cache_folder))):
+            return  # the recorder's pathlines in flight are not checkpointed: start over
         self._manifest = m
         if last >= snap.frame_end:
             self._mode = "complete"
@@ -205,6 +250,8 @@ class BakeRunner:
             self._solver.cancel()
         if self._tracer is not None:
             self._tracer.cancel()
+        if self._recorder is not None:
+            self._recorder.cancel()
 
     @property
     def cancelled(self):
@@ -250,6 +297,8 @@ class BakeRunner:
         cache.write_manifest(folder, manifest)
 
         last_checkpoint, checkpoint_cost = time.perf_counter(), 0.0
+        if snap.pathlines.enabled:
+            self._recorder = self._pathline_recorder(folder)
         try:
             for frame in range(first, snap.frame_end + 1):
                 if self._cancel.is_set():
@@ -257,7 +306,9 @@ class BakeRunner:
                     break
                 self._load_emitters(frame - snap.frame_start)
                 tracer = self._tracer
-                if tracer is None:
+                if self._recorder is not None:
+                    ok = self._recorder.advance_frame(self._solver)
+                elif tracer is None:
                     ok = self._solver.advance_frame()
                 else:
                     tracer.emitting = emits_during(self._emitting_sources,
@@ -284,7 +335,11 @@ class BakeRunner:
                 if frame - snap.frame_start >= len(manifest["frame_inputs"]):
                     manifest["frame_inputs"].append(snap.frame_input_hash(frame))
                 self._frame_done(folder, manifest, result, frame, t0)
+            if self._recorder is not None and not result.cancelled:
+                self._recorder.finish()  # pathlines.bin appears complete, with the last frame
         finally:
+            if self._recorder is not None and not os.path.isfile(cache.pathlines_path(folder)):
+                self._recorder.discard()  # cancelled or failed: no partial pathline file
             if self.frames_done_at_cancel is not None:
                 manifest["last_run"]["frames_done_at_cancel"] = self.frames_done_at_cancel
             self._run_done(folder, manifest, result, t0)

@@ -18,6 +18,8 @@ import uuid
 MANIFEST_NAME = "manifest.json"
 STATE_NAME = "state.bin"
 TRACER_STATE_NAME = "tracer_state.bin"
+#: Pathline groups of a fire bake (graph_fire_synthesis.txt §4.2); ".partial" while recording.
+PATHLINES_NAME = "pathlines.bin"
 FORMAT_VERSION = 1
 KIND = "smoke"
 
@@ -133,7 +135,7 @@ def volume_frames(folder):
 
 def plume_files(folder):
     """Files of the folder that a bake owns: manifest.json, volume_*.vdb, streaks_*.bin, state.bin,
-    tracer_state.bin, the surfaces' files, *.tmp."""
+    tracer_state.bin, pathlines.bin(.partial), the surfaces' and toon files, *.tmp."""
     try:
         names = sorted(os.listdir(folder))
     except OSError:
@@ -143,7 +145,8 @@ def plume_files(folder):
         path = os.path.join(folder, name)
         if not os.path.isfile(path):
             continue
-        if (name in (MANIFEST_NAME, STATE_NAME, TRACER_STATE_NAME) or _frame_of(name) is not None
+        if (name in (MANIFEST_NAME, STATE_NAME, TRACER_STATE_NAME, PATHLINES_NAME,
+                     PATHLINES_NAME + ".partial") or _frame_of(name) is not None
                 or _SURFACE_RE.match(name) or _TOON_RE.match(name) or name.endswith(".tmp")):
             own.append(path)
     return own
@@ -184,3 +187,7 @@ def check_writable(folder):
         return e.strerror or str(e)
     return None
 
+
+
+def pathlines_path(folder):
+    return os.path.join(folder, PATHLINES_NAME)

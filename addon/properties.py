@@ -7,6 +7,7 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from .flowgraph_properties import PlumeFlowGraphSettings
 from .toon_properties import PlumeToonSettings
 
 ROLE_ITEMS = (
@@ -104,8 +105,8 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                                   "no interpolation, faster (Mantaflow's default)")))
     conserve_mass: BoolProperty(
         name="Conserve Mass", default=True,
-        description="Restore the total smoke after each advection, less what left through open "
-                    "sides (advection alone drifts 5-50% in 100 steps)")
+        description="Restore the total smoke and heat after each advection, less what left "
+                    "through open sides (advection alone drifts 5-50% in 100 steps)")
     # --- Pressure ---
     pressure_tolerance: FloatProperty(
         name="Tolerance", default=1e-4, soft_min=1e-8, soft_max=0.1, precision=6,
@@ -140,6 +141,23 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         name="Expansion (φ)", default=1.0, soft_min=0.0, soft_max=10.0,
         description="φ: divergence per unit of fuel burnt per second in the reaction zone (eq. 1)")
     # --- Streak surfaces (smoke_surfaces.txt §3.2-3.4) ---
+    pathlines: BoolProperty(
+        name="Record Pathlines", default=False,
+        description="Record pathline groups during this fire bake for flow-graph fire "
+                    "(graph_fire_synthesis.txt §4.2): particles seeded at Δx/2 in the fuel "
+                    "cells every node step, integrated with RK4, sampled over their lifetime")
+    pathline_nodes_per_frame: IntProperty(
+        name="Nodes per Frame", default=4, min=1, max=64,
+        description="Node steps per frame (Δt_n = frame / this). The synthesis reproduces the "
+                    "bake best when the fastest particles cross about one cell per node step "
+                    "(§4.1: Δt = 0.5 Δx / U); memory grows with its square")
+    pathline_lifetime: FloatProperty(
+        name="Lifetime (t_max)", default=1.0, min=0.01, soft_max=5.0, unit='TIME_ABSOLUTE',
+        description="t_max: how long each pathline is followed, long enough for the fire "
+                    "particles to dissipate (§4.3)")
+    pathline_float16: BoolProperty(
+        name="Half Precision", default=False,
+        description="Store the pathline samples as 16-bit floats (half the file size)")
     streaks: BoolProperty(
         name="Streak Surfaces", default=False,
         description="Streak Surfaces: trace particles from point sources (smoke_surfaces.txt §3.2) "
@@ -199,6 +217,8 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                               description="Frames of the last bake available in the cache")
     # --- Toon smoke (cartoon_smoke.txt, plume.toon_build) ---
     toon: PointerProperty(type=PlumeToonSettings, name="Toon Smoke")
+    # --- Flow-graph fire (graph_fire_synthesis.txt, plume.flowgraph_build / fire_synthesize) ---
+    flowgraph: PointerProperty(type=PlumeFlowGraphSettings, name="Flow-Graph Fire")
 
 
 class PlumeSourceSettings(bpy.types.PropertyGroup):
@@ -255,8 +275,8 @@ class PlumeObjectSettings(bpy.types.PropertyGroup):
     obstacle: PointerProperty(type=PlumeObstacleSettings)
 
 
-classes = (PlumeToonSettings, PlumeDomainSettings, PlumeSourceSettings, PlumeObstacleSettings,
-           PlumeObjectSettings)
+classes = (PlumeToonSettings, PlumeFlowGraphSettings, PlumeDomainSettings, PlumeSourceSettings,
+           PlumeObstacleSettings, PlumeObjectSettings)
 
 
 def register():

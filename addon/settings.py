@@ -180,6 +180,21 @@ class StreakSettings:
     emission_period: int = 1  # steps between two emissions
 
 
+#: Accepted range of the pathline settings (the native PathlineParams bounds).
+NODES_PER_FRAME_RANGE = (1, 64)
+
+
+@dataclass
+class PathlineSettings:
+    """Pathline groups of a fire bake for flow-graph fire (graph_fire_synthesis.txt §4.2): one
+    group per node step Δt_n = frame / nodes_per_frame, sampled over lifetime t_max seconds."""
+
+    enabled: bool = False
+    nodes_per_frame: int = 4
+    lifetime: float = 1.0  # t_max (s)
+    float16: bool = False  # half-precision samples in pathlines.bin
+
+
 @dataclass
 class BakeSnapshot:
     """Everything a bake needs, taken on the main thread before the worker starts."""
@@ -197,6 +212,7 @@ class BakeSnapshot:
     #: motion_source 'MANTAFLOW': the Mantaflow domain to trace (mantaflow_cache.MantaflowSource);
     #: None: Plume simulates.
     mantaflow: Optional[object] = None
+    pathlines: PathlineSettings = field(default_factory=PathlineSettings)
 
     @property
     def frame_count(self):
@@ -222,6 +238,8 @@ class BakeSnapshot:
             data["streaks"] = {
                 "emission_period": self.streaks.emission_period,
                 "sources": [e.streak_fingerprint() for e in self.emitters if e.role == "SOURCE"]}
+        if self.pathlines.enabled:  # absent when off, so older caches still resume
+            data["pathlines"] = dataclasses.asdict(self.pathlines)
         return data
 
     def frame_input_hash(self, frame):
@@ -294,6 +312,37 @@ def validate_source(emitter, frame_start=None):
         if not all(math.isfinite(v) for v in s.velocity):
             raise BakeError(f"Plume: source '{emitter.name}': velocity must be finite "
                             f"(got {tuple(s.velocity)}{at})")
+
+
+def validate_pathlines(domain_name, pathlines, solver, streaks, emitters, bake_frames=None):
+    """Pathline recording (graph_fire_synthesis.txt §4.2) needs a fire bake with fuel sources,
+    lasting long enough (bake_frames) for groups to complete their lifetime."""
+    if not pathlines.enabled:
+        return
+    owner = f"Plume: domain '{domain_name}'"
+    if not solver.combustion:
+        raise BakeError(f"{owner}: pathlines are recorded from a fire bake: turn on combustion "
+                        "or turn pathlines off")
+    if streaks.enabled:
+        raise BakeError(f"{owner}: pathlines and streak surfaces cannot be recorded in one bake: "
+                        "turn one of them off")
+    lo, hi = NODES_PER_FRAME_RANGE
+    if not (lo <= pathlines.nodes_per_frame <= hi):
+        raise BakeError(f"{owner}: pathline_nodes_per_frame must be in [{lo}, {hi}] "
+                        f"(got {pathlines.nodes_per_frame})")
+    if not (math.isfinite(pathlines.lifetime) and 0.0 < pathlines.lifetime <= 60.0):
+        raise BakeError(f"{owner}: pathline_lifetime (t_max) must be in (0, 60] s "
+                        f"(got {pathlines.lifetime})")
+    frames = bake_frames if bake_frames is not None else 0
+    seconds = frames * solver.frame_dt
+    if bake_frames is not None and seconds < 2.0 * pathlines.lifetime:
+        raise BakeError(f"{owner}: the bake ({frames} frames, {seconds:.2f} s) must last at least "
+                        f"twice the pathline lifetime t_max ({pathlines.lifetime:g} s), so that "
+                        "pathline groups complete over half of it: bake more frames or shorten "
+                        "pathline_lifetime")
+    if not any(e.role == "SOURCE" and e.source.fuel > 0.0 for e in emitters):
+        raise BakeError(f"{owner}: pathlines are seeded in the fuel-injection region: give a "
+                        "Source fuel > 0")
 
 
 def validate_streaks(domain_name, streaks, emitters):

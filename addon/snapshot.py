@@ -9,8 +9,8 @@ from mathutils import Vector
 
 from . import cache
 from .mantaflow_cache import BORDER_SETTINGS, MantaflowSource
-from .settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, EmitterSnapshot, SolverSettings,
-                       SourceParams, StreakSettings, domain_grid)
+from .settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, EmitterSnapshot,
+                       PathlineSettings, SolverSettings, SourceParams, StreakSettings, domain_grid)
 
 NOT_A_DOMAIN = ("Plume: the active object is not a Plume domain "
                 "(set one with plume.role_set(role='DOMAIN'))")
@@ -238,4 +238,8 @@ def take_snapshot(context, addon_version="0.1.0"):
         emitters=emitter_snapshots(context, domain, frame_start, frame_end),
         addon_version=addon_version,
         streaks=StreakSettings(enabled=bool(d.streaks), emission_period=int(d.emission_period)),
-        mantaflow=mantaflow_source(domain, scene) if d.motion_source == 'MANTAFLOW' else None)
+        mantaflow=mantaflow_source(domain, scene) if d.motion_source == 'MANTAFLOW' else None,
+        pathlines=PathlineSettings(enabled=bool(d.pathlines),
+                                   nodes_per_frame=int(d.pathline_nodes_per_frame),
+                                   lifetime=float(d.pathline_lifetime),
+                                   float16=bool(d.pathline_float16)))

@@ -11,6 +11,7 @@ Import from an example run as ``blender -b --python examples/NAME.py``::
 import math
 import os
 import sys
+import time
 
 import addon_utils
 import bpy
@@ -47,11 +48,18 @@ def save_blend(out_dir, name):
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(out_dir, name + ".blend"))
 
 
-def camera(scene, location, rotation_deg, lens=50.0, name="Camera"):
+def camera(scene, location, rotation_deg=None, lens=50.0, name="Camera", target=None):
+    """The scene camera at `location`, turned by `rotation_deg` (XYZ Euler) or looking at the
+    point `target` (image up towards +z)."""
+    from mathutils import Vector
     cam = bpy.data.objects.new(name, bpy.data.cameras.new(name))
     scene.collection.objects.link(cam)
     cam.location = location
-    cam.rotation_euler = tuple(math.radians(a) for a in rotation_deg)
+    if target is not None:
+        view = Vector(target) - Vector(location)
+        cam.rotation_euler = view.to_track_quat('-Z', 'Y').to_euler()
+    else:
+        cam.rotation_euler = tuple(math.radians(a) for a in rotation_deg)
     cam.data.lens = lens
     scene.camera = cam
     return cam
@@ -64,13 +72,18 @@ def dark_studio(scene, world_color=(0.012, 0.014, 0.02), sun_energy=4.0):
     sun.data.angle = math.radians(3.0)
     sun.rotation_euler = (math.radians(50.0), 0.0, math.radians(-40.0))
     scene.collection.objects.link(sun)
+    plain_world(scene, world_color)
+    return sun
+
+
+def plain_world(scene, color):
+    """The scene's world: one plain colour, strength 1."""
     world = scene.world or bpy.data.worlds.new("World")
     scene.world = world
     world.use_nodes = True
     bg = world.node_tree.nodes["Background"]
-    bg.inputs["Color"].default_value = (*world_color, 1.0)
+    bg.inputs["Color"].default_value = (*color, 1.0)
     bg.inputs["Strength"].default_value = 1.0
-    return sun
 
 
 def cycles(scene, width, height, samples, filepath):
@@ -100,8 +113,9 @@ def render_frames(scene, frames, pattern):
     return paths
 
 
-def strip(paths, out_path, gap=4):
-    """Puts equally sized PNGs side by side (dark gap between them) into one PNG."""
+def strip(paths, out_path, gap=4, columns=None):
+    """Puts equally sized PNGs side by side (dark gap between them) into one PNG; with
+    `columns`, in rows of that many images (the first row on top)."""
     import numpy as np
     images = []
     for p in paths:
@@ -109,16 +123,17 @@ def strip(paths, out_path, gap=4):
         w, h = img.size
         px = np.empty(w * h * 4, dtype=np.float32)
         img.pixels.foreach_get(px)
-        images.append(px.reshape(h, w, 4))
+        images.append(px.reshape(h, w, 4))  # Blender's rows run bottom to top
         bpy.data.images.remove(img)
-    h = max(i.shape[0] for i in images)
-    w = sum(i.shape[1] for i in images) + gap * (len(images) - 1)
+    columns = columns or len(images)
+    rows = (len(images) + columns - 1) // columns
+    ch, cw = max(i.shape[0] for i in images), max(i.shape[1] for i in images)
+    h, w = rows * ch + gap * (rows - 1), columns * cw + gap * (columns - 1)
     out = np.zeros((h, w, 4), dtype=np.float32)
     out[..., 3] = 1.0
-    x = 0
-    for i in images:
-        out[:i.shape[0], x:x + i.shape[1]] = i
-        x += i.shape[1] + gap
+    for n, i in enumerate(images):
+        y, x = h - (n // columns + 1) * ch - (n // columns) * gap, (n % columns) * (cw + gap)
+        out[y:y + i.shape[0], x:x + i.shape[1]] = i
     img = bpy.data.images.new("plume_strip", w, h, alpha=True)
     img.pixels.foreach_set(out.ravel())
     img.filepath_raw = out_path
@@ -146,18 +161,11 @@ def bake_surfaces(dom, tag):
     """Bake, the Most Surfaces threshold (the peak of the Figure-4 curve the panel shows), Build
     Surfaces; the Volume object is hidden from renders so the sheets show alone, and the .blend
     is saved. Returns (bake seconds, build seconds, h0, surface objects); exits on failure."""
-    import time
     bpy.context.view_layer.objects.active = dom
-    t0 = time.perf_counter()
-    if bpy.ops.plume.bake() != {'FINISHED'}:
-        sys.exit(f"{tag}: the bake failed")
-    bake_s = time.perf_counter() - t0
+    bake_s = run_op(bpy.ops.plume.bake, tag, "the bake")
     if bpy.ops.plume.surfaces_pick_threshold() != {'FINISHED'}:
         sys.exit(f"{tag}: no threshold joins two streaklines")
-    t0 = time.perf_counter()
-    if bpy.ops.plume.surfaces_build() != {'FINISHED'}:
-        sys.exit(f"{tag}: Build Surfaces failed")
-    build_s = time.perf_counter() - t0
+    build_s = run_op(bpy.ops.plume.surfaces_build, tag, "Build Surfaces")
     smoke = bpy.data.objects.get(dom.plume.domain.volume_object)
     if smoke is not None:
         smoke.hide_render = True
@@ -166,11 +174,345 @@ def bake_surfaces(dom, tag):
     return bake_s, build_s, dom.plume.domain.streak_threshold, surfaces
 
 
+def render_frames_timed(scene, frames, out_dir, prefix):
+    """Renders `frames` to OUT_DIR/PREFIX_####.png; returns (seconds per frame, paths)."""
+    t0 = time.perf_counter()
+    paths = render_frames(scene, frames, os.path.join(out_dir, prefix + "_%04d.png"))
+    return (time.perf_counter() - t0) / len(paths), paths
+
+
 def render_strip(scene, frames, out_dir, prefix):
     """Renders `frames` to OUT_DIR/PREFIX_####.png and puts them side by side in
     OUT_DIR/PREFIX_strip.png; returns (seconds per frame, strip path)."""
-    import time
-    t0 = time.perf_counter()
-    paths = render_frames(scene, frames, os.path.join(out_dir, prefix + "_%04d.png"))
-    seconds = (time.perf_counter() - t0) / len(paths)
+    seconds, paths = render_frames_timed(scene, frames, out_dir, prefix)
     return seconds, strip(paths, os.path.join(out_dir, prefix + "_strip.png"))
+
+
+def run_op(op, tag, what):
+    """Runs operator `op` (e.g. bpy.ops.plume.bake); exits naming `what` unless it finishes.
+    Returns its seconds."""
+    t0 = time.perf_counter()
+    if op() != {'FINISHED'}:
+        sys.exit(f"{tag}: {what} failed")
+    return time.perf_counter() - t0
+
+
+# --- Toon smoke (cartoon_smoke.txt) ---------------------------------------------------------
+
+
+def toon_look(scene, background, width, height, samples, filepath):
+    """Cycles set up for flat toon colours: the Standard view transform (Filmic would grey the
+    flat colours), a plain world of colour `background` and no lights (the toon material is
+    emission only)."""
+    cycles(scene, width, height, samples, filepath)
+    scene.view_settings.view_transform = 'Standard'
+    scene.view_settings.look = 'None'
+    plain_world(scene, background)
+
+
+def bake_toon(dom, tag):
+    """Bake, then Build Toon Smoke (plume.toon_build, the artist's button) on domain `dom`; the
+    domain box and its Volume object are hidden from renders so only the billboards show, and
+    the .blend is saved. Returns (bake seconds, build seconds); exits on failure."""
+    bpy.context.view_layer.objects.active = dom
+    bake_s = run_op(bpy.ops.plume.bake, tag, "the bake")
+    build_s = build_toon(dom, tag)
+    for ob in (dom, bpy.data.objects.get(dom.plume.domain.volume_object)):
+        if ob is not None:
+            ob.hide_render = True
+    bpy.ops.wm.save_mainfile()
+    return bake_s, build_s
+
+
+def build_toon(dom, tag):
+    """Build Toon Smoke on `dom` again (e.g. after changing its toon settings), checks that the
+    Composite output is the "Plume Depth Differences" group's image (so the rendered and saved
+    frames carry the outlines); returns the seconds."""
+    bpy.context.view_layer.objects.active = dom
+    seconds = run_op(bpy.ops.plume.toon_build, tag, "Build Toon Smoke")
+    scene = bpy.context.scene
+    comp = next((n for n in scene.node_tree.nodes if n.type == 'COMPOSITE'), None)
+    link = comp.inputs["Image"].links[0] if comp and comp.inputs["Image"].is_linked else None
+    if not (scene.use_nodes and scene.render.use_compositing and link is not None
+            and link.from_node.type == 'GROUP'
+            and link.from_node.node_tree.name == "Plume Depth Differences"):
+        sys.exit(f"{tag}: the Composite output is not the outline group's image")
+    return seconds
+
+
+def source_puffs(t, emission_count, sizes, densities, death_density, depth_threshold):
+    """The toon settings `t` (obj.plume.domain.toon) the examples share: particles only from the
+    Sources, `emission_count` per frame (§2.1; ρ_birth = 2 is above any density of a bake whose
+    Sources set 1, so none is born elsewhere), puffy stencil of diameter sizes[0]..sizes[1] over
+    the density ramp densities[0]..[1], ρ_death, γ. The puffs stay a few cells apart: that gives
+    the paper's big puffy shapes (a particle born in every dense cell merges into one smooth
+    blob). Sizes change by at most a quarter of the largest per frame; a slight stretch."""
+    t.emission_count = emission_count
+    t.birth_density, t.death_density = 2.0, death_density
+    t.ramp_density_low, t.ramp_density_high = densities
+    t.size_low, t.size_high = sizes
+    t.max_size_change = 0.25
+    t.stretch_factor = 0.1
+    t.stencil = 'PUFFY'
+    t.depth_threshold = depth_threshold
+
+
+def sphere_source(name, radius, location, density=1.0, temperature=0.0,
+                  velocity=(0.0, 0.0, 0.0)):
+    """A UV sphere made a Plume Source (hidden from renders) with these settings."""
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=radius, location=location)
+    src = bpy.context.active_object
+    src.name = name
+    bpy.ops.plume.role_set(role='SOURCE')
+    s = src.plume.source
+    s.density, s.temperature, s.velocity = density, temperature, velocity
+    src.hide_render = True
+    return src
+
+
+def burst(src, frames_on):
+    """Keyframes the source's density, temperature and velocity (constant interpolation): as set
+    on frames 1..frames_on, 0 from frames_on + 1 on - a short burst of smoke."""
+    s = src.plume.source
+    on, off = (s.density, s.temperature, tuple(s.velocity)), (0.0, 0.0, (0.0, 0.0, 0.0))
+    for frame, (density, temperature, velocity) in ((1, on), (frames_on + 1, off)):
+        s.density, s.temperature, s.velocity = density, temperature, velocity
+        for name in ("density", "temperature", "velocity"):
+            src.keyframe_insert("plume.source." + name, frame=frame)
+    s.density, s.temperature, s.velocity = on
+    for fc in src.animation_data.action.fcurves:
+        for k in fc.keyframe_points:
+            k.interpolation = 'CONSTANT'
+    return src
+
+
+def flat_box(name, location, size, color):
+    """A box of `size` (m) at `location`, flat `color` (emission only): e.g. a floor or ceiling
+    drawn in a toon picture; it is no Plume object."""
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=location)
+    box = bpy.context.active_object
+    box.name = name
+    box.scale = size
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    emission = nodes.new('ShaderNodeEmission')
+    emission.inputs["Color"].default_value = (*color, 1.0)
+    mat.node_tree.links.new(emission.outputs[0], nodes["Material Output"].inputs["Surface"])
+    box.data.materials.append(mat)
+    return box
+
+
+def shown_frames(fractions, frames):
+    """The frames at `fractions` of a shot of `frames` frames (1 .. frames, sorted, once each)."""
+    return sorted({max(1, min(frames, round(f * frames))) for f in fractions})
+
+
+def toon_summary(tag, grid, frames, bake_s, build_s, dom, render_s, strip_path):
+    """Prints a toon example's times (bake, Build Toon Smoke, render per frame) and its strip."""
+    scene = bpy.context.scene
+    particles = len(bpy.data.objects[dom.plume.domain.toon.object_name].data.vertices)
+    print(f"{tag}: {frames} frames at {grid}, bake {bake_s:.1f} s ({bake_s / frames:.2f} "
+          f"s/frame), Build Toon Smoke {build_s:.1f} s, {particles} particles on frame "
+          f"{scene.frame_current}, render {render_s:.1f} s/frame ({scene.render.resolution_x}x"
+          f"{scene.render.resolution_y}, {scene.cycles.samples} samples) -> {strip_path}",
+          flush=True)
+
+
+def toon_example(tag, usage, default_frames, setup, show, grid):
+    """A toon example from the command line: OUT_DIR [FRAMES]; setup(scene, frames, out_dir)
+    builds the scene (sources, domain, camera, look) and returns the domain; then the .blend is
+    saved to OUT_DIR/TAG.blend, baked, Build Toon Smoke runs, the frames at fractions `show` of
+    the shot are rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are
+    printed (`grid` names the grid in the summary)."""
+    out_dir, frames = parse_args(usage, default_frames)
+    scene = new_scene()
+    dom = setup(scene, frames, out_dir)
+    scene.frame_start, scene.frame_end = 1, frames
+    save_blend(out_dir, tag)
+    bake_s, build_s = bake_toon(dom, tag)
+    render_s, strip_path = render_strip(scene, shown_frames(show, frames), out_dir, tag)
+    toon_summary(tag, grid, frames, bake_s, build_s, dom, render_s, strip_path)
+
+
+# --- Flow-graph fire (graph_fire_synthesis.txt) ---------------------------------------------
+
+#: RAM a pathline sample takes while the graph is built (pathline_group.h: velocity, density,
+#: temperature as floats): the build holds every group of every state, |Ω| L 20 B per node.
+PATHLINE_SAMPLE_BYTES = 20
+
+
+def addon_module(name):
+    """A module of the installed add-on, e.g. '_native', 'cache', 'flowgraph', 'snapshot'."""
+    import importlib
+    return importlib.import_module("plume." + name)
+
+
+def select(objects, active):
+    """Selects exactly `objects` and makes `active` the active object."""
+    bpy.ops.object.select_all(action='DESELECT')
+    for ob in objects:
+        ob.select_set(True)
+    bpy.context.view_layer.objects.active = active
+
+
+def fire_domain(name, box, location, resolution, frames, nodes_per_frame, lifetime):
+    """A box of `box` (m) centred at `location` made a fire domain (combustion on) recording
+    pathline groups (§4.2): one state of a flow graph. All states of a graph share the box, the
+    resolution, the fuel Sources, nodes per frame and lifetime t_max."""
+    dom = domain_cube(name, 1.0, location, resolution, frames)
+    dom.scale = box
+    d = dom.plume.domain
+    d.combustion = d.pathlines = True
+    d.pathline_nodes_per_frame, d.pathline_lifetime = nodes_per_frame, lifetime
+    return dom
+
+
+def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
+    """A mesh primitive (e.g. bpy.ops.mesh.primitive_cylinder_add; 2 m across by default) scaled
+    to `dims` (m) at `location`, made a Plume Source of fuel (the fuel-injection region Ω where
+    pathlines are seeded; no smoke density: the fire makes its soot), hidden from renders."""
+    add_primitive(location=location)
+    src = bpy.context.active_object
+    src.name = name
+    src.scale = tuple(v / 2.0 for v in dims)
+    bpy.ops.plume.role_set(role='SOURCE')
+    s = src.plume.source
+    s.fuel, s.density, s.temperature = fuel, 0.0, temperature
+    src.hide_render = True
+    return src
+
+
+def flicker(src, speed, fuel_share, frames_scale, phase=0.0):
+    """Noise F-curve modifiers on a fuel Source: its horizontal velocity wanders within
+    ±`speed` m/s and its fuel within ±`fuel_share` of itself, over about `frames_scale` frames
+    (a log pile does not burn evenly). The uneven feed breaks the symmetry of the flame, which
+    then flickers as a fire does, so its pathline groups differ over time and the flow graph
+    finds transitions (§4.3)."""
+    s = src.plume.source
+    src.keyframe_insert("plume.source.velocity", frame=1)
+    src.keyframe_insert("plume.source.fuel", frame=1)
+    for n, fc in enumerate(src.animation_data.action.fcurves):
+        if fc.data_path.endswith("velocity") and fc.array_index == 2:
+            continue
+        m = fc.modifiers.new('NOISE')
+        m.blend_type = 'REPLACE'  # value + (noise - 1/2) strength, noise in [0, 1]
+        m.strength = 2.0 * (speed if fc.data_path.endswith("velocity") else fuel_share * s.fuel)
+        m.scale = frames_scale
+        m.phase = phase + 7.0 * n
+    return src
+
+
+def bake_fire_states(domains, tag):
+    """Bakes every state (with its pathlines.bin); prints per state the bake time (per frame) and
+    the pathline file (size, nodes, |Ω|, L, bytes per node), and the RAM Build Flow Graph will
+    hold. Returns the bake seconds per state; exits on failure."""
+    native, cache, snapshot = (addon_module(n) for n in ("_native", "cache", "snapshot"))
+    seconds, ram = [], 0
+    for dom in domains:
+        select([dom], dom)
+        s = run_op(bpy.ops.plume.bake, tag, f"the bake of '{dom.name}'")
+        d = dom.plume.domain
+        frames = d.frame_end - d.frame_start + 1
+        path = cache.pathlines_path(snapshot.cache_folder_of(dom))
+        f = native.PathlineFile.open(path)
+        lay = f.layout
+        node_ram = lay.particles * lay.samples * PATHLINE_SAMPLE_BYTES
+        ram += node_ram * f.node_count
+        print(f"{tag}: bake '{dom.name}' {frames} frames in {s:.1f} s ({s / frames:.2f} s/frame); "
+              f"pathlines.bin {os.path.getsize(path) / 1e6:.0f} MB: {f.node_count} nodes of "
+              f"|Ω| = {lay.particles} pathlines x L = {lay.samples} samples "
+              f"({lay.sample_dt * 1e3:.1f} ms apart), {f.bytes_per_node / 1e6:.2f} MB/node on disk, "
+              f"{node_ram / 1e6:.2f} MB/node in RAM", flush=True)
+        seconds.append(s)
+    print(f"{tag}: Build Flow Graph holds {ram / 1e9:.2f} GB of pathline groups", flush=True)
+    return seconds
+
+
+def build_flow_graph(domains, keeper, tag, block_size):
+    """Build Flow Graph (plume.flowgraph_build) over the states `domains` (name order), kept
+    with `keeper`, blocks of B = `block_size`; prints the graph summary; returns the seconds."""
+    select(domains, keeper)
+    g = keeper.plume.domain.flowgraph
+    g.block_size = block_size
+    seconds = run_op(bpy.ops.plume.flowgraph_build, tag, "Build Flow Graph")
+    print(f"{tag}: Build Flow Graph {seconds:.1f} s (B = {block_size}): {g.state_names}; "
+          f"{g.summary}", flush=True)
+    return seconds
+
+
+def key_target_states(dom, keys):
+    """Keys the flow graph's target state (§5.1) of `dom`: (frame, state) pairs, held constant
+    until the next key."""
+    g = dom.plume.domain.flowgraph
+    for frame, state in keys:
+        g.target_state = state
+        g.keyframe_insert("target_state", frame=frame)
+    for fc in dom.animation_data.action.fcurves:
+        if fc.data_path.endswith("target_state"):
+            for k in fc.keyframe_points:
+                k.interpolation = 'CONSTANT'
+
+
+def synthesize_fire(dom, frames, tag):
+    """Synthesize Fire (plume.fire_synthesize) for frames 1..frames from `dom`'s graph; returns
+    (seconds, the fire Volume object); exits on failure."""
+    g = dom.plume.domain.flowgraph
+    g.frame_start, g.frame_end = 1, frames
+    select([dom], dom)
+    seconds = run_op(bpy.ops.plume.fire_synthesize, tag, "Synthesize Fire")
+    return seconds, bpy.data.objects[g.fire_object]
+
+
+def hide_bakes(domains):
+    """Hides the domains and the Volume objects of their bakes from renders (the synthesized
+    fire shows alone)."""
+    for dom in domains:
+        dom.hide_render = True
+        vo = bpy.data.objects.get(dom.plume.domain.volume_object)
+        if vo is not None:
+            vo.hide_render = True
+
+
+def lit_share(path, level=0.05):
+    """Share of the pixels of PNG `path` brighter than `level` in some channel."""
+    import numpy as np
+    img = bpy.data.images.load(path, check_existing=False)
+    px = np.empty(img.size[0] * img.size[1] * 4, dtype=np.float32)
+    img.pixels.foreach_get(px)
+    bpy.data.images.remove(img)
+    return float((px.reshape(-1, 4)[:, :3].max(axis=1) > level).mean())
+
+
+def flowgraph_example(tag, usage, default_frames, setup, show, block_size):
+    """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene, frames,
+    out_dir) builds the scene (fuel Sources, the state domains in name order, camera, look) and
+    returns (domains, keys): (frame, target state) keys of the synthesis. Then the .blend is
+    saved to OUT_DIR/TAG.blend, every state is baked, Build Flow Graph (kept with state 0), the
+    target states are keyed, FRAMES frames are synthesized, the cost-matrix picture is copied to
+    OUT_DIR/TAG_cost.png, the frames at fractions `show` are rendered to OUT_DIR/TAG_####.png and
+    OUT_DIR/TAG_strip.png, and the times are printed."""
+    import shutil
+    out_dir, frames = parse_args(usage, default_frames)
+    scene = new_scene()
+    domains, keys = setup(scene, frames, out_dir)
+    scene.frame_start, scene.frame_end = 1, frames
+    save_blend(out_dir, tag)
+    bake_fire_states(domains, tag)
+    keeper = domains[0]
+    build_flow_graph(domains, keeper, tag, block_size)
+    key_target_states(keeper, keys)
+    synth_s, fire = synthesize_fire(keeper, frames, tag)
+    print(f"{tag}: Synthesize Fire {frames} frames in {synth_s:.1f} s ({synth_s / frames * 1e3:.0f} "
+          f"ms/frame, VDB writing included) -> '{fire.name}'", flush=True)
+    hide_bakes(domains)
+    bpy.ops.wm.save_mainfile()
+    folder = addon_module("snapshot").cache_folder_of(keeper)
+    shutil.copyfile(addon_module("flowgraph").image_path(folder),
+                    os.path.join(out_dir, tag + "_cost.png"))
+    seconds, paths = render_frames_timed(scene, shown_frames(show, frames), out_dir, tag)
+    lit = ", ".join(f"{lit_share(p) * 100:.0f}%" for p in paths)
+    print(f"{tag}: render {seconds:.1f} s/frame ({scene.render.resolution_x}x"
+          f"{scene.render.resolution_y}, {scene.cycles.samples} samples; lit pixels {lit}) -> "
+          f"{strip(paths, os.path.join(out_dir, tag + '_strip.png'))}", flush=True)

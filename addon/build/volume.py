@@ -84,26 +84,31 @@ def build_volume(domain, folder, frame_start, frames_done, combustion=False, max
             coll.objects.link(ob)
         if not ob.users_collection:
             bpy.context.scene.collection.objects.link(ob)
-    vol = ob.data
-    vol.grids.unload()  # a re-bake rewrote the files: do not keep the old grids in memory
-    vol.filepath = path
-    vol.is_sequence = True
-    vol.frame_start = frame_start
-    vol.frame_duration = frames_done
-    vol.frame_offset = 0
-    vol.sequence_mode = 'CLIP'
-    vol.velocity_unit = 'SECOND'  # the "velocity" grid (default name) is in m/s
-    ob.matrix_world.identity()  # the VDB voxels are in world space
-    mat = material(combustion, max_temperature)
-    if not vol.materials:
-        vol.materials.append(mat)
-    elif vol.materials[0] is None or vol.materials[0].name in (SMOKE_MATERIAL, FIRE_MATERIAL):
-        vol.materials[0] = mat
+    play_sequence(ob, path, frame_start, frames_done, material(combustion, max_temperature))
     domain.plume.domain.volume_object = ob.name
     domain.plume.domain.frames_baked = frames_done
     domain.display_type = 'WIRE'
     domain.hide_render = True
     return ob
+
+
+def play_sequence(ob, path, frame_start, frames, mat):
+    """Points Volume object `ob` at the VDB sequence starting with `path` (world-space voxels)
+    and gives it `mat` unless the artist replaced the Plume material."""
+    vol = ob.data
+    vol.grids.unload()  # a re-bake rewrote the files: do not keep the old grids in memory
+    vol.filepath = path
+    vol.is_sequence = True
+    vol.frame_start = frame_start
+    vol.frame_duration = frames
+    vol.frame_offset = 0
+    vol.sequence_mode = 'CLIP'
+    vol.velocity_unit = 'SECOND'  # the "velocity" grid (default name) is in m/s
+    ob.matrix_world.identity()  # the VDB voxels are in world space
+    if not vol.materials:
+        vol.materials.append(mat)
+    elif vol.materials[0] is None or vol.materials[0].name in (SMOKE_MATERIAL, FIRE_MATERIAL):
+        vol.materials[0] = mat
 
 
 def remove_volume(domain):

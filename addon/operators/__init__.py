@@ -1,7 +1,8 @@
 """Operators: plume.role_set, plume.bake, plume.cache_free, plume.surfaces_build, and on built
 surfaces plume.surface_edits_store / _clear, plume.surfaces_bake_keyframes,
-plume.surfaces_export_mesh; plume.toon_build."""
+plume.surfaces_export_mesh; plume.toon_build; plume.flowgraph_build, plume.fire_synthesize."""
 
-from . import bake, roles, surface_edits, surfaces, toon
+from . import bake, flowgraph, roles, surface_edits, surfaces, toon
 
-classes = roles.classes + bake.classes + surfaces.classes + surface_edits.classes + toon.classes
+classes = (roles.classes + bake.classes + surfaces.classes + surface_edits.classes + toon.classes
+           + flowgraph.classes)

@@ -142,6 +142,12 @@ class PHYSICS_PT_plume_combustion(PlumeDomainPanel, bpy.types.Panel):
         for name in ("burn_rate", "soot_yield", "heat_yield", "conductivity", "cooling_rate",
                      "max_temperature", "expansion"):
             layout.prop(d, name)
+        # Pathline groups for flow-graph fire (graph_fire_synthesis.txt §4.2).
+        layout.prop(d, "pathlines")
+        col = layout.column()
+        col.active = d.pathlines
+        for name in ("pathline_nodes_per_frame", "pathline_lifetime", "pathline_float16"):
+            col.prop(d, name)
 
 
 class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
@@ -252,6 +258,41 @@ class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
             layout.label(text=f"Toon: {t.object_name}", icon='OUTLINER_OB_POINTCLOUD')
 
 
+class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Flow-Graph Fire"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        ob = context.object
+        g = ob.plume.domain.flowgraph
+        col = layout.column(heading="Graph")
+        for name in ("block_size", "epsilon", "min_node_gap", "auto_weights"):
+            col.prop(g, name)
+        sub = col.column(align=True)
+        sub.active = not g.auto_weights
+        sub.prop(g, "alpha")
+        sub.prop(g, "beta")
+        layout.operator("plume.flowgraph_build", icon='NODETREE')
+        if g.summary:
+            layout.label(text=g.state_names, icon='INFO')
+            layout.label(text=g.summary)
+            img = bpy.data.images.get("Plume Flow Graph " + ob.name)
+            if img is not None and img.preview is not None:
+                layout.template_icon(icon_value=img.preview.icon_id, scale=10.0)
+        col = layout.column(heading="Synthesis")
+        row = col.row(align=True)
+        row.prop(g, "frame_start")
+        row.prop(g, "frame_end")
+        for name in ("seed", "traversal", "gamma", "start_state", "target_state", "wind",
+                     "use_force_fields"):
+            col.prop(g, name)
+        layout.operator("plume.fire_synthesize", icon='PLAY')
+        if g.fire_object:
+            layout.label(text=f"Fire: {g.fire_object}", icon='OUTLINER_OB_VOLUME')
+
+
 class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
     bl_label = "Source"
     bl_parent_id = "PHYSICS_PT_plume"
@@ -308,6 +349,7 @@ classes = (
     PHYSICS_PT_plume_cache,
     PHYSICS_PT_plume_streaks,
     PHYSICS_PT_plume_toon,
+    PHYSICS_PT_plume_flowgraph,
     PHYSICS_PT_plume_source,
     PHYSICS_PT_plume_obstacle,
 )

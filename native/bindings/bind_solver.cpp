@@ -191,7 +191,8 @@ void bindParams(py::module_& m) {
   field(c, "trace", &SmokeParams::trace,
         "Trace.MIDPOINT (RK2, the default) or Trace.EULER (first order, grid-point velocity).");
   field(c, "conserve_mass", &SmokeParams::conserveMass,
-        "Restore the total smoke after each advection, less what left through open sides.");
+        "Restore the total smoke (and heat, T - T_amb) after each advection, less what left "
+        "through open sides.");
   c.def_property(
       "gravity", [](const SmokeParams& p) { return fromVec3(p.gravity); },
       [](SmokeParams& p, const py::object& v) { p.gravity = toVec3(v, "gravity"); },

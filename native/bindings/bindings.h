@@ -22,6 +22,14 @@ void bindStreak(pybind11::module_& m);
 void bindMantaflow(pybind11::module_& m);
 /// Toon smoke: particles, billboards, depth differences, toon files (bind_toon.cpp).
 void bindToon(pybind11::module_& m);
+/// PathlineLayout and PathlineGroup, the flow-graph node type (bind_pathline_group.cpp).
+void bindPathlineGroup(pybind11::module_& m);
+/// Flow-graph fire data and synthesis: PathlineRecorder, PathlineFile, Synthesizer,
+/// VelocityField, FireRasterParams, write_fire_vdb (bind_flowgraph_synth.cpp).
+void bindFlowgraphSynth(pybind11::module_& m);
+/// Flow graph: FlowGraphParams, cost_matrix, FlowGraph, RandomWalk, cost_matrix_image
+/// (bind_flowgraph_graph.cpp).
+void bindFlowgraphGraph(pybind11::module_& m);
 
 /// A path argument given as str or os.PathLike, as a std::string (needs the GIL).
 inline std::string pathArg(const pybind11::object& path) {

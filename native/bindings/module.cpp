@@ -44,4 +44,7 @@ PYBIND11_MODULE(_native, m) {
   plume::bindings::bindStreak(m);
   plume::bindings::bindMantaflow(m);
   plume::bindings::bindToon(m);
+  plume::bindings::bindPathlineGroup(m);
+  plume::bindings::bindFlowgraphSynth(m);
+  plume::bindings::bindFlowgraphGraph(m);
 }

@@ -18,15 +18,6 @@
 namespace plume {
 namespace {
 
-/// Cell (i,j,k) is voxel (i,j,k): voxel size Δx, voxel centre origin + (i+½, j+½, k+½) Δx.
-openvdb::math::Transform::Ptr cellTransform(const SmokeParams& p) {
-  auto xform = openvdb::math::Transform::createLinearTransform(double(p.cellSize));
-  xform->postTranslate(openvdb::Vec3d(double(p.origin.x) + 0.5 * double(p.cellSize),
-                                      double(p.origin.y) + 0.5 * double(p.cellSize),
-                                      double(p.origin.z) + 0.5 * double(p.cellSize)));
-  return xform;
-}
-
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw std::runtime_error("VDB file '" + path + "': " + what);
 }
@@ -37,7 +28,7 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
   initializeOpenVdb();
   const SmokeParams& p = solver.params();
   const glm::ivec3 n = p.resolution;
-  const auto xform = cellTransform(p);
+  const auto xform = cellCenteredTransform(p.cellSize, p.origin);
   const int slabs = n.z;
   const std::size_t slab = std::size_t(n.x) * std::size_t(n.y);
 

@@ -28,6 +28,14 @@ void initializeOpenVdb() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
+openvdb::math::Transform::Ptr cellCenteredTransform(float cellSize, glm::vec3 origin) {
+  auto xform = openvdb::math::Transform::createLinearTransform(double(cellSize));
+  xform->postTranslate(openvdb::Vec3d(double(origin.x) + 0.5 * double(cellSize),
+                                      double(origin.y) + 0.5 * double(cellSize),
+                                      double(origin.z) + 0.5 * double(cellSize)));
+  return xform;
+}
+
 openvdb::FloatGrid::Ptr denseFloatGrid(const std::string& name, const float* values, glm::ivec3 n,
                                        const openvdb::math::Transform::Ptr& xform) {
   auto grid = openvdb::FloatGrid::create(/*background=*/0.f);

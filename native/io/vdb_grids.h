@@ -14,6 +14,10 @@ namespace plume {
 /// openvdb::initialize(), once per process (thread-safe).
 void initializeOpenVdb();
 
+/// The transform of Plume's frame VDBs: voxel size Δx = `cellSize`, voxel (i,j,k) centred at
+/// origin + (i + 1/2, j + 1/2, k + 1/2) Δx (cell (i,j,k) of the solver is voxel (i,j,k)).
+openvdb::math::Transform::Ptr cellCenteredTransform(float cellSize, glm::vec3 origin);
+
 /// A fog-volume float grid `name` holding the non-zero values of `values` (x-fastest,
 /// n.x * n.y * n.z, solver layout: value (i,j,k) at voxel (i,j,k)) with transform `xform`.
 openvdb::FloatGrid::Ptr denseFloatGrid(const std::string& name, const float* values, glm::ivec3 n,

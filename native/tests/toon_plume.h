@@ -4,6 +4,7 @@
 /// at 1 m/s and turning about the z axis, with its source at the bottom centre.
 
 #include "toon/toon_fields.h"
+#include "toon/toon_params.h"
 
 #include <cmath>
 
@@ -44,6 +45,22 @@ inline ToonFields plumeFields(const GridFrame& g, float scale = 1.f, float swirl
       for (int i = 0; i < n.x; ++i) f.velocity.v()(i, j, k) = swirl * ((float(i) + 0.5f) * h - axis.x);
   f.velocity.w().fill(1.f);
   return f;
+}
+
+/// Toon settings for the plume: birth above density 0.5, death below 0.1, sizes 1 to 5 cm over
+/// densities 0.1 to 1, at most 10% of the largest size per frame, 8 particles emitted per frame.
+inline ToonParams plumeParams() {
+  ToonParams p;
+  p.birthDensity = 0.5f;
+  p.deathDensity = 0.1f;
+  p.rampDensityLow = 0.1f;
+  p.rampDensityHigh = 1.f;
+  p.sizeLow = 0.01f;
+  p.sizeHigh = 0.05f;
+  p.maxSizeChange = 0.1f;
+  p.emissionCount = 8;
+  p.seed = 7;
+  return p;
 }
 
 /// The 2x2 cells at the bottom centre of the plume.

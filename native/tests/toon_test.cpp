@@ -23,23 +23,10 @@ namespace {
 
 using testing::plumeFields;
 using testing::plumeGrid;
+using testing::plumeParams;
 using testing::plumeSources;
 
 constexpr float kDt = 1.f / 24.f;
-
-ToonParams plumeParams() {
-  ToonParams p;
-  p.birthDensity = 0.5f;
-  p.deathDensity = 0.1f;
-  p.rampDensityLow = 0.1f;
-  p.rampDensityHigh = 1.f;
-  p.sizeLow = 0.01f;
-  p.sizeHigh = 0.05f;
-  p.maxSizeChange = 0.1f;
-  p.emissionCount = 8;
-  p.seed = 7;
-  return p;
-}
 
 /// Cells holding at least one particle inside the domain.
 std::set<std::size_t> occupiedCells(const ToonParticles& t) {
@@ -166,6 +153,24 @@ TEST(ToonParticles, EmissionSpreadsOverTheSourceCells) {
   t.advanceFrame(still, still, kDt, plumeSources(g));
   EXPECT_EQ(t.count(), 3u);
   EXPECT_EQ(t.state().ids.front(), 3u);  // the first three went at size 0, three new ones came
+  // Two sources of 25 cells each (at x < 0.5 m and x > 0.7 m) and 4 particles per frame: each
+  // frame's particles spread over both (in turn, the first 4 frames came from the first source).
+  ToonSources two;
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 5; ++i) {
+      two.cells.emplace_back(i, j, 0);
+      two.cells.emplace_back(7 + i, 7 + j, 0);
+    }
+  std::sort(two.cells.begin(), two.cells.end(), [](glm::ivec3 a, glm::ivec3 b) { return a.x < b.x; });
+  p.emissionCount = 4;
+  ToonParticles burst(p, g);
+  for (int f = 0; f < 3; ++f) {
+    burst.advanceFrame(still, still, kDt, two);
+    int left = 0;
+    for (const glm::vec3& x : burst.state().positions) left += x.x < 0.6f;
+    EXPECT_EQ(left, 2) << "frame " << f;
+    EXPECT_EQ(burst.count(), 4u);
+  }
 }
 
 ToonParticleState runPlume(int threads, ToonIntegration integration) {

@@ -1,87 +1,51 @@
 #pragma once
 /// \file field_sampler.h
 /// The trilinear samples a toon particle takes (cartoon_smoke.txt §2.1: "position, velocity, and
-/// density are linearly interpolated from the simulation grid"), four particles at a time: the
-/// clamped split of each coordinate is computed once per position and shared by every field (the
-/// cell-centred density and temperature, and the three staggered velocity components), and the
-/// interpolation runs on four SSE lanes. Each lane's value is the one sampleLinear /
-/// sampleVelocity (core/sampling.h) return, bit for bit: same clamping, same operations in the
-/// same order.
+/// density are linearly interpolated from the simulation grid"), for a group of kToonLanes
+/// particles at a time: the clamped split of each coordinate is computed once per position and
+/// shared by every field (the cell-centred density and temperature, and the three staggered
+/// velocity components). The interpolation runs on eight AVX2 lanes where the CPU has them (the
+/// solver's corner gathers, core/linear_cells.h), else on two halves of four SSE lanes. Each
+/// lane's value is the one sampleLinear / sampleVelocity (core/sampling.h) return, bit for bit:
+/// same clamping, same operations in the same order, so the choice changes no result.
+///
+/// A NaN coordinate (only a broken velocity field makes one) reads as 0, the grid's first
+/// sample, instead of an index far outside the grid; every other coordinate splits as
+/// splitCoordinate() does.
 
-#include "core/grid3.h"
-#include "core/mac_grid3.h"
-#include "core/sample_points.h"
-
-#include <smmintrin.h>
+#include "toon/toon_fields.h"
 
 namespace plume {
 
-/// Lower sample index and fraction of four coordinates clamped to [0, n-1]
-/// (core/sample_points.h splitCoordinate4, the split of every Plume sample).
-struct AxisSplit4 {
-  __m128i i;
-  __m128 t;
-  AxisSplit4() = default;
-  AxisSplit4(__m128 x, int n) { splitCoordinate4(x, n, i, t); }
+/// Particles per group of the toon samplers.
+constexpr int kToonLanes = 8;
+
+/// kToonLanes 3-vectors as a structure of arrays: c[axis][lane].
+struct ToonLanes3 {
+  alignas(32) float c[3][kToonLanes];
 };
 
-/// The splits of four positions c[0..3] in cell coordinates (cell (i,j,k)'s centre at (i,j,k)) on
-/// a grid of n cells: centred for the cell grids, staggered (c + ½ on n + 1 faces) for the faces.
-struct PositionSplits4 {
-  AxisSplit4 centred[3];
-  AxisSplit4 staggered[3];
-  PositionSplits4(glm::ivec3 n, const glm::vec3* c) {
-    for (int a = 0; a < 3; ++a) {
-      const __m128 x = _mm_setr_ps(c[0][a], c[1][a], c[2][a], c[3][a]);
-      centred[a] = AxisSplit4(x, n[a]);
-      staggered[a] = AxisSplit4(_mm_add_ps(x, _mm_set1_ps(0.5f)), n[a] + 1);
-    }
-  }
+/// The samples of a group of particles at cell coordinates (cell (i,j,k)'s centre at (i,j,k))
+/// on a grid of `cells` cells.
+class ToonFieldSampler {
+ public:
+  /// `wide`: use the eight-lane kernels where the CPU has AVX2 and the grids index in 31 bits
+  /// (false: always four lanes; the values are the same).
+  explicit ToonFieldSampler(glm::ivec3 cells, bool wide = true);
+  /// Whether the eight-lane kernels run.
+  bool wide() const { return mWide; }
+
+  /// The face velocity at `cell`, linear in time between a (t = 0) and b (t = 1):
+  /// (1 - t) v_a + t v_b, reading only a at t <= 0 and only b at t >= 1.
+  void velocity(const MacGrid3& a, const MacGrid3& b, float t, const ToonLanes3& cell,
+                ToonLanes3& v) const;
+  /// Velocity, density and temperature (0 without a temperature grid) of f at `cell`.
+  void fields(const ToonFields& f, const ToonLanes3& cell, ToonLanes3& v, float* density,
+              float* temperature) const;
+
+ private:
+  glm::ivec3 mCells;
+  bool mWide = false;
 };
-
-/// Trilinear samples of g at four stencils (x, y, z): sampleLinear's arithmetic on each lane.
-inline __m128 trilinear4(const ScalarGrid& g, const AxisSplit4& x, const AxisSplit4& y,
-                         const AxisSplit4& z) {
-  const glm::ivec3 n = g.size();
-  const std::ptrdiff_t dx = n.x > 1 ? 1 : 0;
-  const std::ptrdiff_t dy = n.y > 1 ? g.strideY() : 0;
-  const std::ptrdiff_t dz = n.z > 1 ? g.strideZ() : 0;
-  alignas(16) int ix[4], iy[4], iz[4];
-  _mm_store_si128(reinterpret_cast<__m128i*>(ix), x.i);
-  _mm_store_si128(reinterpret_cast<__m128i*>(iy), y.i);
-  _mm_store_si128(reinterpret_cast<__m128i*>(iz), z.i);
-  // f[corner][lane], corner bits: x, y, z.
-  alignas(16) float f[8][4];
-  for (int m = 0; m < 4; ++m) {
-    const float* q = g.data() + g.index(ix[m], iy[m], iz[m]);
-    f[0][m] = q[0];
-    f[1][m] = q[dx];
-    f[2][m] = q[dy];
-    f[3][m] = q[dy + dx];
-    f[4][m] = q[dz];
-    f[5][m] = q[dz + dx];
-    f[6][m] = q[dz + dy];
-    f[7][m] = q[dz + dy + dx];
-  }
-  auto lerp = [](__m128 a, __m128 b, __m128 t) { return _mm_add_ps(a, _mm_mul_ps(t, _mm_sub_ps(b, a))); };
-  auto at = [&](int c) { return _mm_load_ps(f[c]); };
-  const __m128 c00 = lerp(at(0), at(1), x.t), c10 = lerp(at(2), at(3), x.t);
-  const __m128 c01 = lerp(at(4), at(5), x.t), c11 = lerp(at(6), at(7), x.t);
-  return lerp(lerp(c00, c10, y.t), lerp(c01, c11, y.t), z.t);
-}
-
-/// A cell-centred grid at the four positions, into out[0..3].
-inline void sampleCentred4(const ScalarGrid& g, const PositionSplits4& s, float* out) {
-  _mm_storeu_ps(out, trilinear4(g, s.centred[0], s.centred[1], s.centred[2]));
-}
-
-/// The face velocity at the four positions (sampleVelocity's values), into out[0..3].
-inline void sampleFaces4(const MacGrid3& v, const PositionSplits4& s, glm::vec3* out) {
-  alignas(16) float c[3][4];
-  _mm_store_ps(c[0], trilinear4(v.u(), s.staggered[0], s.centred[1], s.centred[2]));
-  _mm_store_ps(c[1], trilinear4(v.v(), s.centred[0], s.staggered[1], s.centred[2]));
-  _mm_store_ps(c[2], trilinear4(v.w(), s.centred[0], s.centred[1], s.staggered[2]));
-  for (int m = 0; m < 4; ++m) out[m] = glm::vec3(c[0][m], c[1][m], c[2][m]);
-}
 
 }  // namespace plume

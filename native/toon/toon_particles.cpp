@@ -6,12 +6,16 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "toon/field_sampler.h"
+#include "toon/ramp_lanes.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include <smmintrin.h>
 
 namespace plume {
 namespace {
@@ -20,7 +24,7 @@ namespace {
 constexpr int kChunk = 512;
 
 /// Random streams of the two stages that create particles.
-enum class Stream : std::uint64_t { Emission = 1, Birth = 2 };
+enum class Stream : std::uint64_t { Emission = 1, Birth = 2, EmissionOffset = 3 };
 
 /// The generator of one emission or birth: a seed per (frame, stage), a stream per index, so a
 /// particle's position does not depend on which thread creates it or on the other particles.
@@ -41,9 +45,12 @@ glm::vec3 uniform3(Rng& r) {
 
 bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+/// Particles per group (field_sampler.h).
+constexpr int kLanes = kToonLanes;
+
 /// Particle indices [first, count), or order[first, count) when `order` is given, in parallel
-/// chunks of kChunk, handed to body(index, lanes) four at a time (field_sampler.h): `lanes`
-/// (1 to 4) are valid, the others repeat the last valid index.
+/// chunks of kChunk, handed to body(index, lanes) kLanes at a time: `lanes` (1 to kLanes) are
+/// valid, the others repeat the last valid index.
 template <typename Body>
 void forGroups(const std::vector<std::uint32_t>* order, std::size_t first, std::size_t count,
                const Body& body) {
@@ -52,10 +59,10 @@ void forGroups(const std::vector<std::uint32_t>* order, std::size_t first, std::
   parallelFor(0, int((n + kChunk - 1) / kChunk), [&](int c) {
     const std::size_t b = first + std::size_t(c) * kChunk;
     const std::size_t e = std::min(count, b + kChunk);
-    for (std::size_t m = b; m < e; m += 4) {
-      const int lanes = int(std::min<std::size_t>(4, e - m));
-      std::size_t index[4];
-      for (int l = 0; l < 4; ++l) {
+    for (std::size_t m = b; m < e; m += kLanes) {
+      const int lanes = int(std::min<std::size_t>(kLanes, e - m));
+      std::size_t index[kLanes];
+      for (int l = 0; l < kLanes; ++l) {
         const std::size_t k = m + std::size_t(std::min(l, lanes - 1));
         index[l] = order ? std::size_t((*order)[k]) : k;
       }
@@ -137,15 +144,22 @@ int ToonParticles::advanceFrame(const ToonFields& before, const ToonFields& afte
   const int n = substeps(before, after, dt);  // every check happens before anything changes
   sources.validate(mGrid);
   ThreadLimit limit(mParams.threads);
+  const ToonFieldSampler sampler(mGrid.resolution);
   sortByRow();
-  advect(before, after, dt, n);
-  sample(after, 0, /*resize=*/true);
+  mOccupied.assign(std::size_t(mGrid.resolution.x) * std::size_t(mGrid.resolution.y) *
+                       std::size_t(mGrid.resolution.z), 0);
+  advectAndSample(sampler, before, after, dt, n);
   for (std::int32_t& a : mState.age) ++a;
   removeDead();
-  const std::size_t first = mState.count();
+  const std::size_t emitted = mState.count();
   emit(sources);
-  birth(after);
-  sample(after, first, /*resize=*/false);  // newborns start at size 0 (§2.3)
+  birth(after, emitted);
+  // Newborns start at size 0 (§2.3); they are created in cell order already.
+  forGroups(nullptr, emitted, mState.count(), [&](const std::size_t* index, int lanes) {
+    ToonLanes3 x;
+    gather(index, x);
+    sampleGroup(sampler, after, index, lanes, x, /*resize=*/false);
+  });
   ++mState.frame;
   return n;
 }
@@ -155,104 +169,163 @@ void ToonParticles::sortByRow() {
   const glm::ivec3 n = mGrid.resolution;
   const std::uint32_t rows = std::uint32_t(n.y) * std::uint32_t(n.z);
   const std::size_t count = mState.count();
-  auto row = [&](glm::vec3 x) {
-    const glm::vec3 c = glm::floor((x - mGrid.origin) * mInvCellSize);
-    if (!(c.y >= 0.f && c.z >= 0.f && c.y < float(n.y) && c.z < float(n.z))) return rows;
-    return std::uint32_t(c.y) + std::uint32_t(n.y) * std::uint32_t(c.z);
-  };
+  mRow.resize(count);
   mRowStart.assign(std::size_t(rows) + 2, 0);
-  for (const glm::vec3& x : mState.positions) ++mRowStart[std::size_t(row(x)) + 1];
+  for (std::size_t m = 0; m < count; ++m) {
+    const glm::vec3& x = mState.positions[m];
+    const float cy = std::floor((x.y - mGrid.origin.y) * mInvCellSize);
+    const float cz = std::floor((x.z - mGrid.origin.z) * mInvCellSize);
+    const bool inside = (cy >= 0.f) & (cz >= 0.f) & (cy < float(n.y)) & (cz < float(n.z));
+    mRow[m] = inside ? std::uint32_t(cy) + std::uint32_t(n.y) * std::uint32_t(cz) : rows;
+    ++mRowStart[std::size_t(mRow[m]) + 1];
+  }
   for (std::size_t r = 1; r < mRowStart.size(); ++r) mRowStart[r] += mRowStart[r - 1];
   mOrder.resize(count);
-  for (std::size_t m = 0; m < count; ++m)
-    mOrder[mRowStart[row(mState.positions[m])]++] = std::uint32_t(m);
+  for (std::size_t m = 0; m < count; ++m) mOrder[mRowStart[mRow[m]]++] = std::uint32_t(m);
 }
 
-void ToonParticles::advect(const ToonFields& a, const ToonFields& b, float dt, int substeps) {
-  const float h = dt / float(substeps);
+void ToonParticles::advectAndSample(const ToonFieldSampler& sampler, const ToonFields& a,
+                                    const ToonFields& b, float dt, int substeps) {
+  const float h = dt / float(substeps), inv = 1.f / float(substeps);
   const bool midpoint = mParams.integration == ToonIntegration::Midpoint;
-  const glm::ivec3 n = mGrid.resolution;
-  // Velocity linear in time between the frame's end fields (t in [0, 1] over the frame).
-  auto velocity = [&](const glm::vec3* x, float t, glm::vec3* v) {
-    glm::vec3 c[4];
-    for (int l = 0; l < 4; ++l) c[l] = toCell(x[l]);
-    const PositionSplits4 s(n, c);
-    if (t <= 0.f || t >= 1.f) return sampleFaces4(t <= 0.f ? a.velocity : b.velocity, s, v);
-    glm::vec3 va[4], vb[4];
-    sampleFaces4(a.velocity, s, va);
-    sampleFaces4(b.velocity, s, vb);
-    for (int l = 0; l < 4; ++l) v[l] = (1.f - t) * va[l] + t * vb[l];
-  };
-  const float inv = 1.f / float(substeps);
   forGroups(&mOrder, 0, mState.count(), [&](const std::size_t* index, int lanes) {
-    glm::vec3 x[4], v[4];
-    for (int l = 0; l < 4; ++l) x[l] = mState.positions[index[l]];
+    ToonLanes3 x, v;
+    // Velocity linear in time between the frame's end fields (t in [0, 1] over the frame).
+    auto velocity = [&](const ToonLanes3& p, float t) {
+      ToonLanes3 c;
+      toCells(p, c);
+      sampler.velocity(a.velocity, b.velocity, t, c, v);
+    };
+    // x + w v into y, lane by lane (the glm form x + w * v, component by component).
+    auto step = [&](const ToonLanes3& p, float w, ToonLanes3& y) {
+      for (int c = 0; c < 3; ++c)
+        for (int l = 0; l < kLanes; ++l) y.c[c][l] = p.c[c][l] + w * v.c[c][l];
+    };
+    gather(index, x);
     for (int s = 0; s < substeps; ++s) {
-      const float t = float(s) * inv;
-      velocity(x, t, v);
+      velocity(x, float(s) * inv);
       if (midpoint) {
-        glm::vec3 xm[4];
-        for (int l = 0; l < 4; ++l) xm[l] = x[l] + (0.5f * h) * v[l];
-        velocity(xm, (float(s) + 0.5f) * inv, v);
+        ToonLanes3 xm;
+        step(x, 0.5f * h, xm);
+        velocity(xm, (float(s) + 0.5f) * inv);
       }
-      for (int l = 0; l < 4; ++l) x[l] += h * v[l];  // §2.1: Euler integration (or midpoint)
+      step(x, h, x);  // §2.1: Euler integration (or midpoint)
     }
-    for (int l = 0; l < lanes; ++l)
-      if (finite(x[l])) mState.positions[index[l]] = x[l];  // a broken field must not poison the cache
+    int finiteLane = 0;  // bit l: lane l is finite
+    for (int half = 0; half < kLanes; half += 4) {
+      __m128 f = finiteLanes(_mm_load_ps(x.c[0] + half));
+      for (int c = 1; c < 3; ++c) f = _mm_and_ps(f, finiteLanes(_mm_load_ps(x.c[c] + half)));
+      finiteLane |= _mm_movemask_ps(f) << half;
+    }
+    for (int l = 0; l < kLanes; ++l) {
+      // A broken field must not poison the cache: the particle stays where it was.
+      glm::vec3& p = mState.positions[index[std::min(l, lanes - 1)]];
+      if (!((finiteLane >> l) & 1))
+        for (int c = 0; c < 3; ++c) x.c[c][l] = p[c];
+      else if (l < lanes)
+        p = glm::vec3(x.c[0][l], x.c[1][l], x.c[2][l]);
+    }
+    sampleGroup(sampler, b, index, lanes, x, /*resize=*/true);
   });
 }
 
-void ToonParticles::sample(const ToonFields& b, std::size_t first, bool resize) {
-  const float step = mParams.maxSizeStep();
-  const bool hasTemperature = b.temperature.count() != 0;
+void ToonParticles::sampleGroup(const ToonFieldSampler& sampler, const ToonFields& b,
+                                const std::size_t* index, int lanes, const ToonLanes3& x,
+                                bool resize) {
   ToonParticleState& s = mState;
-  // Resizing (the particles of the frame start): in row order, as advect(), since they moved at
-  // most a few cells; newborns are created in cell order already.
-  forGroups(resize ? &mOrder : nullptr, first, s.count(), [&](const std::size_t* index, int lanes) {
-    glm::vec3 c[4], v[4];
-    for (int l = 0; l < 4; ++l) c[l] = toCell(s.positions[index[l]]);
-    const PositionSplits4 splits(mGrid.resolution, c);
-    float d[4], temp[4] = {0.f, 0.f, 0.f, 0.f};
-    sampleFaces4(b.velocity, splits, v);
-    sampleCentred4(b.density, splits, d);
-    if (hasTemperature) sampleCentred4(b.temperature, splits, temp);
-    for (int l = 0; l < lanes; ++l) {
-      const std::size_t m = index[l];
-      // No smoke is simulated outside the domain: the particle fades out there.
-      const float density = insideBox(s.positions[m]) && std::isfinite(d[l]) ? d[l] : 0.f;
-      const float target = density < mParams.deathDensity ? 0.f : mParams.rampSize(density);
-      s.velocities[m] = finite(v[l]) ? v[l] : glm::vec3(0.f);
-      s.density[m] = density;
-      s.temperature[m] = std::isfinite(temp[l]) ? temp[l] : 0.f;
-      s.targetSize[m] = std::isfinite(target) ? target : 0.f;
-      s.color[m] = mParams.colorParameter(density, s.temperature[m], glm::length(s.velocities[m]));
-      if (resize) {
-        // §2.3 temporal coherence: at most `step` per frame toward the ramp's size.
-        const float size = s.size[m], diff = s.targetSize[m] - size;
-        s.size[m] = std::abs(diff) <= step ? s.targetSize[m] : (diff > 0.f ? size + step : size - step);
-      }
+  ToonLanes3 c, v;
+  alignas(32) float d[kLanes], temp[kLanes], size[kLanes], target[kLanes], color[kLanes];
+  alignas(32) int cell[3][kLanes];
+  alignas(32) std::uint8_t mark[kLanes];
+  toCells(x, c);
+  sampler.fields(b, c, v, d, temp);
+  for (int l = 0; l < kLanes; ++l) size[l] = s.size[index[l]];
+  const RampLanes4 ramps(mParams);
+  const __m128 death = _mm_set1_ps(mParams.deathDensity);
+  for (int h = 0; h < kLanes; h += 4) {
+    __m128 p[3], inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (int a = 0; a < 3; ++a) {
+      p[a] = _mm_load_ps(x.c[a] + h);
+      inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmpge_ps(p[a], _mm_set1_ps(mGrid.origin[a])),
+                                             _mm_cmple_ps(p[a], _mm_set1_ps(mHi[a]))));
     }
-  });
+    // No smoke is simulated outside the domain: the particle fades out there.
+    __m128 density = _mm_load_ps(d + h);
+    density = _mm_and_ps(_mm_and_ps(inside, finiteLanes(density)), density);
+    __m128 vel[3], finiteVelocity = finiteLanes(_mm_load_ps(v.c[0] + h));
+    for (int a = 1; a < 3; ++a)
+      finiteVelocity = _mm_and_ps(finiteVelocity, finiteLanes(_mm_load_ps(v.c[a] + h)));
+    for (int a = 0; a < 3; ++a) {
+      vel[a] = _mm_and_ps(finiteVelocity, _mm_load_ps(v.c[a] + h));
+      _mm_store_ps(v.c[a] + h, vel[a]);
+    }
+    __m128 temperature = _mm_load_ps(temp + h);
+    temperature = _mm_and_ps(finiteLanes(temperature), temperature);
+    const __m128 goal = ramps.targetSize(density);
+    const __m128 grown = ramps.sizeStep(_mm_load_ps(size + h), goal);
+    _mm_store_ps(d + h, density);
+    _mm_store_ps(temp + h, temperature);
+    _mm_store_ps(target + h, goal);
+    _mm_store_ps(size + h, grown);
+    _mm_store_ps(color + h, ramps.color(density, temperature, vel));
+    // Stage 5's occupancy: a survivor of removeDead() (not shrunk to 0 below ρ_death) inside the
+    // box marks its cell floor((x - origin) / cell size), clamped into the grid.
+    const __m128 dead =
+        _mm_and_ps(_mm_cmple_ps(grown, _mm_setzero_ps()), _mm_cmplt_ps(density, death));
+    const int marked = _mm_movemask_ps(_mm_andnot_ps(dead, inside));
+    for (int l = 0; l < 4; ++l) mark[h + l] = std::uint8_t((marked >> l) & 1);
+    for (int a = 0; a < 3; ++a) {
+      const __m128 f = _mm_floor_ps(
+          _mm_mul_ps(_mm_sub_ps(p[a], _mm_set1_ps(mGrid.origin[a])), _mm_set1_ps(mInvCellSize)));
+      const __m128i i = _mm_min_epi32(_mm_max_epi32(_mm_cvttps_epi32(f), _mm_setzero_si128()),
+                                      _mm_set1_epi32(mGrid.resolution[a] - 1));
+      _mm_store_si128(reinterpret_cast<__m128i*>(cell[a] + h), i);
+    }
+  }
+  const std::size_t nx = std::size_t(mGrid.resolution.x), ny = std::size_t(mGrid.resolution.y);
+  for (int l = 0; l < lanes; ++l) {
+    const std::size_t m = index[l];
+    s.velocities[m] = glm::vec3(v.c[0][l], v.c[1][l], v.c[2][l]);
+    s.density[m] = d[l];
+    s.temperature[m] = temp[l];
+    s.targetSize[m] = target[l];
+    s.color[m] = color[l];
+    if (!resize) continue;
+    s.size[m] = size[l];
+    // Threads may mark one cell together, hence the atomic store.
+    if (mark[l])
+      __atomic_store_n(&mOccupied[std::size_t(cell[0][l]) +
+                                  nx * (std::size_t(cell[1][l]) + ny * std::size_t(cell[2][l]))],
+                       std::uint8_t(1), __ATOMIC_RELAXED);
+  }
 }
 
 void ToonParticles::removeDead() {
   ToonParticleState& s = mState;
-  std::size_t out = 0;
-  for (std::size_t m = 0; m < s.count(); ++m) {
-    // Dying (below ρ_death) and already shrunk to nothing: removing it changes no pixel.
-    if (s.size[m] <= 0.f && s.density[m] < mParams.deathDensity) continue;
-    if (out != m) {
-      s.ids[out] = s.ids[m];
-      s.positions[out] = s.positions[m];
-      s.velocities[out] = s.velocities[m];
-      s.density[out] = s.density[m];
-      s.temperature[out] = s.temperature[m];
-      s.size[out] = s.size[m];
-      s.targetSize[out] = s.targetSize[m];
-      s.color[out] = s.color[m];
-      s.age[out] = s.age[m];
-    }
-    ++out;
+  const std::size_t n = s.count();
+  // Dying (below ρ_death) and already shrunk to nothing: removing it changes no pixel.
+  auto dead = [&](std::size_t m) {
+    return s.size[m] <= 0.f && s.density[m] < mParams.deathDensity;
+  };
+  // The survivors move down in runs (few particles die per frame), every array in turn.
+  std::size_t out = 0, m = 0;
+  while (m < n && !dead(m)) ++m;
+  out = m;
+  while (m < n) {
+    while (m < n && dead(m)) ++m;
+    const std::size_t begin = m;
+    while (m < n && !dead(m)) ++m;
+    auto move = [&](auto& v) { std::copy(v.begin() + begin, v.begin() + m, v.begin() + out); };
+    move(s.ids);
+    move(s.positions);
+    move(s.velocities);
+    move(s.density);
+    move(s.temperature);
+    move(s.size);
+    move(s.targetSize);
+    move(s.color);
+    move(s.age);
+    out += m - begin;
   }
   s.resize(out);
 }
@@ -271,9 +344,14 @@ void ToonParticles::append(glm::vec3 p) {
 void ToonParticles::emit(const ToonSources& sources) {
   const std::uint64_t entries = sources.size(), count = std::uint64_t(mParams.emissionCount);
   if (entries == 0) return;
+  // Stratified over the entries (every source's cells in turn): each frame's particles spread
+  // over all sources, and a per-frame offset makes every cell emit over time. (Entries taken in
+  // turn across frames emitted a short burst from the first source's first cells only.)
+  Rng offsetRng = streamRng(mParams.seed, mState.frame, Stream::EmissionOffset, 0);
+  const double offset = offsetRng.uniform();
   for (std::uint64_t e = 0; e < count && mState.count() < std::size_t(mParams.maxCount); ++e) {
-    // Entries in turn across frames, so every source cell emits over time.
-    const std::uint64_t entry = (std::uint64_t(mState.frame) * count + e) % entries;
+    const std::uint64_t entry = std::min<std::uint64_t>(
+        entries - 1, std::uint64_t((double(e) + offset) * double(entries) / double(count)));
     Rng rng = streamRng(mParams.seed, mState.frame, Stream::Emission, e);
     const glm::vec3 u = uniform3(rng);
     glm::vec3 p;
@@ -289,48 +367,74 @@ void ToonParticles::emit(const ToonSources& sources) {
   }
 }
 
-void ToonParticles::birth(const ToonFields& b) {
+void ToonParticles::birth(const ToonFields& b, std::size_t emitted) {
   const glm::ivec3 n = mGrid.resolution;
   const std::size_t slab = std::size_t(n.x) * std::size_t(n.y);
-  mOccupied.assign(slab * std::size_t(n.z), 0);
-  for (const glm::vec3& x : mState.positions) {
-    if (!insideBox(x)) continue;
-    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((x - mGrid.origin) * mInvCellSize)),
-                                    glm::ivec3(0), n - 1);
-    mOccupied[b.density.index(c.x, c.y, c.z)] = 1;
-  }
+  // The survivors marked their cells in sampleGroup(); the particles just emitted mark theirs.
+  for (std::size_t m = emitted; m < mState.count(); ++m)
+    if (insideBox(mState.positions[m])) mOccupied[cellIndex(mState.positions[m])] = 1;
+  // Pass 1: mWanted[m] = 1 for an empty cell denser than ρ_birth; the count per slab gives each
+  // slab's first rank. Pass 2 fills the wanted cells in cell order from that rank.
   const float threshold = mParams.birthDensity;
-  auto wanted = [&](std::size_t m) { return b.density[m] > threshold && !mOccupied[m]; };
-  // Pass 1: empty dense cells per slab; pass 2 fills them in cell order from each slab's offset.
-  std::vector<std::size_t> offset(std::size_t(n.z) + 1, 0);
+  const float* density = b.density.data();
+  mWanted.resize(mOccupied.size());
+  mSlabOffset.assign(std::size_t(n.z) + 1, 0);
   parallelFor(0, n.z, [&](int k) {
-    std::size_t c = 0;
-    for (std::size_t m = std::size_t(k) * slab, e = m + slab; m < e; ++m) c += wanted(m);
-    offset[std::size_t(k) + 1] = c;
+    std::size_t c = 0, m = std::size_t(k) * slab;
+    const std::size_t e = m + slab;
+    const __m128 limit = _mm_set1_ps(threshold);
+    for (; m + 16 <= e; m += 16) {  // 16 cells: density > ρ_birth (NaN fails) and no particle
+      const __m128i dense = _mm_packs_epi16(
+          _mm_packs_epi32(_mm_castps_si128(_mm_cmpgt_ps(_mm_loadu_ps(density + m), limit)),
+                          _mm_castps_si128(_mm_cmpgt_ps(_mm_loadu_ps(density + m + 4), limit))),
+          _mm_packs_epi32(_mm_castps_si128(_mm_cmpgt_ps(_mm_loadu_ps(density + m + 8), limit)),
+                          _mm_castps_si128(_mm_cmpgt_ps(_mm_loadu_ps(density + m + 12), limit))));
+      const __m128i empty = _mm_cmpeq_epi8(
+          _mm_loadu_si128(reinterpret_cast<const __m128i*>(&mOccupied[m])), _mm_setzero_si128());
+      const __m128i w = _mm_and_si128(dense, empty);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(&mWanted[m]), _mm_and_si128(w, _mm_set1_epi8(1)));
+      c += std::size_t(__builtin_popcount(unsigned(_mm_movemask_epi8(w))));
+    }
+    for (; m < e; ++m) {
+      const std::uint8_t w = std::uint8_t(density[m] > threshold) & std::uint8_t(mOccupied[m] == 0);
+      mWanted[m] = w;
+      c += w;
+    }
+    mSlabOffset[std::size_t(k) + 1] = c;
   });
-  for (int k = 0; k < n.z; ++k) offset[std::size_t(k) + 1] += offset[std::size_t(k)];
+  for (int k = 0; k < n.z; ++k) mSlabOffset[std::size_t(k) + 1] += mSlabOffset[std::size_t(k)];
   const std::size_t room = std::size_t(mParams.maxCount) - std::min(mState.count(), std::size_t(mParams.maxCount));
-  const std::size_t births = std::min(offset.back(), room);
+  const std::size_t births = std::min(mSlabOffset.back(), room);
   if (births == 0) return;
   const std::size_t first = mState.count();
   const std::uint64_t firstId = mState.nextId;
   mState.resize(first + births);
   parallelFor(0, n.z, [&](int k) {
-    std::size_t rank = offset[std::size_t(k)];
-    for (int j = 0; j < n.y && rank < births; ++j)
-      for (int i = 0; i < n.x && rank < births; ++i) {
-        const std::size_t m = b.density.index(i, j, k);
-        if (!wanted(m)) continue;
-        Rng rng = streamRng(mParams.seed, mState.frame, Stream::Birth, m);
-        const std::size_t p = first + rank;
-        mState.ids[p] = firstId + rank;
-        mState.positions[p] = mGrid.origin + (glm::vec3(i, j, k) + uniform3(rng)) * mGrid.cellSize;
-        mState.velocities[p] = glm::vec3(0.f);
-        mState.density[p] = mState.temperature[p] = mState.size[p] = 0.f;
-        mState.targetSize[p] = mState.color[p] = 0.f;
-        mState.age[p] = 0;
-        ++rank;
+    std::size_t rank = mSlabOffset[std::size_t(k)];
+    const std::size_t end = std::min(mSlabOffset[std::size_t(k) + 1], births);
+    const std::size_t base = std::size_t(k) * slab;
+    for (std::size_t r = 0; rank < end; ++r) {
+      // Eight cells at a time past the empty ones (most of a slab).
+      if (r + 8 <= slab) {
+        std::uint64_t word;
+        std::memcpy(&word, &mWanted[base + r], 8);
+        if (word == 0) {
+          r += 7;
+          continue;
+        }
       }
+      if (!mWanted[base + r]) continue;
+      const int i = int(r % std::size_t(n.x)), j = int(r / std::size_t(n.x));
+      Rng rng = streamRng(mParams.seed, mState.frame, Stream::Birth, base + r);
+      const std::size_t p = first + rank;
+      mState.ids[p] = firstId + rank;
+      mState.positions[p] = mGrid.origin + (glm::vec3(i, j, k) + uniform3(rng)) * mGrid.cellSize;
+      mState.velocities[p] = glm::vec3(0.f);
+      mState.density[p] = mState.temperature[p] = mState.size[p] = 0.f;
+      mState.targetSize[p] = mState.color[p] = 0.f;
+      mState.age[p] = 0;
+      ++rank;
+    }
   });
   mState.nextId += births;
 }

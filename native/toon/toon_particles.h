@@ -20,10 +20,12 @@
 /// New particles start at size 0 and grow by the same bounded step. Emission then birth stop
 /// when maxCount particles exist, in their fixed order (entries in turn; cells in index order).
 /// Every random position comes from Rng(seed, stream of (frame, stage, cell or emission index)),
-/// and particles are advected and sampled independently, so the result is bit-identical at any
-/// thread count. Ids are given in creation order and never reused, so Blender can follow a
-/// particle from frame to frame.
+/// and particles are advected and sampled independently (stages 1-3 run as one pass per group of
+/// particles, which also marks the cells that stage 5 finds occupied), so the result is
+/// bit-identical at any thread count. Ids are given in creation order and never reused, so
+/// Blender can follow a particle from frame to frame.
 
+#include "toon/field_sampler.h"
 #include "toon/toon_fields.h"
 #include "toon/toon_params.h"
 
@@ -84,25 +86,48 @@ class ToonParticles {
                    const ToonSources& sources);
 
  private:
-  glm::vec3 toCell(glm::vec3 world) const {
-    return (world - mGrid.origin) * mInvCellSize - glm::vec3(0.5f);
-  }
   bool insideBox(glm::vec3 x) const {
     return x.x >= mGrid.origin.x && x.y >= mGrid.origin.y && x.z >= mGrid.origin.z && x.x <= mHi.x &&
            x.y <= mHi.y && x.z <= mHi.z;
   }
+  /// Index of the cell holding x (inside the box; the far faces count to the last cells).
+  std::size_t cellIndex(glm::vec3 x) const {
+    const glm::ivec3 n = mGrid.resolution;
+    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((x - mGrid.origin) * mInvCellSize)),
+                                    glm::ivec3(0), n - 1);
+    return std::size_t(c.x) +
+           std::size_t(n.x) * (std::size_t(c.y) + std::size_t(n.y) * std::size_t(c.z));
+  }
+  /// Positions of the particles index[0 .. kToonLanes-1].
+  void gather(const std::size_t* index, ToonLanes3& x) const {
+    for (int l = 0; l < kToonLanes; ++l)
+      for (int a = 0; a < 3; ++a) x.c[a][l] = mState.positions[index[l]][a];
+  }
+  /// Cell coordinates (cell (i,j,k)'s centre at (i,j,k)) of every lane of world positions x.
+  void toCells(const ToonLanes3& x, ToonLanes3& c) const {
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < kToonLanes; ++l)
+        c.c[a][l] = (x.c[a][l] - mGrid.origin[a]) * mInvCellSize - 0.5f;
+  }
   /// mOrder = the particles [0, count) sorted by grid row (j, k) of their position, stable: the
-  /// order in which advect() and sample() visit them, so that consecutive particles read the same
+  /// order in which advectAndSample() visits them, so that consecutive particles read the same
   /// few rows of every field (the results do not depend on the order).
   void sortByRow();
-  void advect(const ToonFields& a, const ToonFields& b, float dt, int substeps);
-  /// Stage 2 and the ramps for particles [first, count): velocity, density, temperature from
-  /// `b`; target size and colour. When `resize` (the particles of the frame start, visited in
-  /// mOrder, which must be current), the size moves toward the target.
-  void sample(const ToonFields& b, std::size_t first, bool resize);
+  /// Stages 1-3 for every particle, in mOrder (which must be current): advect, then
+  /// sampleGroup(resize) at the new position.
+  void advectAndSample(const ToonFieldSampler& sampler, const ToonFields& a, const ToonFields& b,
+                       float dt, int substeps);
+  /// Stage 2 and the ramps for the particles index[0 .. lanes-1] at positions x (every lane
+  /// finite, the padding ones too): velocity, density, temperature from `b`; target size and
+  /// colour. When `resize` (the particles of the frame start), the size moves toward the target
+  /// and the particles that survive removeDead() mark their cells in mOccupied for birth().
+  void sampleGroup(const ToonFieldSampler& sampler, const ToonFields& b, const std::size_t* index,
+                   int lanes, const ToonLanes3& x, bool resize);
+  /// Removes the particles shrunk to size 0 below ρ_death, keeping the order of the others.
   void removeDead();
   void emit(const ToonSources& sources);
-  void birth(const ToonFields& b);
+  /// Stage 5; mOccupied holds the survivors' cells, the particles from `emitted` on mark theirs.
+  void birth(const ToonFields& b, std::size_t emitted);
   /// Appends a particle of size 0 at `position` (sampled later).
   void append(glm::vec3 position);
 
@@ -111,8 +136,9 @@ class ToonParticles {
   float mInvCellSize;
   glm::vec3 mHi;  ///< far corner of the domain box (mGrid.origin is the near one)
   ToonParticleState mState;
-  std::vector<std::uint8_t> mOccupied;  ///< per cell, scratch of birth()
-  std::vector<std::uint32_t> mOrder, mRowStart;  ///< scratch of sortByRow()
+  std::vector<std::uint8_t> mOccupied, mWanted;  ///< per cell, scratch of a frame's birth()
+  std::vector<std::size_t> mSlabOffset;          ///< per z slab, scratch of birth()
+  std::vector<std::uint32_t> mOrder, mRowStart, mRow;  ///< scratch of sortByRow()
 };
 
 }  // namespace plume

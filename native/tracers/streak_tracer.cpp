@@ -2,6 +2,7 @@
 
 #include "core/parallel.h"
 #include "solver/smoke_solver.h"
+#include "tracers/domain_sides.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -178,17 +179,8 @@ void StreakTracer::step(const MacGrid3& before, const MacGrid3& after, const Sca
       const glm::vec3 um = 0.5f * (sampleVelocity(before, cm, scheme) + sampleVelocity(after, cm, scheme));
       glm::vec3 xn = x + dt * um;
       if (!finite(xn)) xn = x;  // a broken field must not poison the cache
-      bool left = false;
-      for (int a = 0; a < 3; ++a) {
-        // A closed side holds the particle on it; through an open side it leaves.
-        if (xn[a] < mLo[a]) {
-          if (mBoundaries[std::size_t(2 * a)] == Boundary::Open) left = true;
-          else xn[a] = mLo[a];
-        } else if (xn[a] > mHi[a]) {
-          if (mBoundaries[std::size_t(2 * a + 1)] == Boundary::Open) left = true;
-          else xn[a] = mHi[a];
-        }
-      }
+      // A closed side holds the particle on it; through an open side it leaves.
+      const bool left = applyDomainSides(xn, mLo, mHi, mBoundaries);
       mState.positions[std::size_t(n)] = xn;
       if (left) {
         mState.outside[std::size_t(n)] = 1;

@@ -1,0 +1,384 @@
+"""Flow-graph fire, no ``bpy`` (graph_fire_synthesis.txt §4.3-5.2): the states (fire bakes with
+pathlines.bin), the graph built from them, and the synthesis that walks it.
+
+    states = open_states(native, [("Calm", folder0), ("Windy", folder1)])   # BakeError if bad
+    graph = build_graph(native, states, FlowGraphSettings(), out_folder)   # flowgraph.npz + PNG
+    SynthesisRunner(native, out_folder, SynthesisSettings(...)).run()      # fire/fire_####.vdb
+
+The graph's nodes are the pathline groups of every state, state by state in file order, so node
+n of the graph is group node_steps[n] of state node_states[n]'s pathline file.
+"""
+
+import math
+import os
+import time
+import zlib
+from dataclasses import dataclass, field
+from typing import Callable, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import cache
+from .settings import BakeError
+
+GRAPH_NAME = "flowgraph.npz"
+IMAGE_NAME = "flowgraph_cost.png"
+FIRE_FOLDER = "fire"
+TRAVERSALS = ('UNIFORM', 'BIASED')
+
+
+def graph_path(folder):
+    return os.path.join(folder, GRAPH_NAME)
+
+
+def image_path(folder):
+    return os.path.join(folder, IMAGE_NAME)
+
+
+def fire_path(folder, frame):
+    return os.path.join(folder, FIRE_FOLDER, f"fire_{frame:04d}.vdb")
+
+
+@dataclass
+class FlowGraphSettings:
+    """§4.3: weights of eq. 9, the block size B and ε of eq. 11."""
+
+    block_size: int = 32        # B
+    epsilon: float = 0.0        # ε; 0 = (2a + b) / 3
+    auto_weights: bool = True   # α, β bringing the three terms to one order of magnitude
+    alpha: float = 1.0          # α (density) when not automatic
+    beta: float = 1.0           # β (temperature) when not automatic
+    min_node_gap: int = 8       # transitions between nodes this close in one state are dropped
+
+
+@dataclass
+class SynthesisSettings:
+    """§5: the random walk and what the synthesized particles feel. targets[f] and winds[f] are
+    the keyed target state (-1: none) and uniform wind (m/s) of frame frame_start + f."""
+
+    frame_start: int = 1
+    frame_end: int = 200
+    seed: int = 0
+    traversal: str = 'BIASED'   # UNIFORM: p = 1/d(V_i); BIASED: eq. 12 with γ
+    gamma: float = 0.875        # γ of eq. 12
+    start_state: int = 0
+    targets: List[int] = field(default_factory=list)
+    winds: List[Tuple[float, float, float]] = field(default_factory=list)
+    ignition_temperature: float = 1.0
+    max_temperature: float = 4.0
+    #: turbulence[f]: the Turbulence force fields of frame f as (strength, size, seed) each
+    turbulence: List[List[Tuple[float, float, int]]] = field(default_factory=list)
+
+
+#: Fourier modes of the turbulence velocity (enough for an irregular, smooth field).
+TURBULENCE_MODES = 12
+
+
+def turbulence_velocity(resolution, cell_size, origin, fields, t):
+    """Cell-centred velocity (nx, ny, nz, 3) float32 of Turbulence force fields (§5.2's u_ext
+    "for deforming the fire"): for each field, the curl of a random vector potential made of
+    TURBULENCE_MODES plane waves of wavelength `size` (so the flow is divergence-free: each
+    mode's velocity (k × a) cos(k·x + φ + ωt) is orthogonal to its k), seeded by the field's seed,
+    drifting in time with ω = 2π / (size / strength), scaled to an RMS speed of `strength` m/s.
+    Blender's own turbulence noise is not reachable from Python: this is Plume's reading of the
+    field's Strength, Size and Seed."""
+    n = tuple(int(v) for v in resolution)
+    axes = [origin[a] + (np.arange(n[a], dtype=np.float64) + 0.5) * cell_size for a in range(3)]
+    x = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
+    u = np.zeros(n + (3,), np.float64)
+    for strength, size, seed in fields:
+        if strength == 0.0 or size <= 0.0:
+            continue
+        rng = np.random.default_rng(int(seed))
+        k = rng.normal(size=(TURBULENCE_MODES, 3))
+        k *= (2.0 * np.pi / size) / np.linalg.norm(k, axis=1, keepdims=True)
+        a = rng.normal(size=(TURBULENCE_MODES, 3))
+        phase = rng.uniform(0.0, 2.0 * np.pi, TURBULENCE_MODES)
+        omega = 2.0 * np.pi * abs(strength) / size
+        amp = np.cross(k, a)
+        amp *= abs(strength) * np.sqrt(2.0 / TURBULENCE_MODES) / np.linalg.norm(amp, axis=1,
+                                                                                 keepdims=True)
+        for m in range(TURBULENCE_MODES):
+            u += np.cos(x @ k[m] + phase[m] + omega * t)[..., None] * amp[m]
+    return u.astype(np.float32)
+
+
+@dataclass
+class State:
+    """One fire bake used as a state: its name, cache folder and open pathline file."""
+
+    name: str
+    folder: str
+    file: object  # _native.PathlineFile
+
+
+def validate_graph_settings(s: FlowGraphSettings, owner):
+    if s.block_size < 1:
+        raise BakeError(f"Plume: {owner}: block_size (B) must be >= 1 (got {s.block_size})")
+    if s.min_node_gap < 0:
+        raise BakeError(f"Plume: {owner}: min_node_gap must be >= 0 (got {s.min_node_gap})")
+    if not (math.isfinite(s.epsilon) and s.epsilon >= 0.0):
+        raise BakeError(f"Plume: {owner}: epsilon (ε) must be 0 (automatic: (2a+b)/3) or a "
+                        f"cost in [a, b] (got {s.epsilon})")
+    for name in ("alpha", "beta"):
+        v = getattr(s, name)
+        if not s.auto_weights and not (math.isfinite(v) and v >= 0.0):
+            raise BakeError(f"Plume: {owner}: {name} must be >= 0 (got {v})")
+
+
+def validate_synthesis(s: SynthesisSettings, state_count, owner):
+    if s.frame_end < s.frame_start:
+        raise BakeError(f"Plume: {owner}: synthesis frame_end must be >= frame_start "
+                        f"(got {s.frame_start}..{s.frame_end})")
+    if s.traversal not in TRAVERSALS:
+        raise BakeError(f"Plume: {owner}: traversal must be one of {', '.join(TRAVERSALS)}")
+    if not (0.0 < s.gamma < 1.0):
+        raise BakeError(f"Plume: {owner}: gamma (γ) must be in (0, 1) (got {s.gamma})")
+    if not (0 <= s.start_state < state_count):
+        raise BakeError(f"Plume: {owner}: start_state must be in [0, {state_count - 1}] "
+                        f"(got {s.start_state})")
+    bad = [t for t in s.targets if not (-1 <= t < state_count)]
+    if bad:
+        raise BakeError(f"Plume: {owner}: target_state must be -1 (none) or in [0, "
+                        f"{state_count - 1}] (got {bad[0]})")
+    if not (0.0 <= s.ignition_temperature < s.max_temperature):
+        raise BakeError(f"Plume: {owner}: the fire needs 0 <= ignition temperature < max "
+                        f"temperature (got {s.ignition_temperature}, {s.max_temperature})")
+
+
+def open_states(native, named_folders: Sequence[Tuple[str, str]]) -> List[State]:
+    """Opens the pathline file of every state; BakeError for one state only, a missing or
+    damaged file, or states of different domains (grid, cell size, placement or layout)."""
+    if len(named_folders) < 2:
+        raise BakeError("Plume: flow-graph fire needs at least two baked fire states (got "
+                        f"{len(named_folders)}): select two or three fire domains baked with "
+                        "Record Pathlines (states in name order; the graph is kept with the "
+                        "active one)")
+    states = []
+    for name, folder in named_folders:
+        path = cache.pathlines_path(folder)
+        if not os.path.isfile(path):
+            raise BakeError(f"Plume: domain '{name}' has no pathline file ({path}): turn on "
+                            "Combustion > Record Pathlines and bake it")
+        try:
+            states.append(State(name, folder, native.PathlineFile.open(path)))
+        except RuntimeError as e:
+            raise BakeError(f"Plume: domain '{name}': {e} (bake it again)") from None
+    first = states[0]
+    for s in states[1:]:
+        a, b = first.file, s.file
+        if (tuple(a.resolution) != tuple(b.resolution)
+                or not math.isclose(a.cell_size, b.cell_size, rel_tol=1e-5)
+                or not np.allclose(a.origin, b.origin, atol=1e-4 * a.cell_size)):
+            raise BakeError(f"Plume: states '{first.name}' and '{s.name}' are caches of different "
+                            f"domain sizes ({tuple(a.resolution)} cells of {a.cell_size:.4g} m at "
+                            f"{tuple(round(v, 4) for v in a.origin)} vs {tuple(b.resolution)} of "
+                            f"{b.cell_size:.4g} m at {tuple(round(v, 4) for v in b.origin)}): "
+                            "bake every state on the same domain box and resolution")
+        if a.layout != b.layout:
+            raise BakeError(f"Plume: states '{first.name}' and '{s.name}' have different pathline "
+                            f"layouts ({a.layout} vs {b.layout}): use the same fuel sources, "
+                            "nodes per frame and lifetime in every state")
+    for s in states:
+        if s.file.node_count < 2:
+            raise BakeError(f"Plume: domain '{s.name}' holds {s.file.node_count} pathline "
+                            "groups: bake more frames (at least twice the pathline lifetime)")
+    return states
+
+
+def _params(native, s: FlowGraphSettings, alpha, beta):
+    p = native.FlowGraphParams()
+    p.block_size = int(s.block_size)
+    p.min_node_gap = int(s.min_node_gap)
+    p.alpha, p.beta = float(alpha), float(beta)
+    if s.epsilon > 0.0:
+        p.epsilon_mode = native.EpsilonMode.EXPLICIT
+        p.epsilon = float(s.epsilon)
+    return p
+
+
+def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
+                progress: Optional[Callable[[float], None]] = None):
+    """Cost matrix (eq. 9-10) of every group of every state, the graph (§4.3), then
+    <out_folder>/flowgraph.npz and flowgraph_cost.png (Figure 4), atomically. Returns a dict
+    with the graph, its cost matrix and a summary. BakeError on bad settings (nothing written)."""
+    groups = []
+    for index, st in enumerate(states):
+        groups.extend(st.file.read_group(k, index) for k in range(st.file.node_count))
+    counts = [st.file.node_count for st in states]
+    alpha, beta = ((native.same_magnitude_weights(groups)) if s.auto_weights
+                   else (s.alpha, s.beta))
+    try:
+        params = _params(native, s, alpha, beta)
+        params.validate()
+        job = native.CostMatrixJob(groups, params)
+    except ValueError as e:
+        raise BakeError(f"Plume: flow graph: {e}") from None
+    del groups  # the job holds them
+    if not job.run():
+        raise BakeError("Plume: flow graph: cancelled")
+    cost = job.cost
+    try:
+        graph = native.FlowGraph.build(cost, counts, params)
+    except ValueError as e:
+        raise BakeError(f"Plume: flow graph: {e}") from None
+    image = native.cost_matrix_image(cost, graph, size=min(512, max(64, len(cost))))
+    t = graph.transitions()
+    summary = {"alpha": float(alpha), "beta": float(beta), "a": float(t["a"]),
+               "b": float(t["b"]), "epsilon": float(t["epsilon"]),
+               "candidates": int(len(t["kept"])), "kept": int(np.sum(t["kept"])),
+               "pruned": [int(v) for v in graph.pruned_per_state],
+               "nodes": [int(v) for v in counts]}
+    os.makedirs(out_folder, exist_ok=True)
+    _save_npz(graph_path(out_folder), cost=cost, state_node_counts=np.asarray(counts, np.int64),
+              state_names=np.asarray([st.name for st in states]),
+              state_folders=np.asarray([st.folder for st in states]),
+              settings=np.asarray([s.block_size, s.min_node_gap, s.epsilon, alpha, beta],
+                                  np.float64))
+    _write_atomic(image_path(out_folder), png_rgb(np.asarray(image)))
+    if progress is not None:
+        progress(1.0)
+    return {"graph": graph, "cost": cost, "summary": summary, "params": params}
+
+
+def _write_atomic(path, data: bytes):
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def _save_npz(path, **arrays):
+    tmp = f"{path}.{os.getpid()}.tmp.npz"
+    np.savez_compressed(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+def png_rgb(rgb):
+    """An 8-bit RGB PNG of a (h, w, 3) uint8 array (rows from the top)."""
+    import struct
+    h, w, _ = rgb.shape
+    raw = b"".join(b"\x00" + np.ascontiguousarray(rgb[y], np.uint8).tobytes() for y in range(h))
+
+    def chunk(tag, data):
+        return (struct.pack(">I", len(data)) + tag + data
+                + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
+
+
+def load_graph(native, folder, owner):
+    """(graph, states, params) from <folder>/flowgraph.npz; BakeError when missing or stale."""
+    path = graph_path(folder)
+    if not os.path.isfile(path):
+        raise BakeError(f"Plume: {owner} has no flow graph yet: select the fire states and "
+                        "press Build Flow Graph (plume.flowgraph_build) first")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            cost = np.array(data["cost"])
+            counts = [int(v) for v in data["state_node_counts"]]
+            names = [str(v) for v in data["state_names"]]
+            folders = [str(v) for v in data["state_folders"]]
+            block, gap, eps, alpha, beta = (float(v) for v in data["settings"])
+    except (OSError, KeyError, ValueError) as e:
+        raise BakeError(f"Plume: {owner}: flow graph {path} cannot be read ({e}): build it "
+                        "again") from None
+    states = open_states(native, list(zip(names, folders)))
+    if [st.file.node_count for st in states] != counts:
+        raise BakeError(f"Plume: {owner}: a state was baked again after the flow graph was "
+                        "built: build the flow graph again")
+    s = FlowGraphSettings(block_size=int(block), min_node_gap=int(gap), epsilon=eps,
+                          auto_weights=False, alpha=alpha, beta=beta)
+    params = _params(native, s, alpha, beta)
+    try:
+        graph = native.FlowGraph.build(cost, counts, params)
+    except ValueError as e:
+        raise BakeError(f"Plume: {owner}: {e}") from None
+    return graph, states
+
+
+@dataclass
+class SynthesisResult:
+    frame_start: int
+    last_frame: int
+    nodes_visited: List[int] = field(default_factory=list)
+    transitions_taken: int = 0
+    cancelled: bool = False
+    step_seconds: float = 0.0   # the walk, reading the groups and integrating eq. 13
+    write_seconds: float = 0.0  # rasterizing the particles and writing the frame VDBs
+
+
+class SynthesisRunner:
+    """Walks the graph (§5.1) and integrates the visited nodes' particles (§5.2, eq. 13), one
+    node per node step, nodes_per_frame steps per frame; writes fire/fire_<frame>.vdb (density,
+    temperature, flame) after each frame. progress(done, total) and cancel() are optional."""
+
+    def __init__(self, native, graph, states: List[State], settings: SynthesisSettings,
+                 out_folder, progress=None, cancel=None):
+        self.native, self.graph, self.states, self.s = native, graph, states, settings
+        self.out_folder = out_folder
+        self.progress, self.cancel = progress, cancel
+        f = states[0].file
+        self.steps_per_frame = int(f.nodes_per_frame)
+        self.raster = native.FireRasterParams(
+            voxel_size=float(f.cell_size), origin=tuple(f.origin),
+            ignition_temperature=settings.ignition_temperature,
+            max_temperature=settings.max_temperature)
+        self.walk = native.RandomWalk(
+            graph, int(settings.seed),
+            bias=(native.WalkBias.TEMPORAL if settings.traversal == 'BIASED'
+                  else native.WalkBias.UNIFORM),
+            gamma=float(settings.gamma), start_state=int(settings.start_state))
+        self.node_states = np.asarray(graph.node_states)
+        self.node_steps = np.asarray(graph.node_steps)
+
+    def external_velocity(self, i):
+        """u_ext of frame index i: the uniform wind, or a VelocityField with the turbulence."""
+        s = self.s
+        wind = tuple(s.winds[i]) if i < len(s.winds) else (0.0, 0.0, 0.0)
+        fields = s.turbulence[i] if i < len(s.turbulence) else []
+        if not fields:
+            return wind
+        f = self.states[0].file
+        t = i * self.steps_per_frame * f.layout.sample_dt  # seconds since the first frame
+        u = turbulence_velocity(f.resolution, f.cell_size, f.origin, fields, t)
+        u += np.asarray(wind, np.float32)
+        return self.native.VelocityField(u, float(f.cell_size), tuple(f.origin))
+
+    def run(self) -> SynthesisResult:
+        s, native = self.s, self.native
+        syn = native.Synthesizer(self.states[0].file.layout)
+        result = SynthesisResult(frame_start=s.frame_start, last_frame=s.frame_start - 1)
+        fire_dir = os.path.join(self.out_folder, FIRE_FOLDER)
+        os.makedirs(fire_dir, exist_ok=True)
+        for name in os.listdir(fire_dir):  # frames of an older synthesis would mix in
+            if name.startswith("fire_") and name.endswith(".vdb"):
+                os.remove(os.path.join(fire_dir, name))
+        total = s.frame_end - s.frame_start + 1
+        node = self.walk.current
+        for i in range(total):
+            if self.cancel is not None and self.cancel():
+                result.cancelled = True
+                break
+            target = s.targets[i] if i < len(s.targets) else -1
+            wind = self.external_velocity(i)
+            t0 = time.perf_counter()
+            for _ in range(self.steps_per_frame):
+                state = int(self.node_states[node])
+                syn.step_node(self.states[state].file, int(self.node_steps[node]), state, wind)
+                result.nodes_visited.append(int(node))
+                nxt = self.walk.next(target)
+                if nxt != node + 1 or self.node_states[nxt] != state:
+                    result.transitions_taken += 1
+                node = nxt
+            frame = s.frame_start + i
+            t1 = time.perf_counter()
+            syn.write_vdb(fire_path(self.out_folder, frame), self.raster, frame)
+            result.step_seconds += t1 - t0
+            result.write_seconds += time.perf_counter() - t1
+            result.last_frame = frame
+            if self.progress is not None:
+                self.progress(i + 1, total)
+        return result

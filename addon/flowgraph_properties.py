@@ -1,0 +1,67 @@
+"""``obj.plume.domain.flowgraph``: flow-graph fire settings of the domain that holds the graph
+(graph_fire_synthesis.txt §4.3-5.2), read by plume.flowgraph_build and plume.fire_synthesize.
+Soft limits only: the operators validate with messages naming the setting and its range."""
+
+import bpy
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
+                       IntProperty, StringProperty)
+
+
+class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
+    # --- Graph (§4.3) ---
+    block_size: IntProperty(
+        name="Block Size (B)", default=32, soft_min=1, soft_max=256,
+        description="B: the cost matrix is cut into B×B blocks and each block's minimum is a "
+                    "candidate transition; at most (N/B)² transitions (§4.3); >= 1")
+    epsilon: FloatProperty(
+        name="Threshold (ε)", default=0.0, min=0.0, precision=4,
+        description="ε of eq. 11: candidates cheaper than ε become transitions. 0 = (2a+b)/3 "
+                    "(the paper's), a and b the cheapest and dearest candidate; else in [a, b]")
+    auto_weights: BoolProperty(
+        name="Automatic Weights", default=True,
+        description="α and β bring the velocity, density and temperature terms of eq. 9 to one "
+                    "order of magnitude over the data")
+    alpha: FloatProperty(name="α (Density)", default=1.0, min=0.0,
+                         description="Weight of the soot density difference in eq. 9")
+    beta: FloatProperty(name="β (Temperature)", default=1.0, min=0.0,
+                        description="Weight of the temperature difference in eq. 9")
+    min_node_gap: IntProperty(
+        name="Min Node Gap", default=8, min=0, soft_max=64,
+        description="Transitions between nodes of one state closer than this many node steps "
+                    "are dropped (§4.3: they would stutter)")
+    # --- Synthesis (§5) ---
+    frame_start: IntProperty(name="Start", default=1, description="First synthesized frame")
+    frame_end: IntProperty(name="End", default=250, description="Last synthesized frame")
+    seed: IntProperty(name="Seed", default=0, min=0,
+                      description="Seed of the random walk (same seed, same fire)")
+    traversal: EnumProperty(
+        name="Traversal", default='BIASED',
+        items=(('UNIFORM', "Random", "Every out-edge equally likely, p = 1/d(V_i) (§5.1)"),
+               ('BIASED', "Temporal Bias", "The temporal edge with probability γ, the "
+                                           "transitions share 1 − γ (eq. 12)")))
+    gamma: FloatProperty(name="γ", default=0.875, min=0.0, max=1.0,
+                         description="γ of eq. 12: probability of following the temporal edge; "
+                                     "in (0, 1)")
+    start_state: IntProperty(name="Start State", default=0, min=0,
+                             description="The walk starts at node 0 of this state")
+    target_state: IntProperty(
+        name="Target State", default=-1, min=-1,
+        description="Steer the walk into this state (§5.1) and stay there; -1: no target. Key "
+                    "it over the timeline to move the fire between states")
+    wind: FloatVectorProperty(
+        name="Wind", size=3, subtype='VELOCITY', default=(0.0, 0.0, 0.0),
+        description="Uniform external velocity u_ext of eq. 13 (m/s); keyable")
+    use_force_fields: BoolProperty(
+        name="Force Fields", default=True,
+        description="Add the scene's force fields to u_ext: a Wind field adds Strength m/s "
+                    "along its Z axis, a Turbulence field a divergence-free swirl of RMS speed "
+                    "Strength m/s and wavelength Size (falloff ignored)")
+    # --- Built data ---
+    summary: StringProperty(name="Graph", default="", description="Summary of the last build")
+    state_names: StringProperty(name="States", default="",
+                                description="The states of the graph, in order")
+    fire_object: StringProperty(name="Fire Object", default="",
+                                description="Volume object of the synthesized fire")
+
+
+classes = (PlumeFlowGraphSettings,)

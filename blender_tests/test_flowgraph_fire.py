@@ -1,0 +1,202 @@
+"""Flow-graph fire end to end (graph_fire_synthesis.txt §4-5, issue 6): two 40-frame fire states
+at 32³ (no wind, and a side wind) baked with Record Pathlines, plume.flowgraph_build on both,
+then plume.fire_synthesize for 200 frames with a keyed target state: a Volume object over the
+synthesized VDB frames with grids density, temperature and flame, which renders non-empty. Bad
+input (one state only, B <= 0, ε outside [a, b], a missing or truncated pathline file, states of
+different domain sizes) gives a clear error and changes nothing.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_flowgraph_fire.py
+"""
+
+import os
+import shutil
+import sys
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (OUT_DIR, add_domain, add_sphere_source, assert_reports_error,  # noqa: E402
+                     image_pixels, native, reset_scene, rmtree, run, select_only, temp_dir,
+                     tree_listing)
+
+FRAMES = 40
+SYNTH_FRAMES = 200
+RESOLUTION = 32
+
+
+def fire_state(name, cache_dir, wind=(0.0, 0.0, 0.0), size=2.0):
+    dom = add_domain(size=size, resolution=RESOLUTION, frame_end=FRAMES,
+                     cache_directory=cache_dir + "/", name=name)
+    d = dom.plume.domain
+    d.combustion = True
+    d.pathlines = True
+    d.pathline_nodes_per_frame = 2
+    d.pathline_lifetime = 0.5  # 24 samples: a 40-frame bake completes 58 groups
+    d.wind = wind
+    d.wind_strength = 2.0 if any(wind) else 0.0
+    return dom
+
+
+def select(objs, active):
+    bpy.ops.object.select_all(action='DESELECT')
+    for o in objs:
+        o.select_set(True)
+    bpy.context.view_layer.objects.active = active
+
+
+class FlowGraphFireTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = temp_dir("plume_flowgraph_")
+        reset_scene()
+        src = add_sphere_source(radius=0.2, location=(0.0, 0.0, 0.3), name="Burner")
+        src.plume.source.fuel = 1.0
+        src.plume.source.density = 0.0
+        cls.calm = fire_state("Calm", cls.tmp)
+        cls.windy = fire_state("Windy", cls.tmp, wind=(1.0, 0.0, 0.0))
+        for dom in (cls.calm, cls.windy):
+            select_only(dom)
+            t0 = time.perf_counter()
+            assert bpy.ops.plume.bake() == {'FINISHED'}
+            print(f"  bake {dom.name}: {time.perf_counter() - t0:.1f} s")
+
+    @classmethod
+    def tearDownClass(cls):
+        rmtree(cls.tmp)
+
+    def folder(self, dom):
+        return os.path.join(self.tmp, dom.name)
+
+    def state(self):
+        return (len(bpy.data.objects), len(bpy.data.volumes), len(bpy.data.images),
+                tuple(tree_listing(self.tmp)), self.windy.plume.domain.flowgraph.summary)
+
+    def test_0_turbulence_is_divergence_free(self):
+        """u_ext of a Turbulence force field: divergence-free to the finite-difference error and
+        of RMS speed Strength (12 random plane waves: the RMS over a box of several wavelengths
+        is within 25% of it)."""
+        from plume import flowgraph
+        h, size, strength = 0.02, 0.5, 0.8
+        u = flowgraph.turbulence_velocity((64, 64, 64), h, (0.0, 0.0, 0.0),
+                                          [(strength, size, 3)], 0.4).astype(np.float64)
+        rms = float(np.sqrt(np.mean(np.sum(u * u, axis=-1))))
+        self.assertAlmostEqual(rms, strength, delta=0.25 * strength)
+        div = sum(np.gradient(u[..., a], h, axis=a) for a in range(3))
+        dudx = np.abs(np.gradient(u[..., 0], h, axis=0)).mean()
+        # Central differences of waves ~1/25 wavelength apart: |div| ≈ 0 up to O((kh)²) of |∂u|.
+        self.assertLess(float(np.abs(div).mean()), 0.02 * float(dudx))
+
+    def test_1_build_synthesize_render(self):
+        n = native()
+        for dom in (self.calm, self.windy):
+            f = n.PathlineFile.open(os.path.join(self.folder(dom), "pathlines.bin"))
+            print(f"  {dom.name}: {f.node_count} nodes of {f.layout}, {f.bytes_per_node} B/node")
+            self.assertGreater(f.node_count, 40)
+        select([self.calm, self.windy], self.windy)
+        g = self.windy.plume.domain.flowgraph
+        # 116 nodes: B = 32 leaves 4 x 4 blocks, too few transitions for endless walks (the
+        # build says so); B = 8 gives up to 15² candidates (Figure 4 shows B = 8, 16, 32).
+        g.block_size = 8
+        t0 = time.perf_counter()
+        self.assertEqual(bpy.ops.plume.flowgraph_build(), {'FINISHED'})
+        print(f"  flowgraph_build: {time.perf_counter() - t0:.1f} s; {g.state_names}; {g.summary}")
+        folder = self.folder(self.windy)
+        self.assertTrue(os.path.isfile(os.path.join(folder, "flowgraph.npz")))
+        png = image_pixels(os.path.join(folder, "flowgraph_cost.png"))
+        shutil.copyfile(os.path.join(folder, "flowgraph_cost.png"),
+                        os.path.join(OUT_DIR, "flowgraph_cost.png"))
+        self.assertGreater(float(png[..., :3].std()), 0.02)  # a picture, not a flat colour
+        self.assertEqual(g.state_names, "0: Calm, 1: Windy")
+        # The walk starts in state 0 and is steered into state 1 from frame 100 on.
+        g.frame_start, g.frame_end = 1, SYNTH_FRAMES
+        g.target_state = 0
+        g.keyframe_insert("target_state", frame=1)
+        g.target_state = 1
+        g.keyframe_insert("target_state", frame=100)
+        # A Turbulence force field deforms the synthesized fire (u_ext of eq. 13).
+        bpy.ops.object.effector_add(type='TURBULENCE', location=(0.0, 0.0, 1.0))
+        bpy.context.active_object.field.strength = 0.3
+        bpy.context.active_object.field.size = 0.5
+        select_only(self.windy)
+        t0 = time.perf_counter()
+        self.assertEqual(bpy.ops.plume.fire_synthesize(), {'FINISHED'})
+        print(f"  fire_synthesize {SYNTH_FRAMES} frames: {time.perf_counter() - t0:.1f} s")
+        fire = bpy.data.objects[g.fire_object]
+        self.assertEqual(fire.type, 'VOLUME')
+        files = sorted(os.listdir(os.path.join(folder, "fire")))
+        self.assertEqual(len(files), SYNTH_FRAMES)
+        scn = bpy.context.scene
+        scn.frame_set(150)
+        vol = fire.data
+        vol.grids.load()
+        self.assertTrue({"density", "temperature", "flame"} <= {gr.name for gr in vol.grids})
+        # Render one frame: the fire must show (emission from flame, blackbody from temperature).
+        for dom in (self.calm, self.windy):
+            dom.hide_render = True
+            vo = bpy.data.objects.get(dom.plume.domain.volume_object)
+            if vo is not None:
+                vo.hide_render = True
+        cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+        scn.collection.objects.link(cam)
+        cam.location, cam.rotation_euler = (0.0, -4.5, 1.0), (np.pi / 2, 0.0, 0.0)
+        scn.camera = cam
+        scn.render.engine = 'CYCLES'
+        scn.cycles.samples = 8
+        scn.cycles.use_denoising = False
+        scn.render.resolution_x, scn.render.resolution_y = 160, 120
+        scn.render.resolution_percentage = 100
+        if scn.world is None:
+            scn.world = bpy.data.worlds.new("World")
+        scn.world.use_nodes = True
+        scn.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
+        out = os.path.join(OUT_DIR, "flowgraph")
+        os.makedirs(out, exist_ok=True)
+        scn.render.filepath = os.path.join(out, "fire.png")
+        bpy.ops.render.render(write_still=True)
+        px = image_pixels(scn.render.filepath)[..., :3]
+        print(f"  render: max {px.max():.3f}, lit pixels {(px.max(axis=2) > 0.05).mean() * 100:.1f}%")
+        self.assertGreater(float((px.max(axis=2) > 0.05).mean()), 0.005)
+
+    def test_2_bad_input_changes_nothing(self):
+        op = bpy.ops.plume.flowgraph_build
+        select([self.windy], self.windy)
+        assert_reports_error(self, op, "at least two baked fire states", self.state)
+        select([self.calm, self.windy], self.windy)
+        g = self.windy.plume.domain.flowgraph
+        g.block_size = 0
+        assert_reports_error(self, op, r"block_size \(B\) must be >= 1", self.state)
+        g.block_size = 8
+        g.epsilon = 1e9
+        assert_reports_error(self, op, r"epsilon.*\[", self.state)
+        g.epsilon = 0.0
+        # A truncated pathline file, then a missing one.
+        path = os.path.join(self.folder(self.calm), "pathlines.bin")
+        keep = path + ".keep"
+        shutil.copyfile(path, keep)
+        try:
+            with open(path, "r+b") as f:
+                f.truncate(os.path.getsize(path) // 2)
+            assert_reports_error(self, op, "domain 'Calm'.*pathlines.bin", self.state)
+            os.remove(path)
+            assert_reports_error(self, op, "Calm' has no pathline file", self.state)
+        finally:
+            os.replace(keep, path)
+        # A state baked on another domain size.
+        other = fire_state("Wide", self.tmp, size=2.5)
+        select_only(other)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        select([self.calm, other], other)
+        assert_reports_error(self, op, "different domain sizes", self.state)
+        # Synthesis without a graph.
+        select_only(other)
+        assert_reports_error(self, bpy.ops.plume.fire_synthesize, "has no flow graph yet",
+                             self.state)
+
+
+if __name__ == "__main__":
+    run(FlowGraphFireTest)

@@ -1,0 +1,215 @@
+// Benchmark of flow-graph fire synthesis (issue 6, graph_fire_synthesis.txt §5.2, Table 1):
+// - synthesis per step at 3,200 pathlines per node with L = 48 (issue: <= 1 ms; the paper's
+//   campfire, 3,217 pathlines per node: 35 ms), with a uniform and with a field u_ext, and the
+//   gather of all live particles (positions, density, temperature) a frame's output needs, and
+//   the read of one node from a pathline file (float32 and float16);
+// - VDB rasterization of those ~150k particles per frame, timed separately;
+// - the pathline recorder's cost per solver step of a 64³ fire bake (3,200 seeds, L = 48).
+// Run: build/native/plume_bench_flowgraph
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "flowgraph/fire_raster.h"
+#include "flowgraph/pathline_recorder.h"
+#include "flowgraph/synthesizer.h"
+#include "io/pathline_file.h"
+#include "tests/flowgraph_fire.h"
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+namespace plume {
+namespace {
+
+constexpr int kParticles = 3200;
+constexpr int kSamples = 48;
+constexpr float kNodeDt = 1.f / 48.f;
+
+/// Fire-like groups: seeds on a 1 m burner square at the bottom of a 2 m box, rising at 0.5 to
+/// 2.5 m/s with a swirl, density and temperature fading over the lifetime.
+std::vector<PathlineGroup> fireGroups(int count) {
+  const PathlineLayout layout{kParticles, kSamples, kNodeDt};
+  std::vector<PathlineGroup> groups(static_cast<std::size_t>(count));
+  Rng rng(9);
+  for (int k = 0; k < count; ++k) {
+    PathlineGroup& g = groups[std::size_t(k)];
+    g.step = k;
+    g.layout = layout;
+    g.start.resize(kParticles);
+    g.velocity.resize(layout.values());
+    g.density.resize(layout.values());
+    g.temperature.resize(layout.values());
+    for (int p = 0; p < kParticles; ++p) {
+      g.start[std::size_t(p)] = glm::vec3(0.5f + float(rng.uniform()), 0.5f + float(rng.uniform()), 0.05f);
+      const float rise = 0.5f + 2.f * float(rng.uniform()), phase = 6.28f * float(rng.uniform());
+      for (int s = 0; s < kSamples; ++s) {
+        const float t = float(s) * kNodeDt, life = 1.f - float(s) / kSamples;
+        const std::size_t i = g.index(p, s);
+        g.velocity[i] = glm::vec3(0.4f * std::cos(phase + 5.f * t), 0.4f * std::sin(phase + 5.f * t), rise);
+        g.density[i] = life;
+        g.temperature[i] = 4.f * life * life;
+      }
+    }
+  }
+  return groups;
+}
+
+/// u_ext = wind + a gentle shear, evaluated per particle (the field path of eq. 13).
+struct GustField final : ExternalVelocity {
+  void evaluate(const glm::vec3* x, int n, double t, glm::vec3* out) const override {
+    for (int m = 0; m < n; ++m)
+      out[m] = glm::vec3(0.3f + 0.2f * x[m].z, 0.1f * float(std::sin(t)), 0.f);
+  }
+};
+
+const std::vector<PathlineGroup>& groups() {
+  static const std::vector<PathlineGroup> g = fireGroups(8);
+  return g;
+}
+
+/// A synthesizer whose ring is full (L live groups: ~153,600 particles).
+std::unique_ptr<Synthesizer> warmSynthesizer(int threads) {
+  auto s = std::make_unique<Synthesizer>(groups()[0].layout, threads);
+  for (int n = 0; n < 2 * kSamples; ++n) s->step(groups()[std::size_t(n % 8)], glm::vec3(0.2f, 0.f, 0.f));
+  return s;
+}
+
+void BM_SynthesisStepUniformWind(benchmark::State& state) {
+  auto s = warmSynthesizer(int(state.range(0)));
+  int n = 0;
+  for (auto _ : state) s->step(groups()[std::size_t(n++ % 8)], glm::vec3(0.2f, 0.f, 0.f));
+  state.counters["particles"] = double(s->particleCount());
+}
+
+void BM_SynthesisStepFieldWind(benchmark::State& state) {
+  auto s = warmSynthesizer(int(state.range(0)));
+  const GustField field;
+  int n = 0;
+  for (auto _ : state) s->step(groups()[std::size_t(n++ % 8)], field);
+  state.counters["particles"] = double(s->particleCount());
+}
+
+void BM_SynthesisGather(benchmark::State& state) {
+  auto s = warmSynthesizer(int(state.range(0)));
+  SynthParticles out;
+  for (auto _ : state) {
+    s->gather(out);
+    benchmark::DoNotOptimize(out.positions.data());
+  }
+  state.counters["particles"] = double(out.size());
+}
+
+/// Reading one node from a pathline file (the synthesis streams one per step): the block read,
+/// its checksum and the decoding; Arg: 0 float32, 1 float16.
+void BM_PathlineReadGroup(benchmark::State& state) {
+  const bool half = state.range(0) != 0;
+  const std::string path = std::string("/tmp/plume_bench_pathlines") + (half ? "16" : "32") + ".bin";
+  PathlineFileInfo info;
+  info.layout = groups()[0].layout;
+  info.resolution = glm::ivec3(128, 64, 64);
+  info.cellSize = 1.f / 64.f;
+  info.float16 = half;
+  {
+    PathlineFileWriter w(path, info);
+    for (int k = 0; k < 8; ++k) {
+      PathlineGroup g = groups()[std::size_t(k)];
+      g.step = k;
+      w.append(g);
+    }
+    w.finish();
+  }
+  const PathlineFile file = PathlineFile::open(path);
+  PathlineGroup g;
+  int k = 0;
+  for (auto _ : state) file.readGroup(k++ % 8, g);
+  state.counters["bytes_per_node"] = double(file.bytesPerNode());
+  std::remove(path.c_str());
+}
+
+void BM_FireRasterFrame(benchmark::State& state) {
+  auto s = warmSynthesizer(0);
+  SynthParticles out;
+  s->gather(out);
+  FireRasterParams p;
+  p.voxelSize = 1.f / 48.f;  // the particles fill about 1 x 1 x 2.5 m: 48 x 48 x 120 voxels
+  p.threads = int(state.range(0));
+  std::size_t voxels = 0;
+  for (auto _ : state) {
+    const FireGrids g = rasterizeFire({out.positions.data(), out.density.data(), out.temperature.data(), out.size()}, p);
+    voxels = g.density->activeVoxelCount();
+  }
+  state.counters["particles"] = double(out.size());
+  state.counters["voxels"] = double(voxels);
+}
+
+/// Times the recorder's share of every step it follows.
+class TimedRecorder final : public StepObserver {
+ public:
+  explicit TimedRecorder(PathlineRecorder& r) : mRecorder(r) {}
+  void beforeStep(const SmokeSolver& s) override { timed([&] { mRecorder.beforeStep(s); }); }
+  void afterStep(const SmokeSolver& s, float dt) override {
+    timed([&] { mRecorder.afterStep(s, dt); });
+    ++steps;
+  }
+  double seconds = 0.0;
+  int steps = 0;
+
+ private:
+  template <typename F>
+  void timed(const F& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  PathlineRecorder& mRecorder;
+};
+
+void BM_RecorderPerSolverStep64(benchmark::State& state) {
+  // 64³ fire with a burner of 20 x 10 x 2 cells: 400 cells, the issue's 3,200 seeds.
+  const int n = 64;
+  const SmokeParams params = testing::fireParams(n, int(state.range(0)));
+  SmokeSolver solver(params);
+  CellSet burner;
+  for (int k = 1; k < 3; ++k)
+    for (int j = 27; j < 37; ++j)
+      for (int i = 22; i < 42; ++i) burner.cells.push_back(std::uint32_t(i + n * (j + n * k)));
+  solver.addSource(burner, testing::fireFuel());
+  PathlineParams pp;  // 2 nodes per frame, 1 s: L = 48
+  long long completed = 0;
+  PathlineRecorder recorder(pp, params, burner,
+                            [&](const PathlineGroup&, const std::vector<glm::vec3>&) { ++completed; });
+  TimedRecorder timed(recorder);
+  // Fill the recorder: L groups alive after L / nodes_per_frame frames.
+  for (int f = 0; f < 26; ++f) solver.advanceFrame(&timed);
+  timed.seconds = 0.0;
+  timed.steps = 0;
+  double total = 0.0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    solver.advanceFrame(&timed);
+    total += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  const double steps = double(timed.steps);
+  state.counters["seeds"] = double(recorder.layout().particles);
+  state.counters["live_particles"] = double(recorder.layout().particles) * recorder.layout().samples;
+  state.counters["recorder_ms_per_step"] = 1e3 * timed.seconds / steps;
+  state.counters["solver_ms_per_step"] = 1e3 * (total - timed.seconds) / steps;
+  state.counters["recorder_share"] = timed.seconds / (total - timed.seconds);
+  state.counters["steps_per_frame"] = steps / double(state.iterations());
+  benchmark::DoNotOptimize(completed);
+}
+
+}  // namespace
+}  // namespace plume
+
+BENCHMARK(plume::BM_SynthesisStepUniformWind)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_SynthesisStepFieldWind)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_SynthesisGather)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_PathlineReadGroup)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_FireRasterFrame)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_RecorderPerSolverStep64)->Arg(1)->Arg(0)->Iterations(6)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_MAIN();

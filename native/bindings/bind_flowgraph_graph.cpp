@@ -1,0 +1,300 @@
+/// \file bind_flowgraph_graph.cpp
+/// The flow graph for Python (graph_fire_synthesis.txt §4.3-5.1): FlowGraphParams, the cost
+/// matrix of eq. 9-10 from PathlineGroup objects (bind_pathline_group.cpp), the graph with its
+/// pruning, random walks and the Figure 4 picture. Conversions and docstrings only; long calls
+/// release the GIL. std::invalid_argument becomes ValueError.
+
+#include "bindings/bindings.h"
+
+#include "flowgraph/cost_matrix.h"
+#include "flowgraph/cost_matrix_image.h"
+#include "flowgraph/flow_graph.h"
+#include "flowgraph/random_walk.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cstring>
+
+namespace py = pybind11;
+
+namespace plume::bindings {
+namespace {
+
+using DoubleC = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using LongC = py::array_t<long long, py::array::c_style | py::array::forcecast>;
+
+/// A Python sequence of PathlineGroup as pointers (the sequence must outlive their use).
+std::vector<const PathlineGroup*> groupPointers(const py::sequence& groups) {
+  std::vector<const PathlineGroup*> p;
+  p.reserve(py::len(groups));
+  for (std::size_t n = 0; n < py::len(groups); ++n) {
+    if (!py::isinstance<PathlineGroup>(groups[n]))
+      throw py::value_error("groups[" + std::to_string(n) + "] is not a PathlineGroup");
+    p.push_back(&groups[n].cast<const PathlineGroup&>());
+  }
+  return p;
+}
+
+/// An (N, N) float64 array as a checked CostMatrix (ValueError otherwise).
+CostMatrix toCost(const py::object& o) {
+  const DoubleC a = DoubleC::ensure(o);
+  if (!a || a.ndim() != 2 || a.shape(0) != a.shape(1))
+    throw py::value_error("cost must be a square (N, N) float array");
+  std::vector<double> v(std::size_t(a.size()));
+  if (!v.empty()) std::memcpy(v.data(), a.data(), v.size() * sizeof(double));
+  py::gil_scoped_release release;
+  return CostMatrix::fromValues(int(a.shape(0)), std::move(v));
+}
+
+template <typename T, typename Fn>
+py::array_t<T> arrayOf(std::size_t n, const Fn& fn) {
+  py::array_t<T> a(static_cast<py::ssize_t>(n));
+  for (std::size_t i = 0; i < n; ++i) a.mutable_data()[i] = T(fn(i));
+  return a;
+}
+
+/// The state node counts of a graph (before pruning).
+std::vector<int> stateCounts(const FlowGraph& g) {
+  std::vector<int> c;
+  for (int s = 0; s < g.stateCount(); ++s) c.push_back(g.stateNodeCount(s));
+  return c;
+}
+
+/// An (N, N) float64 NumPy copy of C.
+py::array_t<double> costArray(const CostMatrix& c) {
+  py::array_t<double> a({py::ssize_t(c.size()), py::ssize_t(c.size())});
+  if (c.size()) std::memcpy(a.mutable_data(), c.values().data(), c.values().size() * sizeof(double));
+  return a;
+}
+
+/// computeCostMatrix() run by a worker thread while another polls progress or cancels.
+struct CostMatrixJob {
+  py::object groups;  // keeps the PathlineGroups alive
+  std::vector<const PathlineGroup*> pointers;
+  FlowGraphParams params;
+  CostMatrixProgress progress;
+  CostMatrix cost;
+  bool finished = false;
+};
+
+void bindParams(py::module_& m) {
+  py::enum_<EpsilonMode>(m, "EpsilonMode", "How ε of eq. 11 is chosen from a, b (§4.3).")
+      .value("TWO_THIRDS", EpsilonMode::TwoThirds, "ε = (2a + b) / 3, the paper's.")
+      .value("EXPLICIT", EpsilonMode::Explicit, "FlowGraphParams.epsilon, which must lie in [a, b].");
+  py::enum_<WalkBias>(m, "WalkBias", "Edge choice of a random walk without target (§5.1).")
+      .value("UNIFORM", WalkBias::Uniform, "p = 1 / d(V_i).")
+      .value("TEMPORAL", WalkBias::Temporal, "Eq. 12: γ on the temporal edge, (1 − γ)/(d − 1) on the others.");
+
+  py::class_<FlowGraphParams> c(m, "FlowGraphParams", "Settings of the flow graph (§4.3).");
+  c.def(py::init<>());
+  c.def_readwrite("alpha", &FlowGraphParams::alpha, "α of eq. 9: weight of the density difference (>= 0).");
+  c.def_readwrite("beta", &FlowGraphParams::beta, "β of eq. 9: weight of the temperature difference (>= 0).");
+  c.def_readwrite("block_size", &FlowGraphParams::blockSize, "B: one candidate per B×B block (default 32, >= 1).");
+  c.def_readwrite("epsilon_mode", &FlowGraphParams::epsilonMode, "EpsilonMode.TWO_THIRDS or EXPLICIT.");
+  c.def_readwrite("epsilon", &FlowGraphParams::epsilon, "ε for EpsilonMode.EXPLICIT, in [a, b].");
+  c.def_readwrite("min_node_gap", &FlowGraphParams::minNodeGap,
+                  "Pairs of one state at most this many node steps apart are no candidates (default 8).");
+  c.def_readwrite("threads", &FlowGraphParams::threads, "Worker threads of the cost matrix; 0 = all cores.");
+  c.def("validate", &FlowGraphParams::validate, "ValueError naming the setting and its range.");
+
+  m.def(
+      "same_magnitude_weights",
+      [](const py::sequence& groups, int threads) {
+        const auto p = groupPointers(groups);
+        py::gil_scoped_release release;
+        const FlowWeights w = sameMagnitudeWeights(p, threads);
+        return std::make_pair(w.alpha, w.beta);
+      },
+      py::arg("groups"), py::arg("threads") = 0,
+      "(alpha, beta) of eq. 9 bringing the mean squared differences of velocity, density and "
+      "temperature over all pairs of groups to the same magnitude (§4.3).");
+  m.def(
+      "cost_matrix",
+      [](const py::sequence& groups, const FlowGraphParams& params) {
+        const auto p = groupPointers(groups);
+        CostMatrix c;
+        {
+          py::gil_scoped_release release;
+          c = computeCostMatrix(p, params);
+        }
+        return costArray(c);
+      },
+      py::arg("groups"), py::arg("params") = FlowGraphParams(),
+      "C of eq. 9-10, (N, N) float64, for PathlineGroups ordered state by state and "
+      "chronologically (all must share one layout). Uses params.alpha, beta and threads.");
+}
+
+void bindJob(py::module_& m) {
+  py::class_<CostMatrixJob> j(m, "CostMatrixJob",
+                              "cost_matrix() for a worker thread: run() computes (GIL released), another "
+                              "thread may read progress or call cancel().");
+  j.def(py::init([](const py::sequence& groups, const FlowGraphParams& params) {
+          auto job = std::make_unique<CostMatrixJob>();
+          job->groups = groups;
+          job->pointers = groupPointers(groups);
+          job->params = params;
+          return job;
+        }),
+        py::arg("groups"), py::arg("params") = FlowGraphParams());
+  j.def(
+      "run",
+      [](CostMatrixJob& job) {
+        CostMatrix c;
+        {
+          py::gil_scoped_release release;
+          c = computeCostMatrix(job.pointers, job.params, &job.progress);
+        }
+        job.finished = !job.progress.cancel.load();
+        if (job.finished) job.cost = std::move(c);
+        return job.finished;
+      },
+      "Computes C; False when cancel() was called (no result then). ValueError on bad groups or params.");
+  j.def("cancel", [](CostMatrixJob& job) { job.progress.cancel = true; }, "Thread-safe: run() stops early.");
+  j.def_property_readonly("progress", [](const CostMatrixJob& job) { return job.progress.fraction(); },
+                          "Finished fraction in [0, 1].");
+  j.def_property_readonly(
+      "cost",
+      [](const CostMatrixJob& job) {
+        if (!job.finished) throw py::value_error("the cost matrix is not computed (run() first, not cancelled)");
+        return costArray(job.cost);
+      },
+      "C, (N, N) float64, after a run() that returned True.");
+}
+
+void bindGraph(py::module_& m) {
+  py::class_<FlowGraph> g(m, "FlowGraph",
+                          "The flow graph of §4.3: temporal edges (eq. 8), kept transitions (eq. 11) read as "
+                          "i -> j + 1, nodes that cannot reach a cycle pruned.");
+  g.def_static(
+      "build",
+      [](const py::object& cost, const std::vector<int>& counts, const FlowGraphParams& params) {
+        const CostMatrix c = toCost(cost);
+        py::gil_scoped_release release;
+        return FlowGraph::build(c, counts, params);
+      },
+      py::arg("cost"), py::arg("state_node_counts"), py::arg("params") = FlowGraphParams(),
+      "The graph of cost matrix `cost` (N, N) whose nodes are state_node_counts[0] nodes of state 0, "
+      "then those of state 1, ... ValueError if a state's first node is pruned.");
+  g.def_property_readonly("node_count", &FlowGraph::nodeCount, "N, pruned nodes included.");
+  g.def_property_readonly("state_count", &FlowGraph::stateCount, "Number of states.");
+  g.def_property_readonly("state_node_counts", &stateCounts, "Nodes per state (before pruning).");
+  g.def_property_readonly("pruned_per_state", &FlowGraph::prunedPerState, "Pruned nodes per state.");
+  g.def_property_readonly(
+      "node_states", [](const FlowGraph& f) { return arrayOf<int>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.state(int(n)); }); },
+      "State of every node, (N,) int32.");
+  g.def_property_readonly(
+      "node_steps", [](const FlowGraph& f) { return arrayOf<int>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.step(int(n)); }); },
+      "Step of every node inside its state, (N,) int32.");
+  g.def_property_readonly(
+      "pruned", [](const FlowGraph& f) { return arrayOf<bool>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.pruned(int(n)); }); },
+      "True for the pruned nodes, (N,) bool.");
+  g.def_property_readonly(
+      "stays_in_state",
+      [](const FlowGraph& f) { return arrayOf<bool>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.staysInState(int(n)); }); },
+      "True where a walk can stay in the node's state forever, (N,) bool.");
+  g.def(
+      "out_degree",
+      [](const FlowGraph& f, int node) {
+        if (node < 0 || node >= f.nodeCount())
+          throw py::value_error("node must be in [0, " + std::to_string(f.nodeCount() - 1) + "]");
+        return f.outDegree(node);
+      },
+      py::arg("node"), "d(V_i) of §5.1.");
+  g.def("reachable_states", &FlowGraph::reachableStates, py::arg("state"),
+        "States a walk from the first node of `state` can ever visit (a target outside is never reached).");
+  g.def(
+      "edges",
+      [](const FlowGraph& f) {
+        std::vector<int> from;
+        for (int n = 0; n < f.nodeCount(); ++n)
+          for (int k = 0; k < f.outDegree(n); ++k) from.push_back(n);
+        const FlowEdge* e = f.outEdges(0).begin();
+        py::dict d;
+        d["from"] = arrayOf<int>(from.size(), [&](std::size_t k) { return from[k]; });
+        d["to"] = arrayOf<int>(from.size(), [&](std::size_t k) { return e[k].to; });
+        d["cost"] = arrayOf<double>(from.size(), [&](std::size_t k) { return e[k].cost; });
+        d["temporal"] = arrayOf<bool>(from.size(), [&](std::size_t k) { return e[k].temporal; });
+        return d;
+      },
+      "Every edge of the pruned graph: dict of (E,) arrays from, to, cost, temporal (by source node).");
+  g.def(
+      "transitions",
+      [](const FlowGraph& f) {
+        const TransitionSelection& s = f.transitions();
+        const auto& c = s.candidates;
+        py::dict d;
+        d["row"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].row; });
+        d["col"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].col; });
+        d["cost"] = arrayOf<double>(c.size(), [&](std::size_t k) { return c[k].cost; });
+        d["kept"] = arrayOf<bool>(c.size(), [&](std::size_t k) { return c[k].kept; });
+        d["a"] = s.a;
+        d["b"] = s.b;
+        d["epsilon"] = s.epsilon;
+        d["blocks_per_side"] = s.blocksPerSide;
+        return d;
+      },
+      "The block candidates (row, col, cost, kept arrays; edge row -> col + 1), a, b, ε and M (§4.3).");
+
+  m.def(
+      "cost_matrix_image",
+      [](const py::object& cost, const FlowGraph& graph, int size) {
+        const CostMatrix c = toCost(cost);
+        RgbImage img;
+        {
+          py::gil_scoped_release release;
+          img = costMatrixImage(c, graph.transitions(), stateCounts(graph), size);
+        }
+        py::array_t<std::uint8_t> a({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(3)});
+        std::memcpy(a.mutable_data(), img.pixels.data(), img.pixels.size());
+        return a;
+      },
+      py::arg("cost"), py::arg("graph"), py::arg("size") = 512,
+      "Figure 4: (size, size, 3) uint8 RGB, top row = node 0; grey cost (darker = lower), blue "
+      "filtered candidates, yellow kept transitions, red lines between states.");
+}
+
+void bindWalk(py::module_& m) {
+  py::class_<RandomWalk> w(m, "RandomWalk", "A seeded random walk on a FlowGraph (§5.1).");
+  w.def(py::init<const FlowGraph&, std::uint64_t, WalkBias, double, int>(), py::arg("graph"), py::arg("seed"),
+        py::arg("bias") = WalkBias::Uniform, py::arg("gamma") = 0.875, py::arg("start_state") = 0,
+        py::keep_alive<1, 2>(), "Starts at the first node of start_state.");
+  w.def_property_readonly("current", &RandomWalk::current, "The node visited now.");
+  w.def("next", &RandomWalk::next, py::arg("target_state") = -1,
+        "Follows one edge (steered to target_state unless -1) and returns the new node.");
+  w.def(
+      "run",
+      [](RandomWalk& walk, const py::object& targets) {
+        const LongC t = LongC::ensure(targets);
+        if (!t || t.ndim() != 1) throw py::value_error("targets must be a 1-D integer array");
+        std::vector<int> nodes(std::size_t(t.size()));
+        const std::vector<long long> tv(t.data(), t.data() + t.size());
+        {
+          py::gil_scoped_release release;
+          for (std::size_t k = 0; k < nodes.size(); ++k)
+            nodes[k] = walk.next(int(std::max(-2LL, std::min(tv[k], 1LL << 30))));  // next() checks the range
+        }
+        return arrayOf<int>(nodes.size(), [&](std::size_t k) { return nodes[k]; });
+      },
+      py::arg("targets"), "next(targets[k]) for every k (-1: no target); the nodes visited, (K,) int32.");
+  w.def(
+      "edge_probabilities",
+      [](const RandomWalk& walk, int node, int target) {
+        const std::vector<double> p = walk.edgeProbabilities(node, target);
+        return arrayOf<double>(p.size(), [&](std::size_t k) { return p[k]; });
+      },
+      py::arg("node"), py::arg("target_state") = -1,
+      "Probability of each out-edge of node (FlowGraph.edges order), eq. 12 or §5.1 target rule.");
+}
+
+}  // namespace
+
+void bindFlowgraphGraph(py::module_& m) {
+  bindParams(m);
+  bindJob(m);
+  bindGraph(m);
+  bindWalk(m);
+}
+
+}  // namespace plume::bindings

@@ -1,0 +1,109 @@
+#pragma once
+/// \file synthesizer.h
+/// Fire synthesis from a walk on the flow graph (graph_fire_synthesis.txt §5.2, eq. 13,
+/// Algorithm 1): each visited node emits its group's particles at their start positions; every
+/// particle then follows its own pathline's velocity samples plus an external velocity,
+///   x_{k+1} = x_k + ∫_{t_k}^{t_k + Δt_n} [u(t) + u_ext(t)] dt,              (13)
+/// carries its pathline's density and temperature, and is removed after its lifetime of L
+/// samples. A transition (a visited node that is not the successor of the previous one) only
+/// changes which group is emitted: particles already alive keep their own pathline.
+///
+/// Quadrature. u(t) is known at the samples, Δt_n apart: the pathline part of eq. 13 is the
+/// trapezoid rule between the samples of the particle's age a and a + 1,
+///   ∫ u dt ≈ Δt_n (u_a + u_{a+1}) / 2,
+/// second order: over a lifetime it differs from the recorded pathline by at most
+/// t_max Δt_n² max|ü| / 12 (ü: second time derivative of the velocity along the pathline). A
+/// uniform u_ext is given per step (constant over it); a field u_ext(x, t) is integrated with
+/// Heun's method (trapezoid with an Euler predictor), also second order.
+///
+/// Layout and cost. The pathline part of a particle's position does not depend on u_ext, so it
+/// is summed once when its group is emitted (sample-major arrays of positions, density and
+/// temperature per group, in a ring of L slots); what u_ext adds is kept apart: one vector per
+/// group for a uniform u_ext, one per particle once a field is used. A step with a uniform
+/// u_ext therefore costs the emission of one group (|Ω| L values) plus O(L); positions are
+/// formed (pathline part + external part) by gather(). No allocation once the ring is full;
+/// parallel over particles with fixed chunks, so results do not depend on the thread count.
+
+#include "flowgraph/pathline_group.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace plume {
+
+/// An external velocity field u_ext(x, t) (§5.2: "velocity introduced by (optional) external
+/// forces, useful for fire deformation"), evaluated in batches.
+class ExternalVelocity {
+ public:
+  virtual ~ExternalVelocity() = default;
+  /// u_ext (m/s) at the n world positions x, at synthesis time t (s), into out. Called from
+  /// several threads at once, on disjoint ranges.
+  virtual void evaluate(const glm::vec3* x, int n, double t, glm::vec3* out) const = 0;
+};
+
+/// Live particles as gathered: world positions, density and temperature from the samples of
+/// their age (oldest group first, particle order within a group).
+struct SynthParticles {
+  std::vector<glm::vec3> positions;
+  std::vector<float> density;
+  std::vector<float> temperature;
+  std::size_t size() const { return positions.size(); }
+};
+
+/// Particles of a synthesized fire (see the file comment).
+class Synthesizer {
+ public:
+  /// Every emitted group must have `layout` (|Ω| >= 1, L >= 2, Δt_n > 0: std::invalid_argument
+  /// otherwise). `threads`: worker threads (0: all cores).
+  explicit Synthesizer(const PathlineLayout& layout, int threads = 0);
+
+  const PathlineLayout& layout() const { return mLayout; }
+
+  /// One synthesis step (Algorithm 1): particles alive move over Δt_n by eq. 13 with the uniform
+  /// external velocity `externalVelocity` (m/s, constant over the step) and age by one; those
+  /// at the end of their lifetime are removed; then `emitted` (the visited node) emits its
+  /// particles at their start positions. Throws std::invalid_argument when `emitted` does not
+  /// have the layout or its arrays do not match it.
+  void step(const PathlineGroup& emitted, glm::vec3 externalVelocity = glm::vec3(0.f));
+  /// The same with u_ext(x, t) from a field (Heun's method per particle).
+  void step(const PathlineGroup& emitted, const ExternalVelocity& field);
+
+  /// Steps taken. After step n (counting from 0) the particles are at synthesis time n Δt_n.
+  long long steps() const { return mSteps; }
+  double time() const { return mSteps > 0 ? double(mSteps - 1) * double(mLayout.sampleDt) : 0.0; }
+  /// Groups alive (at most L) and their particles.
+  int liveGroups() const;
+  std::size_t particleCount() const { return std::size_t(liveGroups()) * std::size_t(mLayout.particles); }
+  /// Step at which the oldest live group was emitted (groups emitted at firstLiveStep(),
+  /// firstLiveStep() + 1, ..., steps() - 1 are alive, oldest first in gather()).
+  long long firstLiveStep() const { return mSteps - liveGroups(); }
+
+  /// Positions, density and temperature of every live particle into `out` (buffers reused).
+  void gather(SynthParticles& out) const;
+
+ private:
+  struct Slot {
+    long long emittedAt = -1;
+    std::vector<glm::vec3> path;          ///< [age][particle]: start + Σ trapezoids (eq. 13 without u_ext)
+    std::vector<float> density, temperature;  ///< [age][particle]
+    glm::vec3 uniformOffset{0.f};         ///< ∫ of the uniform u_ext since emission
+    std::vector<glm::vec3> fieldOffset;   ///< ∫ of field u_ext since emission, per particle
+    bool hasField = false;
+  };
+  void advance(glm::vec3 uniform, const ExternalVelocity* field);
+  void emit(const PathlineGroup& g);
+  void checkGroup(const PathlineGroup& g) const;
+  Slot& slotOf(long long emittedAt) { return mSlots[std::size_t(emittedAt % mLayout.samples)]; }
+  const Slot& slotOf(long long emittedAt) const {
+    return mSlots[std::size_t(emittedAt % mLayout.samples)];
+  }
+
+  PathlineLayout mLayout;
+  int mThreads;
+  std::vector<Slot> mSlots;  ///< ring of L: the group emitted at step n lives in slot n mod L
+  long long mSteps = 0;
+};
+
+}  // namespace plume

@@ -1,0 +1,561 @@
+/// \file flowgraph_synth_test.cpp
+/// Flow-graph fire synthesis (graph_fire_synthesis.txt §4.2, §5.2): RK4 pathlines (eq. 6), the
+/// pathline file, the synthesizer (eq. 13) and the VDB rasterization. The reproduction of a real
+/// bake by a temporal walk is in flowgraph_reproduction_test.cpp.
+
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "flowgraph/fire_raster.h"
+#include "flowgraph/pathline_integrator.h"
+#include "flowgraph/pathline_recorder.h"
+#include "flowgraph/synthesizer.h"
+#include "flowgraph/velocity_field.h"
+#include "io/pathline_file.h"
+#include "io/vdb_frame.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace plume {
+namespace {
+
+constexpr int kN = 16;
+constexpr float kH = 1.f / kN;
+const glm::vec3 kCentre(0.5f, 0.5f, 0.5f);
+
+/// A MAC grid of kN³ cells of size kH at the origin holding u(x) = ω ẑ × (x - c): linear, so
+/// trilinear sampling reproduces it exactly inside the grid.
+MacGrid3 rotation(float omega) {
+  MacGrid3 m{glm::ivec3(kN)};
+  for (int a = 0; a < 2; ++a) {
+    ScalarGrid& g = m.component(a);
+    const glm::ivec3 n = g.size();
+    for (int k = 0; k < n.z; ++k)
+      for (int j = 0; j < n.y; ++j)
+        for (int i = 0; i < n.x; ++i) {
+          glm::vec3 x = (glm::vec3(i, j, k) + glm::vec3(0.5f)) * kH;
+          x[a] -= 0.5f * kH;  // faces of axis a sit half a cell lower
+          g(i, j, k) = a == 0 ? -omega * (x.y - kCentre.y) : omega * (x.x - kCentre.x);
+        }
+  }
+  return m;
+}
+
+MacGrid3 uniform(glm::vec3 u) {
+  MacGrid3 m{glm::ivec3(kN)};
+  for (int a = 0; a < 3; ++a) m.component(a).fill(u[a]);
+  return m;
+}
+
+glm::vec3 rotated(glm::vec3 x, float angle) {
+  const glm::vec3 d = x - kCentre;
+  return kCentre + glm::vec3(std::cos(angle) * d.x - std::sin(angle) * d.y,
+                             std::sin(angle) * d.x + std::cos(angle) * d.y, d.z);
+}
+
+TEST(PathlineIntegrator, ExactOnAFieldLinearInTime) {
+  // u(t) = a + θ (b - a) everywhere: x(θ) = x0 + dt (θ a + θ²/2 (b - a)), a quadratic RK4 is
+  // exact for.
+  const glm::vec3 a(0.3f, -0.2f, 0.5f), b(-0.1f, 0.4f, 0.9f);
+  const MacGrid3 ga = uniform(a), gb = uniform(b);
+  const SubstepVelocity u(ga, gb, kH, glm::vec3(0.f));
+  const glm::vec3 x0(0.4f, 0.5f, 0.3f);
+  const float dt = 0.2f;
+  const glm::vec3 x = integrateRk4(u, x0, 0.25f, 0.75f, dt, 1);
+  const glm::vec3 exact = x0 + dt * (0.5f * a + 0.5f * (0.75f * 0.75f - 0.25f * 0.25f) * (b - a));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(x[c], exact[c], 1e-6f);
+}
+
+TEST(PathlineIntegrator, FourthOrderOnAnUnsteadyRotation) {
+  // ω blends from ω0 at the substep's start to ω1 at its end; rotations about one axis commute,
+  // so the exact pathline turns by ∫ω dt = dt (ω0 + ω1) / 2.
+  const float w0 = 2.f, w1 = 4.f, dt = 1.f;
+  const MacGrid3 g0 = rotation(w0), g1 = rotation(w1);
+  const SubstepVelocity u(g0, g1, kH, glm::vec3(0.f));
+  const glm::vec3 x0(0.75f, 0.5f, 0.5f);
+  const glm::vec3 exact = rotated(x0, dt * 0.5f * (w0 + w1));
+  double error[3];
+  const int steps[3] = {4, 8, 16};
+  for (int n = 0; n < 3; ++n) error[n] = glm::length(integrateRk4(u, x0, 0.f, 1.f, dt, steps[n]) - exact);
+  const double order1 = std::log2(error[0] / error[1]), order2 = std::log2(error[1] / error[2]);
+  std::cout << "RK4 errors " << error[0] << " " << error[1] << " " << error[2] << ", orders "
+            << order1 << " " << order2 << "\n";
+  EXPECT_GE(order1, 3.5);
+  EXPECT_GE(order2, 3.5);
+  EXPECT_LT(error[2], 1e-4);
+}
+
+TEST(PathlineIntegrator, StepCountFollowsTheSpeed) {
+  // 3 cells in one substep need 3 steps; advancePathline() then matches integrateRk4(3).
+  const MacGrid3 g = rotation(3.f);
+  const SubstepVelocity u(g, g, kH, glm::vec3(0.f));
+  const glm::vec3 x0(0.75f, 0.5f, 0.5f);  // speed 0.75 m/s = 12 cells/s
+  const float dt = 0.25f;                  // 3 cells
+  const glm::vec3 a = advancePathline(u, x0, 0.f, 1.f, dt, kH);
+  const glm::vec3 b = integrateRk4(u, x0, 0.f, 1.f, dt, 3);
+  EXPECT_EQ(a, b);
+  EXPECT_NEAR(glm::length(a - rotated(x0, 0.75f)), 0.f, 2e-4f);
+}
+
+TEST(PathlineSeeds, EightPerCellAtHalfCellSpacing) {
+  CellSet cells;
+  cells.cells = {5, 3, 5};  // duplicates and order do not matter
+  const auto seeds = pathlineSeeds(cells, glm::ivec3(4, 2, 2), 0.5f, glm::vec3(1.f, 0.f, 0.f));
+  ASSERT_EQ(seeds.size(), 16u);
+  // Cell 3 = (3, 0, 0) first, x fastest: (3.25, 0.25, 0.25) Δx, then (3.75, 0.25, 0.25) Δx.
+  EXPECT_EQ(seeds[0], glm::vec3(1.f + 3.25f * 0.5f, 0.125f, 0.125f));
+  EXPECT_EQ(seeds[1], glm::vec3(1.f + 3.75f * 0.5f, 0.125f, 0.125f));
+  EXPECT_EQ(seeds[2], glm::vec3(1.f + 3.25f * 0.5f, 0.375f, 0.125f));
+  EXPECT_EQ(seeds[8], glm::vec3(1.f + 1.25f * 0.5f, 0.625f, 0.125f));  // cell 5 = (1, 1, 0)
+  EXPECT_THROW(pathlineSeeds(CellSet{}, glm::ivec3(4), 1.f, glm::vec3(0.f)), std::invalid_argument);
+  cells.cells = {64};
+  EXPECT_THROW(pathlineSeeds(cells, glm::ivec3(4), 1.f, glm::vec3(0.f)), std::invalid_argument);
+}
+
+TEST(PathlineParams, ValidateNamesTheSetting) {
+  auto message = [](const PathlineParams& p, float frameDt) {
+    try {
+      p.validate();
+      p.samples(frameDt);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  PathlineParams p;
+  EXPECT_EQ(p.samples(1.f / 24.f), 48);  // 1 s at 2 nodes per frame
+  p.nodesPerFrame = 0;
+  EXPECT_NE(message(p, 1.f / 24.f).find("nodes_per_frame"), std::string::npos);
+  p = PathlineParams();
+  p.lifetime = -1.f;
+  EXPECT_NE(message(p, 1.f / 24.f).find("lifetime"), std::string::npos);
+  p.lifetime = 0.01f;  // less than two node steps
+  EXPECT_NE(message(p, 1.f / 24.f).find("lifetime"), std::string::npos);
+}
+
+// --- pathline files -----------------------------------------------------------------------
+
+PathlineGroup randomGroup(const PathlineLayout& layout, int step, std::uint64_t seed) {
+  PathlineGroup g;
+  g.step = step;
+  g.layout = layout;
+  Rng rng(seed);
+  auto r = [&](double lo, double hi) { return float(lo + (hi - lo) * rng.uniform()); };
+  g.start.resize(std::size_t(layout.particles));
+  for (auto& x : g.start) x = glm::vec3(r(0, 1), r(0, 1), r(0, 1));
+  const std::size_t v = layout.values();
+  g.velocity.resize(v);
+  g.density.resize(v);
+  g.temperature.resize(v);
+  for (std::size_t n = 0; n < v; ++n) {
+    g.velocity[n] = glm::vec3(r(-3, 3), r(-3, 3), r(-1, 8));
+    g.density[n] = n % 7 == 0 ? 0.f : r(0, 2);
+    g.temperature[n] = r(0, 5);
+  }
+  return g;
+}
+
+PathlineFileInfo fileInfo(const PathlineLayout& layout, bool half) {
+  PathlineFileInfo info;
+  info.layout = layout;
+  info.resolution = glm::ivec3(24, 20, 32);
+  info.cellSize = 0.05f;
+  info.origin = glm::vec3(-0.5f, 0.25f, 0.f);
+  info.nodesPerFrame = 2;
+  info.float16 = half;
+  return info;
+}
+
+std::string tempPath(const std::string& name) { return ::testing::TempDir() + "plume_pathlines_" + name; }
+
+/// Writes `count` random groups; returns them.
+std::vector<PathlineGroup> writeGroups(const std::string& path, const PathlineFileInfo& info, int count) {
+  std::vector<PathlineGroup> groups;
+  PathlineFileWriter w(path, info);
+  for (int k = 0; k < count; ++k) {
+    groups.push_back(randomGroup(info.layout, k, std::uint64_t(k) + 11));
+    w.append(groups.back());
+  }
+  w.finish();
+  return groups;
+}
+
+void expectThrowsNaming(const std::function<void()>& f, const std::string& path, const std::string& what) {
+  try {
+    f();
+    ADD_FAILURE() << "no error for " << path;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+  }
+}
+
+TEST(PathlineFile, RoundTripIsExactInFloat32) {
+  const PathlineLayout layout{37, 9, 1.f / 48.f};
+  const std::string path = tempPath("f32.bin");
+  const auto groups = writeGroups(path, fileInfo(layout, false), 5);
+  EXPECT_FALSE(fs::exists(path + ".partial"));
+  const PathlineFile f = PathlineFile::open(path);
+  EXPECT_EQ(f.nodeCount(), 5);
+  EXPECT_TRUE(f.layout() == layout);
+  EXPECT_EQ(f.info().resolution, glm::ivec3(24, 20, 32));
+  EXPECT_EQ(f.info().origin, glm::vec3(-0.5f, 0.25f, 0.f));
+  EXPECT_EQ(f.info().nodesPerFrame, 2);
+  for (int k : {3, 0, 4}) {
+    const PathlineGroup g = f.readGroup(k, /*state=*/2);
+    EXPECT_EQ(g.state, 2);
+    EXPECT_EQ(g.step, k);
+    EXPECT_EQ(g.start, groups[std::size_t(k)].start);
+    EXPECT_EQ(g.velocity, groups[std::size_t(k)].velocity);
+    EXPECT_EQ(g.density, groups[std::size_t(k)].density);
+    EXPECT_EQ(g.temperature, groups[std::size_t(k)].temperature);
+  }
+  EXPECT_EQ(fs::file_size(path), 80 + 5 * f.bytesPerNode() + 16 * 5 + 8);
+  EXPECT_THROW(f.readGroup(5), std::out_of_range);
+  // The size: |Ω| = 3,200, L = 48.
+  PathlineFileInfo big = fileInfo(PathlineLayout{3200, 48, 1.f / 48.f}, false);
+  std::cout << "bytes per node (3200 pathlines, 48 samples): float32 " << big.blockBytes();
+  big.float16 = true;
+  std::cout << ", float16 " << big.blockBytes() << "\n";
+}
+
+TEST(PathlineFile, HalfPrecisionRoundsToNearest) {
+  // Every finite half survives float -> half -> float; floats round within half an ulp (2^-11
+  // relative for normal halves, 2^-25 absolute below them).
+  for (std::uint32_t b = 0; b < 0x10000u; ++b) {
+    if ((b & 0x7c00u) == 0x7c00u) continue;  // inf / NaN
+    const float f = halfToFloat(std::uint16_t(b));
+    ASSERT_EQ(halfToFloat(floatToHalf(f)), f) << b;
+  }
+  Rng rng(3);
+  for (int n = 0; n < 100000; ++n) {
+    const float f = float((rng.uniform() - 0.5) * std::pow(2.0, 30.0 * rng.uniform() - 20.0));
+    const float back = halfToFloat(floatToHalf(f));
+    ASSERT_LE(std::fabs(back - f), std::fabs(f) * 0x1p-11f + 0x1p-25f) << f;
+  }
+  EXPECT_EQ(halfToFloat(floatToHalf(1e9f)), 65504.f);  // clamped, not infinite
+  EXPECT_EQ(halfToFloat(floatToHalf(NAN)), 0.f);
+}
+
+TEST(PathlineFile, Float16RoundTripWithinHalfRounding) {
+  const PathlineLayout layout{20, 6, 0.02f};
+  const std::string path = tempPath("f16.bin");
+  const auto groups = writeGroups(path, fileInfo(layout, true), 3);
+  const PathlineFile f = PathlineFile::open(path);
+  EXPECT_TRUE(f.info().float16);
+  const PathlineGroup g = f.readGroup(1);
+  const PathlineGroup& w = groups[1];
+  EXPECT_EQ(g.start, w.start);  // positions stay float32
+  auto close = [](float a, float b) { return std::fabs(a - b) <= std::fabs(b) * 0x1p-11f + 0x1p-25f; };
+  for (std::size_t n = 0; n < layout.values(); ++n) {
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(close(g.velocity[n][c], w.velocity[n][c]));
+    ASSERT_TRUE(close(g.density[n], w.density[n]));
+    ASSERT_TRUE(close(g.temperature[n], w.temperature[n]));
+  }
+  PathlineFileInfo f32 = f.info();
+  f32.float16 = false;
+  EXPECT_LT(f.bytesPerNode(), f32.blockBytes());
+}
+
+void corruptByte(const std::string& path, std::uint64_t at) {
+  std::fstream io(path, std::ios::binary | std::ios::in | std::ios::out);
+  io.seekg(std::streamoff(at));
+  char c;
+  io.read(&c, 1);
+  c = char(c ^ 0x5a);
+  io.seekp(std::streamoff(at));
+  io.write(&c, 1);
+}
+
+TEST(PathlineFile, TruncatedOrCorruptFilesNameTheFile) {
+  const PathlineLayout layout{10, 4, 0.05f};
+  const PathlineFileInfo info = fileInfo(layout, false);
+  const std::string path = tempPath("bad.bin");
+  writeGroups(path, info, 3);
+  const auto size = fs::file_size(path);
+  expectThrowsNaming([&] { PathlineFile::open(tempPath("missing.bin")); }, tempPath("missing.bin"),
+                     "cannot be opened");
+  fs::resize_file(path, size - 5);
+  expectThrowsNaming([&] { PathlineFile::open(path); }, path, "truncated");
+  fs::resize_file(path, 40);
+  expectThrowsNaming([&] { PathlineFile::open(path); }, path, "truncated");
+  writeGroups(path, info, 3);
+  corruptByte(path, 20);  // the header
+  expectThrowsNaming([&] { PathlineFile::open(path); }, path, "corrupt");
+  writeGroups(path, info, 3);
+  corruptByte(path, size - 12);  // the table
+  expectThrowsNaming([&] { PathlineFile::open(path); }, path, "corrupt");
+  writeGroups(path, info, 3);
+  corruptByte(path, 80 + info.blockBytes() + 100);  // node 1
+  const PathlineFile f = PathlineFile::open(path);  // the table is fine
+  EXPECT_NO_THROW(f.readGroup(0));
+  expectThrowsNaming([&] { f.readGroup(1); }, path, "corrupt");
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << std::string(200, 'x');
+  expectThrowsNaming([&] { PathlineFile::open(path); }, path, "bad magic");
+}
+
+TEST(PathlineFile, UnfinishedWriteNeverReadsAsComplete) {
+  const PathlineLayout layout{10, 4, 0.05f};
+  const std::string path = tempPath("killed.bin");
+  writeGroups(path, fileInfo(layout, false), 2);  // an older complete file
+  {
+    // A bake killed after two groups: the writer never reaches finish() (its destructor leaves
+    // the file as a kill would).
+    PathlineFileWriter w(path, fileInfo(layout, false));
+    EXPECT_FALSE(fs::exists(path));  // the older file is gone: it belonged to the replaced bake
+    w.append(randomGroup(layout, 0, 1));
+    w.append(randomGroup(layout, 1, 2));
+  }
+  EXPECT_FALSE(fs::exists(path));
+  ASSERT_TRUE(fs::exists(path + ".partial"));
+  // Even under the final name, the partial file says it is incomplete.
+  fs::copy_file(path + ".partial", path);
+  expectThrowsNaming([&] { PathlineFile::open(path); }, path, "incomplete");
+  fs::remove(path);
+  {
+    PathlineFileWriter w(path, fileInfo(layout, false));
+    w.append(randomGroup(layout, 0, 1));
+    EXPECT_THROW(w.append(randomGroup(layout, 5, 1)), std::invalid_argument);  // not node 1
+    w.discard();
+  }
+  EXPECT_FALSE(fs::exists(path + ".partial"));
+  EXPECT_FALSE(fs::exists(path));
+}
+
+// --- synthesizer ----------------------------------------------------------------------------
+
+/// A group whose particle p moves with u(t) = a_p + t b (t = local time), samples exact.
+PathlineGroup linearGroup(const PathlineLayout& layout, int step, glm::vec3 b) {
+  PathlineGroup g = randomGroup(layout, step, std::uint64_t(step) + 100);
+  for (int p = 0; p < layout.particles; ++p)
+    for (int s = 0; s < layout.samples; ++s)
+      g.velocity[g.index(p, s)] = glm::vec3(0.1f * float(p), -0.2f, 1.f + float(step)) +
+                                  float(s) * layout.sampleDt * b;
+  return g;
+}
+
+TEST(Synthesizer, ParticlesFollowTheirOwnPathlineAndDie) {
+  // Velocity linear in time: the trapezoid rule (eq. 13) is exact. Node 5 is visited after node
+  // 0 (a transition): the particles of node 0 keep following node 0's pathlines.
+  const PathlineLayout layout{7, 5, 0.1f};
+  const glm::vec3 b(0.5f, 0.f, -1.f), wind(0.2f, 0.f, 0.f);
+  std::vector<PathlineGroup> nodes;
+  for (int k = 0; k < 8; ++k) nodes.push_back(linearGroup(layout, k, b));
+  Synthesizer s(layout);
+  const int walk[] = {0, 5, 6, 2, 3, 4, 7};
+  SynthParticles out;
+  for (int n = 0; n < 7; ++n) {
+    s.step(nodes[std::size_t(walk[n])], wind);
+    EXPECT_EQ(s.liveGroups(), std::min(n + 1, layout.samples));
+    s.gather(out);
+    ASSERT_EQ(out.size(), s.particleCount());
+    for (int gi = 0; gi < s.liveGroups(); ++gi) {
+      const long long e = s.firstLiveStep() + gi;
+      const PathlineGroup& g = nodes[std::size_t(walk[e])];
+      const int age = int(s.steps() - 1 - e);
+      const float t = float(age) * layout.sampleDt;
+      for (int p = 0; p < layout.particles; ++p) {
+        const std::size_t i = std::size_t(gi * layout.particles + p);
+        const glm::vec3 a = g.velocity[g.index(p, 0)];
+        const glm::vec3 exact = g.start[std::size_t(p)] + t * a + 0.5f * t * t * b + t * wind;
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(out.positions[i][c], exact[c], 1e-5f);
+        ASSERT_EQ(out.density[i], g.density[g.index(p, age)]);
+        ASSERT_EQ(out.temperature[i], g.temperature[g.index(p, age)]);
+      }
+    }
+  }
+  // Lifetime L = 5 samples: after 7 steps the groups of steps 0 and 1 are gone.
+  EXPECT_EQ(s.firstLiveStep(), 2);
+  PathlineGroup wrong = nodes[0];
+  wrong.layout.samples = 4;
+  EXPECT_THROW(s.step(wrong), std::invalid_argument);
+}
+
+/// u_ext = c + K x (a constant plus a shear), for the field path.
+struct ShearField final : ExternalVelocity {
+  glm::vec3 c{0.f};
+  float k = 0.f;
+  void evaluate(const glm::vec3* x, int n, double, glm::vec3* out) const override {
+    for (int m = 0; m < n; ++m) out[m] = c + glm::vec3(k * x[m].z, 0.f, 0.f);
+  }
+};
+
+TEST(Synthesizer, ExternalFieldsIntegrateWithHeun) {
+  const PathlineLayout layout{600, 6, 0.05f};  // two parallel chunks
+  std::vector<PathlineGroup> nodes;
+  for (int k = 0; k < 9; ++k) nodes.push_back(linearGroup(layout, k, glm::vec3(0.f)));
+  // A constant field equals the uniform velocity (Heun is exact for it).
+  ShearField constant;
+  constant.c = glm::vec3(0.3f, -0.1f, 0.2f);
+  Synthesizer a(layout), b(layout);
+  SynthParticles pa, pb;
+  for (const auto& g : nodes) {
+    a.step(g, constant.c);
+    b.step(g, constant);
+  }
+  a.gather(pa);
+  b.gather(pb);
+  for (std::size_t n = 0; n < pa.size(); ++n)
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(pa.positions[n][c], pb.positions[n][c], 1e-5f);
+  // One step of a shear u_x = k z with the pathline moving z at w: Heun gives
+  // Δx = h k (z + (z + h w)) / 2, exact since u_ext is linear along the straight step.
+  ShearField shear;
+  shear.k = 2.f;
+  Synthesizer c(layout);
+  c.step(nodes[0]);
+  c.step(nodes[1], shear);
+  SynthParticles pc;
+  c.gather(pc);
+  const PathlineGroup& g = nodes[0];
+  const float h = layout.sampleDt;
+  for (int p = 0; p < layout.particles; ++p) {
+    const glm::vec3 x0 = g.start[std::size_t(p)];
+    const float w = g.velocity[g.index(p, 0)].z;
+    const float expected = x0.x + h * g.velocity[g.index(p, 0)].x + h * shear.k * (x0.z + 0.5f * h * w);
+    ASSERT_NEAR(pc.positions[std::size_t(p)].x, expected, 1e-5f);
+  }
+}
+
+TEST(Synthesizer, BitIdenticalAtOneAndTwoThreads) {
+  const PathlineLayout layout{1500, 8, 0.05f};
+  std::vector<PathlineGroup> nodes;
+  for (int k = 0; k < 4; ++k) nodes.push_back(randomGroup(layout, k, std::uint64_t(k) + 7));
+  ShearField shear;
+  shear.k = 0.7f;
+  SynthParticles out[2];
+  for (int t = 0; t < 2; ++t) {
+    Synthesizer s(layout, t + 1);
+    for (int n = 0; n < 12; ++n) {
+      if (n % 3 == 0) s.step(nodes[std::size_t(n % 4)], shear);
+      else s.step(nodes[std::size_t(n % 4)], glm::vec3(0.1f, 0.f, 0.f));
+    }
+    s.gather(out[t]);
+  }
+  EXPECT_EQ(out[0].positions, out[1].positions);
+  EXPECT_EQ(out[0].density, out[1].density);
+  EXPECT_EQ(out[0].temperature, out[1].temperature);
+}
+
+TEST(GridVelocityField, TrilinearInsideClampedOutside) {
+  // u = (x + 2y, -z, 3): linear, so trilinear sampling is exact between cell centres.
+  const float h = 0.25f;
+  const glm::vec3 origin(-1.f, 0.f, 0.5f);
+  VectorGrid g(glm::ivec3(5, 4, 6));
+  auto exact = [&](glm::vec3 x) { return glm::vec3(x.x + 2.f * x.y, -x.z, 3.f); };
+  for (int k = 0; k < 6; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 5; ++i) g(i, j, k) = exact(origin + (glm::vec3(i, j, k) + 0.5f) * h);
+  const GridVelocityField f(g, h, origin);
+  const glm::vec3 inside = origin + glm::vec3(0.7f, 0.61f, 1.2f);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(f.at(inside)[c], exact(inside)[c], 1e-5f);
+  // Beyond the last centre the nearest values hold.
+  const glm::vec3 below = origin + glm::vec3(-5.f, 0.125f, 0.125f);
+  EXPECT_EQ(f.at(below), g(0, 0, 0));
+  glm::vec3 out[2];
+  const glm::vec3 x[2] = {inside, below};
+  f.evaluate(x, 2, 0.0, out);
+  EXPECT_EQ(out[1], g(0, 0, 0));
+  EXPECT_THROW(GridVelocityField(g, 0.f, origin), std::invalid_argument);
+  g(1, 1, 1).x = NAN;
+  EXPECT_THROW(GridVelocityField(g, h, origin), std::invalid_argument);
+}
+
+// --- rasterization --------------------------------------------------------------------------
+
+struct Cloud {
+  std::vector<glm::vec3> x;
+  std::vector<float> r, t;
+  FireParticleView view() const { return {x.data(), r.data(), t.data(), x.size()}; }
+};
+
+Cloud randomCloud(int count) {
+  Cloud c;
+  Rng rng(5);
+  for (int n = 0; n < count; ++n) {
+    c.x.emplace_back(0.3 + 0.4 * rng.uniform(), 0.2 + 0.5 * rng.uniform(), 0.1 + 0.8 * rng.uniform());
+    c.r.push_back(float(rng.uniform()));
+    c.t.push_back(float(5.0 * rng.uniform()));
+  }
+  return c;
+}
+
+double gridSum(const openvdb::FloatGrid& g) {
+  double s = 0.0;
+  for (auto it = g.cbeginValueOn(); it; ++it) s += double(*it);
+  return s;
+}
+
+TEST(FireRaster, ConservesMassAndMapsFlame) {
+  FireRasterParams p;
+  p.voxelSize = 1.f / 32.f;
+  const Cloud c = randomCloud(20000);
+  const FireGrids g = rasterizeFire(c.view(), p);
+  // Σ ρ_v Δx³ = Σ R_p V_p with V_p = (Δx/2)³.
+  double mass = 0.0;
+  for (float r : c.r) mass += double(r) * std::pow(0.5 * p.voxelSize, 3.0);
+  const double h3 = std::pow(double(p.voxelSize), 3.0);
+  EXPECT_NEAR(gridSum(*g.density) * h3, mass, 1e-5 * mass);
+  // Temperatures are means of particle temperatures in [0, 5]; flame maps [1, 4] to [0, 1].
+  for (auto it = g.temperature->cbeginValueOn(); it; ++it) {
+    ASSERT_GE(*it, 0.f);
+    ASSERT_LE(*it, 5.f + 1e-4f);
+    const float f = g.flame->tree().getValue(it.getCoord());
+    ASSERT_NEAR(f, std::min(1.f, std::max(0.f, (*it - 1.f) / 3.f)), 1e-6f);
+  }
+  EXPECT_EQ(g.density->getName(), "density");
+  EXPECT_EQ(g.flame->getGridClass(), openvdb::GRID_FOG_VOLUME);
+}
+
+TEST(FireRaster, OneParticleAtAVoxelCentre) {
+  FireRasterParams p;
+  p.voxelSize = 0.1f;
+  p.origin = glm::vec3(-1.f, 0.f, 0.f);
+  p.particleVolume = 0.002f;
+  // Voxel (3, 4, 5) is centred at origin + (3.5, 4.5, 5.5) Δx.
+  const glm::vec3 x = p.origin + glm::vec3(3.5f, 4.5f, 5.5f) * p.voxelSize;
+  const float r = 2.f, t = 3.f;
+  const FireGrids g = rasterizeFire({&x, &r, &t, 1}, p);
+  const openvdb::Coord ijk(3, 4, 5);
+  EXPECT_NEAR(g.density->tree().getValue(ijk), r * p.particleVolume / 0.001f, 1e-4f);
+  EXPECT_NEAR(g.temperature->tree().getValue(ijk), t, 1e-5f);  // weight 1: its own temperature
+  EXPECT_NEAR(g.flame->tree().getValue(ijk), 2.f / 3.f, 1e-5f);
+  // Its neighbours get the rest of the hat weight: nothing but float rounding here.
+  EXPECT_NEAR(gridSum(*g.density), r * p.particleVolume / 0.001f, 1e-4f);
+}
+
+TEST(FireRaster, DeterministicAndWrittenAsAFrameVdb) {
+  const Cloud c = randomCloud(30000);
+  FireGrids g[2];
+  for (int t = 0; t < 2; ++t) {
+    FireRasterParams p;
+    p.voxelSize = 1.f / 48.f;
+    p.threads = t + 1;
+    g[t] = rasterizeFire(c.view(), p);
+  }
+  for (auto pick : {&FireGrids::density, &FireGrids::temperature, &FireGrids::flame}) {
+    const openvdb::FloatGrid& a = *(g[0].*pick);
+    const openvdb::FloatGrid& b = *(g[1].*pick);
+    ASSERT_EQ(a.activeVoxelCount(), b.activeVoxelCount());
+    for (auto it = a.cbeginValueOn(); it; ++it) ASSERT_EQ(*it, b.tree().getValue(it.getCoord()));
+  }
+  const std::string path = tempPath("fire_0001.vdb");
+  writeFireVdb(path, g[0], 1);
+  auto names = vdbGridNames(path);
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"density", "flame", "temperature"}));
+  const DenseGrid d = readVdbGrid(path, "density");
+  EXPECT_NEAR(d.voxelSize, 1.f / 48.f, 1e-7f);
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+}
+
+}  // namespace
+}  // namespace plume
