@@ -32,12 +32,18 @@ const bool kHasAvx2 = hasAvx2();
 void SamplePoints::reserve(std::size_t count) {
   reserveHugePages(mIndex, count);
   for (std::vector<float>& t : mT) reserveHugePages(t, count);
+  // Ghost weights: reserved only (untouched pages cost nothing where no side is a ghost side).
+  reserveHugePages(mGhost, count);
+  mGhostGroups.reserve(count / SamplePoints::kGhostGroup + 1);
 }
 
 void SamplePoints::resize(glm::ivec3 gridSize, std::size_t count) {
   mGridSize = gridSize;
   mIndex.resize(count);
   for (std::vector<float>& t : mT) t.resize(count);
+  if (mGhostSides == 0) return;
+  mGhost.resize(count);
+  mGhostGroups.assign((count + kGhostGroup - 1) / kGhostGroup, 0);
 }
 
 void PointSink::set(int m, glm::vec3 p) {
@@ -48,6 +54,13 @@ void PointSink::set(int m, glm::vec3 p) {
       c[0] >= 1 && c[1] >= 1 && c[2] >= 1 && c[0] + 2 < s.x && c[1] + 2 < s.y && c[2] + 2 < s.z;
   mIndex[m] = std::uint32_t(c[0] + s.x * (c[1] + s.y * c[2])) |
               (inside ? 0u : SamplePoints::kNearSide);
+  // A point past a side is clamped onto it, so only points near a side can have a ghost weight.
+  if (mGhostSides == 0 || inside) return;
+  const float w = ghostWeight(p, s, mGhostSides);
+  if (!(w > 0.f)) return;
+  mGhost[m] = w;
+  mIndex[m] |= SamplePoints::kGhost;
+  mGroups[(mFirst + std::size_t(m)) / SamplePoints::kGhostGroup] = 1;
 }
 
 #if defined(__SSE4_1__)
@@ -62,6 +75,41 @@ void PointSink::set4(int m, __m128 x, __m128 y, __m128 z) {
 #endif
 
 #if defined(PLUME_GATHER_DISPATCH)
+__attribute__((target("avx2"))) __m256i PointSink::ghost8(int m, const __m256* pos) {
+  const __m256i none = _mm256_setzero_si256();
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.f);
+  __m256 outside = zero;
+  for (int a = 0; a < 3; ++a) {
+    const __m256 last = _mm256_set1_ps(float(mGridSize[a] - 1));
+    if (mGhostSides & ghostSideBit(2 * a))
+      outside = _mm256_or_ps(outside, _mm256_cmp_ps(pos[a], zero, _CMP_LT_OQ));
+    if (mGhostSides & ghostSideBit(2 * a + 1))
+      outside = _mm256_or_ps(outside, _mm256_cmp_ps(pos[a], last, _CMP_GT_OQ));
+  }
+  if (_mm256_testz_ps(outside, outside)) return none;  // most points near a side
+  __m256 keep = one;
+  for (int a = 0; a < 3; ++a) {
+    // ghostWeight()'s operations on eight lanes (adding the 0 of a non-ghost side is exact).
+    const __m256 below = _mm256_max_ps(_mm256_sub_ps(zero, pos[a]), zero);
+    const __m256 last = _mm256_set1_ps(float(mGridSize[a] - 1));
+    const __m256 past = _mm256_max_ps(_mm256_sub_ps(pos[a], last), zero);
+    __m256 d = zero;
+    if (mGhostSides & ghostSideBit(2 * a)) d = _mm256_add_ps(d, below);
+    if (mGhostSides & ghostSideBit(2 * a + 1)) d = _mm256_add_ps(d, past);
+    keep = _mm256_mul_ps(keep, _mm256_sub_ps(one, _mm256_min_ps(d, one)));
+  }
+  const __m256 w = _mm256_sub_ps(one, keep);
+  const __m256 has = _mm256_cmp_ps(w, zero, _CMP_GT_OQ);
+  _mm256_storeu_ps(mGhost + m, w);
+  // The eight points lie in at most two groups: points 0 .. split-1 in the first.
+  const unsigned lanes = unsigned(_mm256_movemask_ps(has));
+  const std::size_t first = mFirst + std::size_t(m), g = first / SamplePoints::kGhostGroup;
+  const unsigned split = unsigned(SamplePoints::kGhostGroup - first % SamplePoints::kGhostGroup);
+  if (lanes & ((1u << split) - 1u)) mGroups[g] = 1;
+  if (split < 8 && (lanes >> split)) mGroups[g + 1] = 1;
+  return _mm256_and_si256(_mm256_castps_si256(has), _mm256_set1_epi32(int(SamplePoints::kGhost)));
+}
+
 __attribute__((target("avx2"))) void PointSink::set8(int m, __m256 x, __m256 y, __m256 z) {
   const __m256 pos[3] = {x, y, z};
   __m256i c[3], inside = _mm256_set1_epi32(-1);
@@ -78,7 +126,11 @@ __attribute__((target("avx2"))) void PointSink::set8(int m, __m256 x, __m256 y, 
                 _mm256_set1_epi32(mGridSize.x),
                 _mm256_add_epi32(c[1], _mm256_mullo_epi32(_mm256_set1_epi32(mGridSize.y), c[2]))));
   const __m256i near = _mm256_andnot_si256(inside, _mm256_set1_epi32(int(SamplePoints::kNearSide)));
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(mIndex + m), _mm256_or_si256(index, near));
+  __m256i flags = near;
+  // Only a point clamped onto a ghost side has a ghost weight, and such a point is near a side.
+  if (mGhostSides != 0 && !_mm256_testz_si256(near, near))
+    flags = _mm256_or_si256(flags, ghost8(m, pos));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(mIndex + m), _mm256_or_si256(index, flags));
 }
 #endif
 

@@ -57,13 +57,39 @@ __attribute__((target("avx2"))) inline void splitCoordinate8(__m256 x, int n, __
 }
 #endif
 
+/// Bit of side s (-x, +x, -y, +y, -z, +z, as plume::Side) in a mask of ghost sides.
+constexpr std::uint8_t ghostSideBit(int side) { return std::uint8_t(1u << side); }
+
+/// Share of a ghost layer in the trilinear sample at p (index space of a grid of `size`): past
+/// the last sample on a side in `sides`, the grid continues with one more layer of a constant
+/// value (the ambient air beyond an open side of the domain), so a position that far or further
+/// out reads it alone. Per axis w_a = min(1, distance past the last sample), and the ghost's
+/// share is 1 - Π_a (1 - w_a), exactly what a trilinear sample of the padded grid gives it.
+inline float ghostWeight(glm::vec3 p, glm::ivec3 size, std::uint8_t sides) {
+  float keep = 1.f;
+  for (int a = 0; a < 3; ++a) {
+    float d = 0.f;
+    if (sides & ghostSideBit(2 * a)) d += p[a] < 0.f ? -p[a] : 0.f;
+    const float past = p[a] - float(size[a] - 1);
+    if (sides & ghostSideBit(2 * a + 1)) d += past > 0.f ? past : 0.f;
+    keep *= 1.f - (d < 1.f ? d : 1.f);
+  }
+  return 1.f - keep;
+}
+
 /// Where split points are written: set() and friends split a position and store it as point m
 /// (clamped into the grid, cell and fractions exactly as sampleLinear() and
-/// sampleMonotonicCubic() split it, core/sampling.cpp).
+/// sampleMonotonicCubic() split it, core/sampling.cpp), and, with ghost sides, the ghost weight
+/// (ghostWeight() of the unclamped position) of the points that have one.
 class PointSink {
  public:
-  PointSink(glm::ivec3 gridSize, std::uint32_t* index, float* tx, float* ty, float* tz)
-      : mGridSize(gridSize), mIndex(index), mT{tx, ty, tz} {}
+  /// With ghost sides: `ghost` is where the ghost weight of point 0 goes, `groups` the flags of
+  /// SamplePoints::ghostGroups(), `first` the number of point 0 among them.
+  PointSink(glm::ivec3 gridSize, std::uint32_t* index, float* tx, float* ty, float* tz,
+            std::uint8_t ghostSides = 0, float* ghost = nullptr, std::uint8_t* groups = nullptr,
+            std::size_t first = 0)
+      : mGridSize(gridSize), mIndex(index), mT{tx, ty, tz}, mGhostSides(ghostSides),
+        mGhost(ghost), mGroups(groups), mFirst(first) {}
   void set(int m, glm::vec3 p);
 #if defined(__SSE4_1__)
   /// set() of points m .. m+3 at the lanes of x, y, z.
@@ -78,6 +104,16 @@ class PointSink {
   glm::ivec3 mGridSize;
   std::uint32_t* mIndex;
   float* mT[3];
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(PLUME_NO_AVX2)
+  /// set8()'s ghost weights of points m .. m+7 at pos (unclamped, some of them near a side);
+  /// returns their kGhost flags.
+  __attribute__((target("avx2"))) __m256i ghost8(int m, const __m256* pos);
+#endif
+
+  std::uint8_t mGhostSides;
+  float* mGhost;
+  std::uint8_t* mGroups;
+  std::size_t mFirst;
 };
 
 /// Split positions in the index space of grids of one size (sample (i,j,k) at p = (i,j,k)).
@@ -85,18 +121,28 @@ class SamplePoints {
  public:
   /// Flag in index(): the point's 4×4×4 monotonic cubic stencil (i-1 .. i+2) leaves the grid.
   static constexpr std::uint32_t kNearSide = 1u << 31;
-  /// The index without kNearSide.
-  static constexpr std::uint32_t kIndexMask = kNearSide - 1u;
+  /// Flag in index(), with ghost sides only: the point has a ghost weight > 0 (in ghost()). Such
+  /// a point is clamped onto a side, so it has kNearSide too.
+  static constexpr std::uint32_t kGhost = 1u << 30;
+  /// The index without the flags (grids hold fewer than 2^30 samples: SmokeParams::validate()).
+  static constexpr std::uint32_t kIndexMask = kGhost - 1u;
 
   /// Allocates room for `count` points; resize() within it never allocates.
   void reserve(std::size_t count);
-  /// `count` points (values unset) in grids of `gridSize` samples.
+  /// `count` points (values unset) in grids of `gridSize` samples; clears the ghost groups.
   void resize(glm::ivec3 gridSize, std::size_t count);
+  /// Sides (ghostSideBit() mask) past which the grid continues with a constant ghost layer:
+  /// points written after the next resize() get their ghostWeight(). 0 (the default): none.
+  void setGhostSides(std::uint8_t sides) { mGhostSides = sides; }
+  std::uint8_t ghostSides() const { return mGhostSides; }
 
   /// Writes points first, first+1, ... (PointSink's m counts from `first`).
   PointSink sink(std::size_t first) {
+    if (mGhostSides == 0)
+      return {mGridSize, mIndex.data() + first, mT[0].data() + first, mT[1].data() + first,
+              mT[2].data() + first};
     return {mGridSize, mIndex.data() + first, mT[0].data() + first, mT[1].data() + first,
-            mT[2].data() + first};
+            mT[2].data() + first, mGhostSides, mGhost.data() + first, mGhostGroups.data(), first};
   }
   /// Stores point n at p.
   void set(std::size_t n, glm::vec3 p) { sink(n).set(0, p); }
@@ -111,11 +157,22 @@ class SamplePoints {
   const float* tx() const { return mT[0].data(); }
   const float* ty() const { return mT[1].data(); }
   const float* tz() const { return mT[2].data(); }
+  /// With ghost sides: the ghost weight of point n where index() has kGhost (elsewhere the
+  /// weight is 0 and this holds anything).
+  const float* ghost() const { return mGhost.data(); }
+  /// Points come in groups of kGhostGroup (n / kGhostGroup); with ghost sides, the flag of a
+  /// group is set when one of its points written since resize() got a ghost weight > 0, so
+  /// that the few such points are found without reading the others.
+  static constexpr std::size_t kGhostGroup = 8;
+  const std::uint8_t* ghostGroups() const { return mGhostGroups.data(); }
 
  private:
   glm::ivec3 mGridSize{0};
   std::vector<std::uint32_t> mIndex;
   std::vector<float> mT[3];
+  std::uint8_t mGhostSides = 0;
+  std::vector<float> mGhost;               ///< sized only with ghost sides
+  std::vector<std::uint8_t> mGhostGroups;  ///< one flag per kGhostGroup points
 };
 
 /// Trilinear samples of `grid` at points first .. first+count-1 into out[0 .. count-1]: the

@@ -1,5 +1,6 @@
 #include "solver/advection.h"
 
+#include "solver/inflow.h"
 #include "solver/linear_runs.h"
 
 #include <algorithm>
@@ -79,8 +80,12 @@ void Advector::reserve(std::size_t count, std::size_t fields, Advection scheme) 
 }
 
 void Advector::trace(const MacGrid3& velocity, glm::ivec3 size, glm::vec3 offset, float dt,
-                     float cellSize, Advection scheme, const BlockMask* mask, Trace order) {
+                     float cellSize, Advection scheme, const BlockMask* mask, Trace order,
+                     std::uint8_t openSides) {
   mScheme = scheme;
+  // Only the back-traces read the air beyond the open sides: the forward traces of BFECC and
+  // MacCormack serve their error estimate, which the fall-back below discards there.
+  mBack.setGhostSides(openSides);
   // Traces are made once and stored for every pass (32 bytes a sample): made again in each pass
   // that reads them, even Euler traces cost 1.4 times as much (measured at 128³).
   // BFECC and MacCormack also need the forward traces (their reverse step A⁻¹).
@@ -89,8 +94,8 @@ void Advector::trace(const MacGrid3& velocity, glm::ivec3 size, glm::vec3 offset
 }
 
 void Advector::advect(const ScalarGrid& src, ScalarGrid& dst, Interpolation interpolation,
-                      const BlockMask* mask, float background) {
-  const Field field{&src, &dst, background};
+                      const BlockMask* mask, float background, const ScalarGrid* ambient) {
+  const Field field{&src, &dst, background, ambient};
   advect(&field, 1, interpolation, mask);
 }
 
@@ -113,15 +118,25 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
     forward[f] = &mForward[f];
     backward[f] = &mBackward[f];
   }
+  // Samples whose back-trace ended past an open side take in the air outside (inflow.h).
+  const ScalarGrid* ambient[kMaxFields];
+  for (std::size_t f = 0; f < count; ++f) ambient[f] = fields[f].ambient;
+  auto inflow = [&](ScalarGrid* const* grids) {
+    blendInflow(grids, count, background, ambient, mBack, mask);
+  };
   if (mScheme == Advection::SemiLagrangian) {
     pass(src, dst, background, count, mBack, interpolation, mask, kAsIs,
          [&](std::size_t f, std::size_t c, float* out) { semiLagrangianRun(*src[f], mBack, c, out); });
+    inflow(dst);
     return;
   }
   // φ̂ = A(φ): the semi-Lagrangian step along the back-traces.
   for (std::size_t f = 0; f < count; ++f) mForward[f].reshape(size);
   pass(src, forward, background, count, mBack, interpolation, mask, kAsIs,
        [&](std::size_t f, std::size_t c, float* out) { semiLagrangianRun(*src[f], mBack, c, out); });
+  inflow(forward);
+  // Where the air came in from outside, the result is φ̂ itself.
+  auto fallBack = [&] { copyInflow(forward, dst, count, mBack, mask); };
   if (mScheme == Advection::MacCormack) {
     // Selle et al. 2008 eq. 7: φ = φ̂ + ½(φⁿ - φ̄) with φ̄ = A⁻¹(φ̂), fused with the reverse step,
     // then clamped to the range of φⁿ around the back-traced point (§4, first limiter).
@@ -135,6 +150,7 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
         [&](std::size_t f, std::size_t c, float* out) {
           macCormackRun(*src[f], *forward[f], mBack, mFore, c, out);
         });
+    fallBack();
     return;
   }
   // BFECC (Kim et al. 2005): φ̄ = A⁻¹(φ̂) and the corrected field φ + ½(φ - φ̄) in one pass...
@@ -157,6 +173,7 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
       [&](std::size_t f, std::size_t c, float* out) {
         clampedRun(*backward[f], *src[f], mBack, c, out);
       });
+  fallBack();
 }
 
 }  // namespace plume

@@ -27,11 +27,14 @@ namespace plume {
 class Advector {
  public:
   /// One field advect() carries: src into dst (dst must not alias src), and its value in clean
-  /// air, which it keeps outside the active blocks of the mask.
+  /// air, which it keeps outside the active blocks of the mask and finds beyond the open sides
+  /// given to trace() (inflow.h); `ambient`, when given, holds a value of the air beyond those
+  /// sides per sample instead (a wind field).
   struct Field {
     const ScalarGrid* src;
     ScalarGrid* dst;
     float background;
+    const ScalarGrid* ambient = nullptr;
   };
   /// Most fields advect() carries in one call (density, temperature, fuel, soot).
   static constexpr std::size_t kMaxFields = 4;
@@ -42,19 +45,23 @@ class Advector {
 
   /// Traces every sample of a grid of `size` whose sample (0,0,0) sits at `offset`: back by Δt
   /// (and forth by Δt for BFECC and MacCormack) through `velocity` with the trace `order`, only
-  /// in the active blocks of `mask` (nullptr = everywhere).
+  /// in the active blocks of `mask` (nullptr = everywhere). Back-traces that end past one of
+  /// `openSides` (openSides() mask) read the air outside (inflow.h); past other sides they are
+  /// clamped onto the side.
   void trace(const MacGrid3& velocity, glm::ivec3 size, glm::vec3 offset, float dt, float cellSize,
-             Advection scheme, const BlockMask* mask, Trace order = Trace::Midpoint);
+             Advection scheme, const BlockMask* mask, Trace order = Trace::Midpoint,
+             std::uint8_t openSides = 0);
 
   /// Each field's dst = its src advected with the last trace(). With BFECC: φ̂ = A(φ),
   /// φ̄ = A⁻¹(φ̂), result = A(φ + ½(φ - φ̄)) clamped to the range of φ around the back-traced
   /// point. With MacCormack: result = φ̂ + ½(φ - φ̄), clamped the same way (two passes, not
-  /// three). Every src must have the traced size; at most kMaxFields (and what reserve() gave).
+  /// three). Both fall back to the semi-Lagrangian value where the back-trace ends past an open
+  /// side. Every src must have the traced size; at most kMaxFields (and what reserve() gave).
   void advect(const Field* fields, std::size_t count, Interpolation interpolation,
               const BlockMask* mask);
   /// advect() of one field.
   void advect(const ScalarGrid& src, ScalarGrid& dst, Interpolation interpolation,
-              const BlockMask* mask, float background);
+              const BlockMask* mask, float background, const ScalarGrid* ambient = nullptr);
 
  private:
   BackTracer mTracer;

@@ -22,7 +22,12 @@ enum class Advection { SemiLagrangian, Bfecc, MacCormack };
 /// an exact average of 2 or 4 faces and needs no interpolation (Mantaflow's default trace).
 enum class Trace { Midpoint, Euler };
 
-/// A side of the domain is open (air: p = 0, outflow; smoke_surfaces.txt's default) or a wall.
+/// A side of the domain is open (smoke_surfaces.txt's default) or a wall (Closed: no flow
+/// through it, u·n = 0; scalars and tangential velocity zero-gradient).
+/// Open: the ambient air lies beyond it (inflow.h). p = 0 outside; what flows out leaves with
+/// zero gradient; what flows in is ambient air: ρ = F = S = 0, T = T_amb, velocity 0 (or the
+/// wind's, when wind_strength > 0), so air enters only where the pressure projection draws it
+/// in (or the wind blows it in), never by copying the inside's values back in.
 enum class Boundary { Open, Closed };
 
 /// Sides in the order -x, +x, -y, +y, -z, +z.
@@ -47,7 +52,9 @@ struct SmokeParams {
   Advection advection = Advection::Bfecc;
   Interpolation interpolation = Interpolation::MonotonicCubic;
   Trace trace = Trace::Midpoint;  ///< back-trace order (Euler: Mantaflow's first-order trace)
-  bool conserveMass = true;  ///< restore Σρ after advection (minus outflow), see mass_conservation.h
+  /// Restore Σρ, ΣF, ΣS and the heat Σ(T - T_amb) after advection (minus outflow), see
+  /// mass_conservation.h.
+  bool conserveMass = true;
 
   // --- Forces (Fedkiw 2001 eq. 8, 9) ---
   glm::vec3 gravity{0.f, 0.f, -9.81f};  ///< g; buoyancy acts against it

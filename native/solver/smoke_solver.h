@@ -134,6 +134,7 @@ class SmokeSolver {
   ScalarGrid mScalarTmp[Advector::kMaxFields];  ///< advected scalars (burn: [0] is scratch)
   ScalarGrid mPressure, mRhs, mDivergenceTarget;
   VectorGrid mVorticity, mForce, mWindField;
+  MacGrid3 mWindFaces;  ///< mWindField on the faces: the air beyond open sides (inflow.h)
   ScalarGrid mVorticityMagnitude;  ///< |ω|, scratch of vorticity confinement
   Advector mAdvector;
   BlockMask mMask, mMaskTmp;  ///< blocks of cells near smoke (advection skips the rest)

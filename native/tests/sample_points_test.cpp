@@ -81,5 +81,69 @@ TEST(SamplePoints, FourLaneSplitMatchesScalarSplit) {
 }
 #endif
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(PLUME_NO_AVX2)
+/// Points 8m .. 8m+7 of `positions` through set8() (AVX2).
+__attribute__((target("avx2"))) void setEight(SamplePoints& points,
+                                              const std::vector<glm::vec3>& positions,
+                                              std::size_t m) {
+  alignas(32) float c[3][8];
+  for (int l = 0; l < 8; ++l)
+    for (int a = 0; a < 3; ++a) c[a][l] = positions[m + std::size_t(l)][a];
+  points.sink(m).set8(0, _mm256_load_ps(c[0]), _mm256_load_ps(c[1]), _mm256_load_ps(c[2]));
+}
+#endif
+
+TEST(SamplePoints, GhostWeightsOfPointsPastGhostSides) {
+  // Past the sides in the mask a point gets ghostWeight() of its unclamped position and kGhost;
+  // its group of points is flagged. set(), set4() and set8() must agree bit for bit.
+  const glm::ivec3 size(11, 8, 7);
+  const std::uint8_t sides = ghostSideBit(0) | ghostSideBit(3) | ghostSideBit(4) | ghostSideBit(5);
+  const Fixture f(size, 800, 9);  // positions 1.5 samples past every side and beyond
+  SamplePoints one;
+  one.setGhostSides(sides);
+  one.resize(size, f.positions.size());
+  for (std::size_t m = 0; m < f.positions.size(); ++m) one.set(m, f.positions[m]);
+  int ghosts = 0;
+  for (std::size_t m = 0; m < f.positions.size(); ++m) {
+    const float w = ghostWeight(f.positions[m], size, sides);
+    const bool flagged = (one.index()[m] & SamplePoints::kGhost) != 0;
+    ASSERT_EQ(flagged, w > 0.f) << m;
+    ASSERT_EQ(one.index()[m] & ~SamplePoints::kGhost, f.points.index()[m]) << m;
+    if (!flagged) continue;
+    ++ghosts;
+    ASSERT_EQ(one.ghost()[m], w) << m;
+    ASSERT_NE(one.index()[m] & SamplePoints::kNearSide, 0u) << m;
+    ASSERT_EQ(one.ghostGroups()[m / SamplePoints::kGhostGroup], 1) << m;
+  }
+  EXPECT_GT(ghosts, 100);
+  std::vector<SamplePoints> others;
+#if defined(__SSE4_1__)
+  others.emplace_back();
+  others.back().setGhostSides(sides);
+  others.back().resize(size, f.positions.size());
+  for (std::size_t m = 0; m < f.positions.size(); m += 4) {
+    alignas(16) float c[3][4];
+    for (int l = 0; l < 4; ++l)
+      for (int a = 0; a < 3; ++a) c[a][l] = f.positions[m + std::size_t(l)][a];
+    others.back().sink(m).set4(0, _mm_load_ps(c[0]), _mm_load_ps(c[1]), _mm_load_ps(c[2]));
+  }
+#endif
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(PLUME_NO_AVX2)
+  if (hasAvx2()) {
+    others.emplace_back();
+    others.back().setGhostSides(sides);
+    others.back().resize(size, f.positions.size());
+    for (std::size_t m = 0; m < f.positions.size(); m += 8) setEight(others.back(), f.positions, m);
+  }
+#endif
+  for (const SamplePoints& p : others)
+    for (std::size_t m = 0; m < f.positions.size(); ++m) {
+      ASSERT_EQ(p.index()[m], one.index()[m]) << m;
+      if (one.index()[m] & SamplePoints::kGhost) ASSERT_EQ(p.ghost()[m], one.ghost()[m]) << m;
+      ASSERT_EQ(p.ghostGroups()[m / SamplePoints::kGhostGroup],
+                one.ghostGroups()[m / SamplePoints::kGhostGroup]) << m;
+    }
+}
+
 }  // namespace
 }  // namespace plume

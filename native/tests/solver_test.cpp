@@ -138,6 +138,76 @@ TEST(Advection, MassCorrectionKeepsValuesInRange) {
   }
 }
 
+TEST(Advection, MassesOfSeveralFieldsMatchMassesOneByOne) {
+  // totalMasses() sums density, heat, fuel and soot together; each must be totalMass() exactly.
+  Rng rng(3);
+  ScalarGrid fields[4] = {ScalarGrid({9, 7, 5}), ScalarGrid({9, 7, 5}), ScalarGrid({9, 7, 5}),
+                          ScalarGrid({9, 7, 5})};
+  for (ScalarGrid& g : fields)
+    for (std::size_t n = 0; n < g.count(); ++n) g[n] = float(rng.uniform(0.0, 2.0));
+  const ScalarGrid* q[4] = {&fields[0], &fields[1], &fields[2], &fields[3]};
+  const float background[4] = {0.f, 0.25f, 0.f, -1.f};
+  double out[4];
+  float peaks[4];
+  totalMasses(q, background, 4, out, peaks);
+  for (int f = 0; f < 4; ++f) {
+    EXPECT_EQ(out[f], totalMass(fields[f], background[f])) << f;
+    float peak = 0.f;
+    for (std::size_t n = 0; n < fields[f].count(); ++n) peak = std::max(peak, fields[f][n] - background[f]);
+    EXPECT_EQ(peaks[f], peak) << f;
+  }
+  // restoreMasses() of all four (a surplus, two deficits, one too large to fill) gives each
+  // field exactly what restoreMass() gives it alone.
+  const double targets[4] = {out[0] * 0.9, out[1] * 1.05, out[2] * 1.2, out[3] * 3.0};
+  ScalarGrid alone[4] = {fields[0], fields[1], fields[2], fields[3]};
+  double missingAlone[4], missing[4];
+  for (int f = 0; f < 4; ++f) missingAlone[f] = restoreMass(alone[f], targets[f], background[f]);
+  ScalarGrid* grids[4] = {&fields[0], &fields[1], &fields[2], &fields[3]};
+  restoreMasses(grids, targets, background, 4, out, peaks, missing);
+  for (int f = 0; f < 4; ++f) {
+    EXPECT_EQ(fields[f].values(), alone[f].values()) << f;
+    EXPECT_EQ(missing[f], missingAlone[f]) << f;
+  }
+  EXPECT_GT(missing[3], 0.0);  // 3x the mass does not fit under the peak
+}
+
+TEST(Advection, MassCorrectionInTheMaskMatchesTheWholeGrid) {
+  // Smoke in one corner of a 64³ grid: with the block mask the totals and the correction read
+  // only the blocks near it, and must give what the whole grid gives, bit for bit.
+  const glm::ivec3 n(64, 64, 64);
+  Rng rng(4);
+  ScalarGrid density(n), heat(n, 0.25f);
+  for (int k = 0; k < 12; ++k)
+    for (int j = 0; j < 10; ++j)
+      for (int i = 0; i < 9; ++i) {
+        density(i, j, k) = float(rng.uniform(0.0, 1.0));
+        heat(i, j, k) = 0.25f + float(rng.uniform(0.0, 2.0));
+      }
+  BlockMask mask, other;
+  mask.build(density, 0.f);
+  other.build(heat, 0.25f);
+  mask.merge(other);
+  ASSERT_LT(mask.fill(), 0.5f);
+  const float background[2] = {0.f, 0.25f};
+  for (double factor : {0.8, 1.1}) {
+    ScalarGrid a[2] = {density, heat}, b[2] = {density, heat};
+    ScalarGrid* ga[2] = {&a[0], &a[1]};
+    ScalarGrid* gb[2] = {&b[0], &b[1]};
+    double ma[2], mb[2];
+    float pa[2], pb[2];
+    totalMasses(ga, background, 2, ma, pa);
+    totalMasses(gb, background, 2, mb, pb, &mask);
+    for (int f = 0; f < 2; ++f) {
+      EXPECT_EQ(ma[f], mb[f]);
+      EXPECT_EQ(pa[f], pb[f]);
+    }
+    const double targets[2] = {ma[0] * factor, ma[1] * factor};
+    restoreMasses(ga, targets, background, 2, ma, pa);
+    restoreMasses(gb, targets, background, 2, mb, pb, nullptr, &mask);
+    for (int f = 0; f < 2; ++f) EXPECT_EQ(a[f].values(), b[f].values()) << factor;
+  }
+}
+
 TEST(Advection, OpenSidesLetSmokeLeave) {
   // The mass correction must not hold smoke in: a blob blown out through an open side is gone.
   const glm::ivec3 res(24, 12, 12);
