@@ -197,11 +197,9 @@ def _params(native, s: FlowGraphSettings, alpha, beta):
     return p
 
 
-def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
-                progress: Optional[Callable[[float], None]] = None):
-    """Cost matrix (eq. 9-10) of every group of every state, the graph (§4.3), then
-    <out_folder>/flowgraph.npz and flowgraph_cost.png (Figure 4), atomically. Returns a dict
-    with the graph, its cost matrix and a summary. BakeError on bad settings (nothing written)."""
+def cost_matrix(native, states: List[State], s: FlowGraphSettings):
+    """C of eq. 9-10 over every group of every state, state by state: (cost, node counts per
+    state, FlowGraphParams with the weights α, β). BakeError on bad settings."""
     groups = []
     for index, st in enumerate(states):
         groups.extend(st.file.read_group(k, index) for k in range(st.file.node_count))
@@ -217,11 +215,23 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
     del groups  # the job holds them
     if not job.run():
         raise BakeError("Plume: flow graph: cancelled")
-    cost = job.cost
+    return job.cost, counts, params
+
+
+def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
+                progress: Optional[Callable[[float], None]] = None):
+    """Cost matrix (eq. 9-10) of every group of every state, the graph (§4.3), then
+    <out_folder>/flowgraph.npz and flowgraph_cost.png (Figure 4), atomically. Returns a dict
+    with the graph, its cost matrix and a summary. BakeError on bad settings (nothing written;
+    when too few transitions join the states, the message gives the candidates' range [a, b]
+    to choose ε from)."""
+    cost, counts, params = cost_matrix(native, states, s)
+    alpha, beta = params.alpha, params.beta
     try:
         graph = native.FlowGraph.build(cost, counts, params)
     except ValueError as e:
-        raise BakeError(f"Plume: flow graph: {e}") from None
+        raise BakeError(f"Plume: flow graph: {e}{_candidate_range(native, cost, counts, params)}"
+                        ) from None
     image = native.cost_matrix_image(cost, graph, size=min(512, max(64, len(cost))))
     t = graph.transitions()
     summary = {"alpha": float(alpha), "beta": float(beta), "a": float(t["a"]),
@@ -239,6 +249,17 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
     if progress is not None:
         progress(1.0)
     return {"graph": graph, "cost": cost, "summary": summary, "params": params}
+
+
+def _candidate_range(native, cost, counts, params):
+    """' (the candidate costs span [a, b] = ...)' for an error message, or '' when the
+    candidates cannot be selected either (the message already says why)."""
+    try:
+        t = native.select_transitions(cost, counts, params)
+    except ValueError:
+        return ""
+    return (f" (the candidate transition costs span [a, b] = [{t['a']:.4g}, {t['b']:.4g}]: an "
+            "ε nearer b keeps more transitions)")
 
 
 def _write_atomic(path, data: bytes):

@@ -9,6 +9,13 @@ SMOKE_MATERIAL = "Plume Smoke"
 FIRE_MATERIAL = "Plume Fire"
 #: Principled Volume density multiplier of the smoke material (the solver's ρ is ~1 in sources).
 SMOKE_DENSITY = 5.0
+#: Fire material: T_max shows as a blackbody of this many kelvin (emission colour and the
+#: Principled Volume's own blackbody), the flame grid (0..1) scaled by FIRE_EMISSION is the
+#: emission strength, the soot density is scaled by FIRE_DENSITY (lighter than smoke, so the
+#: flame behind it shows). Orange-yellow where T is near T_max, dark red as it cools.
+FIRE_KELVIN = 2800.0
+FIRE_EMISSION = 8.0
+FIRE_DENSITY = 2.0
 
 
 def volume_name(domain):
@@ -38,17 +45,34 @@ def _setup_material(mat, combustion, max_temperature):
     pv.inputs["Temperature Attribute"].default_value = "temperature"
     pv.inputs["Color"].default_value = (0.6, 0.6, 0.6, 1.0)
     if combustion:
-        # Cycles multiplies the Temperature input by the attribute: map T_max to ~1800 K.
+        # Cycles multiplies the Temperature input by the attribute: T_max -> FIRE_KELVIN.
+        kelvin = FIRE_KELVIN / max(max_temperature, 1e-3)
+        pv.inputs["Density"].default_value = FIRE_DENSITY
         pv.inputs["Blackbody Intensity"].default_value = 1.0
-        pv.inputs["Temperature"].default_value = 1800.0 / max(max_temperature, 1e-3)
-        attr = nt.nodes.new("ShaderNodeAttribute")
-        attr.location = (-250, -200)
-        attr.attribute_name = "flame"
-        nt.links.new(attr.outputs["Fac"], pv.inputs["Emission Strength"])
-        pv.inputs["Emission Color"].default_value = (1.0, 0.45, 0.1, 1.0)
+        pv.inputs["Temperature"].default_value = kelvin
+        nt.links.new(_scaled_attribute(nt, "flame", FIRE_EMISSION, -300).outputs[0],
+                     pv.inputs["Emission Strength"])
+        blackbody = nt.nodes.new("ShaderNodeBlackbody")
+        blackbody.location = (-200, -100)
+        nt.links.new(_scaled_attribute(nt, "temperature", kelvin, -100).outputs[0],
+                     blackbody.inputs["Temperature"])
+        nt.links.new(blackbody.outputs["Color"], pv.inputs["Emission Color"])
     else:
         pv.inputs["Blackbody Intensity"].default_value = 0.0
     nt.links.new(pv.outputs["Volume"], out.inputs["Volume"])
+
+
+def _scaled_attribute(nt, name, factor, y):
+    """A Math node: the volume attribute `name` times `factor`."""
+    attr = nt.nodes.new("ShaderNodeAttribute")
+    attr.location = (-600, y)
+    attr.attribute_name = name
+    scale = nt.nodes.new("ShaderNodeMath")
+    scale.location = (-400, y)
+    scale.operation = 'MULTIPLY'
+    nt.links.new(attr.outputs["Fac"], scale.inputs[0])
+    scale.inputs[1].default_value = factor
+    return scale
 
 
 def material(combustion, max_temperature=4.0):

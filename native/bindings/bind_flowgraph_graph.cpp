@@ -163,10 +163,26 @@ void bindJob(py::module_& m) {
       "C, (N, N) float64, after a run() that returned True.");
 }
 
+/// FlowGraph.transitions() and select_transitions() as a dict.
+py::dict selectionDict(const TransitionSelection& s) {
+  const auto& c = s.candidates;
+  py::dict d;
+  d["row"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].row; });
+  d["col"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].col; });
+  d["cost"] = arrayOf<double>(c.size(), [&](std::size_t k) { return c[k].cost; });
+  d["kept"] = arrayOf<bool>(c.size(), [&](std::size_t k) { return c[k].kept; });
+  d["a"] = s.a;
+  d["b"] = s.b;
+  d["epsilon"] = s.epsilon;
+  d["blocks_per_side"] = s.blocksPerSide;
+  return d;
+}
+
 void bindGraph(py::module_& m) {
   py::class_<FlowGraph> g(m, "FlowGraph",
                           "The flow graph of §4.3: temporal edges (eq. 8), kept transitions (eq. 11) read as "
-                          "i -> j + 1, nodes that cannot reach a cycle pruned.");
+                          "i -> j + 1, nodes that cannot reach a cycle or the largest strongly "
+                          "connected component (traps) pruned.");
   g.def_static(
       "build",
       [](const py::object& cost, const std::vector<int>& counts, const FlowGraphParams& params) {
@@ -220,22 +236,22 @@ void bindGraph(py::module_& m) {
       },
       "Every edge of the pruned graph: dict of (E,) arrays from, to, cost, temporal (by source node).");
   g.def(
-      "transitions",
-      [](const FlowGraph& f) {
-        const TransitionSelection& s = f.transitions();
-        const auto& c = s.candidates;
-        py::dict d;
-        d["row"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].row; });
-        d["col"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].col; });
-        d["cost"] = arrayOf<double>(c.size(), [&](std::size_t k) { return c[k].cost; });
-        d["kept"] = arrayOf<bool>(c.size(), [&](std::size_t k) { return c[k].kept; });
-        d["a"] = s.a;
-        d["b"] = s.b;
-        d["epsilon"] = s.epsilon;
-        d["blocks_per_side"] = s.blocksPerSide;
-        return d;
-      },
+      "transitions", [](const FlowGraph& f) { return selectionDict(f.transitions()); },
       "The block candidates (row, col, cost, kept arrays; edge row -> col + 1), a, b, ε and M (§4.3).");
+  m.def(
+      "select_transitions",
+      [](const py::object& cost, const std::vector<int>& counts, const FlowGraphParams& params) {
+        const CostMatrix c = toCost(cost);
+        TransitionSelection s;
+        {
+          py::gil_scoped_release release;
+          s = selectTransitions(c, counts, params);
+        }
+        return selectionDict(s);
+      },
+      py::arg("cost"), py::arg("state_node_counts"), py::arg("params") = FlowGraphParams(),
+      "The candidates of eq. 11 without building the graph (FlowGraph.transitions() of a graph "
+      "that could not be built: a and b tell which ε to give). ValueError on bad params.");
 
   m.def(
       "cost_matrix_image",

@@ -1,6 +1,7 @@
 /// \file flow_graph.cpp
 /// Building the flow graph (§4.3): edges, then the pruning of every node that cannot reach a
-/// cycle (a walk through it would end), then the nodes from which a walk can stay in its state.
+/// cycle (a walk through it would end) or the main strongly connected component (a walk into it
+/// would be trapped), then the nodes from which a walk can stay in its state.
 
 #include "flowgraph/flow_graph.h"
 
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace plume {
 namespace {
@@ -69,6 +71,112 @@ std::vector<char> reachingCycle(const EdgeLists& g, const std::vector<char>& ali
   return keep;
 }
 
+/// Strongly connected components of the alive nodes over edges between alive nodes (Tarjan's
+/// algorithm without recursion): a component id per node, -1 for the nodes not alive.
+std::vector<int> strongComponents(const EdgeLists& g, const std::vector<char>& alive) {
+  const int n = int(alive.size());
+  std::vector<int> index(std::size_t(n), -1), low(std::size_t(n), 0), component(std::size_t(n), -1), open;
+  std::vector<char> onStack(std::size_t(n), 0);
+  std::vector<std::pair<int, int>> calls;  // (node, its next edge to look at)
+  int counter = 0, components = 0;
+  auto visit = [&](int v) {
+    index[std::size_t(v)] = low[std::size_t(v)] = counter++;
+    open.push_back(v);
+    onStack[std::size_t(v)] = 1;
+    calls.push_back({v, g.begin[std::size_t(v)]});
+  };
+  for (int root = 0; root < n; ++root) {
+    if (!alive[std::size_t(root)] || index[std::size_t(root)] >= 0) continue;
+    visit(root);
+    while (!calls.empty()) {
+      const int v = calls.back().first;
+      const int k = calls.back().second;
+      if (k < g.begin[std::size_t(v) + 1]) {
+        ++calls.back().second;
+        const int w = g.edges[std::size_t(k)].to;
+        if (!alive[std::size_t(w)]) continue;
+        if (index[std::size_t(w)] < 0) visit(w);
+        else if (onStack[std::size_t(w)]) low[std::size_t(v)] = std::min(low[std::size_t(v)], index[std::size_t(w)]);
+        continue;
+      }
+      if (low[std::size_t(v)] == index[std::size_t(v)]) {
+        int w;
+        do {
+          w = open.back();
+          open.pop_back();
+          onStack[std::size_t(w)] = 0;
+          component[std::size_t(w)] = components;
+        } while (w != v);
+        ++components;
+      }
+      calls.pop_back();
+      if (!calls.empty()) {
+        const int u = calls.back().first;
+        low[std::size_t(u)] = std::min(low[std::size_t(u)], low[std::size_t(v)]);
+      }
+    }
+  }
+  return component;
+}
+
+/// The alive nodes that can reach the largest strongly connected component of their part of
+/// the graph (weakly connected component; ties: the component of the lowest node). A node that
+/// cannot is a trap: a walk entering it never comes back, e.g. a short loop at the end of a
+/// state whose only exits lead back into it would replay the same few groups forever. Keeping
+/// only the nodes that reach the main component (as motion graphs keep their largest strongly
+/// connected component, Kovar et al. 2002) leaves every node an out-edge towards it.
+std::vector<char> reachingMainComponent(const EdgeLists& g, const std::vector<char>& alive) {
+  const std::size_t n = alive.size();
+  const std::vector<int> scc = strongComponents(g, alive);
+  // Weakly connected parts (union-find over the alive edges).
+  std::vector<int> part(n);
+  for (std::size_t m = 0; m < n; ++m) part[m] = int(m);
+  auto root = [&](int m) {
+    while (part[std::size_t(m)] != m) m = part[std::size_t(m)] = part[std::size_t(part[std::size_t(m)])];
+    return m;
+  };
+  std::vector<int> sccSize(n, 0);
+  for (std::size_t m = 0; m < n; ++m) {
+    if (!alive[m]) continue;
+    ++sccSize[std::size_t(scc[m])];
+    for (int k = g.begin[m]; k < g.begin[m + 1]; ++k) {
+      const int to = g.edges[std::size_t(k)].to;
+      if (alive[std::size_t(to)]) part[std::size_t(root(int(m)))] = root(to);
+    }
+  }
+  // The largest component of each part (scanned by node: ties go to the lowest node).
+  std::vector<int> mainOf(n, -1);
+  for (std::size_t m = 0; m < n; ++m) {
+    if (!alive[m]) continue;
+    int& best = mainOf[std::size_t(root(int(m)))];
+    if (best < 0 || sccSize[std::size_t(scc[m])] > sccSize[std::size_t(best)]) best = scc[m];
+  }
+  // Backwards from the main components over the alive edges.
+  std::vector<std::vector<int>> predecessors(n);
+  for (std::size_t m = 0; m < n; ++m)
+    if (alive[m])
+      for (int k = g.begin[m]; k < g.begin[m + 1]; ++k)
+        if (alive[std::size_t(g.edges[std::size_t(k)].to)])
+          predecessors[std::size_t(g.edges[std::size_t(k)].to)].push_back(int(m));
+  std::vector<char> keep(n, 0);
+  std::vector<int> stack;
+  for (std::size_t m = 0; m < n; ++m)
+    if (alive[m] && scc[m] == mainOf[std::size_t(root(int(m)))]) {
+      keep[m] = 1;
+      stack.push_back(int(m));
+    }
+  while (!stack.empty()) {
+    const int m = stack.back();
+    stack.pop_back();
+    for (int p : predecessors[std::size_t(m)])
+      if (!keep[std::size_t(p)]) {
+        keep[std::size_t(p)] = 1;
+        stack.push_back(p);
+      }
+  }
+  return keep;
+}
+
 }  // namespace
 
 int FlowGraph::temporalEdgeCount() const {
@@ -115,9 +223,10 @@ FlowGraph FlowGraph::build(const CostMatrix& cost, const std::vector<int>& state
     if (c.kept) lists[std::size_t(c.row)].push_back({c.col + 1, c.cost, false});
   const EdgeLists all = compress(lists);
 
-  // Prune what cannot reach a cycle; keep the edges between the nodes left.
-  const std::vector<char> alive =
-      reachingCycle(all, std::vector<char>(std::size_t(n), 1), [](int, const FlowEdge&) { return true; });
+  // Prune what cannot reach a cycle, then the traps (what cannot reach the main strongly
+  // connected component); keep the edges between the nodes left.
+  const std::vector<char> alive = reachingMainComponent(
+      all, reachingCycle(all, std::vector<char>(std::size_t(n), 1), [](int, const FlowEdge&) { return true; }));
   for (int m = 0; m < n; ++m) {
     auto& l = lists[std::size_t(m)];
     if (!alive[std::size_t(m)]) l.clear();

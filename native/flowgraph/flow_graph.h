@@ -2,8 +2,9 @@
 /// \file flow_graph.h
 /// The flow graph G = (V, E) of graph_fire_synthesis.txt §4.3: one node per pathline group
 /// (state, step), temporal edges k → k+1 inside a state (eq. 8) and the kept transition edges
-/// (eq. 11), with every node that cannot continue forever pruned, so a random walk (§5.1)
-/// never ends.
+/// (eq. 11), with every node that cannot continue forever, or from which a walk could never
+/// come back to the main part of the graph, pruned: a random walk (§5.1) never ends nor gets
+/// trapped.
 ///
 /// Edge direction. c_ij compares the groups i and j; a walk emits one group per node step. A
 /// candidate (i, j) becomes the edge i → j + 1: after emitting i, continue with the successor of
@@ -47,9 +48,14 @@ class FlowGraph {
   /// §4.3: temporal edges (eq. 8), transitions from selectTransitions() (eq. 11, read as
   /// row → col + 1), then pruning: nodes of out-degree 0 are removed with the edges into them,
   /// repeatedly, until every node left has an out-edge, i.e. exactly the nodes that can reach a
-  /// cycle remain. Throws std::invalid_argument for invalid params or counts, or when the first
-  /// node of a state is pruned (no walk could start there; the message names the states and
-  /// says to add states, lower block_size or raise epsilon).
+  /// cycle remain; then the traps: in each weakly connected part of the graph, the nodes that
+  /// cannot reach its largest strongly connected component (a walk entering them could never
+  /// leave, e.g. a short loop at the end of a state whose only exit leads back into it, replayed
+  /// forever; motion graphs keep their largest strongly connected component for the same
+  /// reason, Kovar et al. 2002). Every node left has an out-edge towards that component.
+  /// Throws std::invalid_argument for invalid params or counts, or when the first node of a
+  /// state is pruned (no walk could start there; the message names the states and says to add
+  /// states, lower block_size or raise epsilon).
   static FlowGraph build(const CostMatrix& cost, const std::vector<int>& stateNodeCounts,
                          const FlowGraphParams& params);
 
@@ -65,7 +71,7 @@ class FlowGraph {
   int node(int state, int step) const { return mOffsets[std::size_t(state)] + step; }
   /// Nodes of a state before pruning.
   int stateNodeCount(int state) const { return mOffsets[std::size_t(state) + 1] - mOffsets[std::size_t(state)]; }
-  /// True when the node was pruned (it could not reach a cycle).
+  /// True when the node was pruned (it could not reach a cycle, or it was a trap).
   bool pruned(int node) const { return mPruned[std::size_t(node)] != 0; }
   /// Pruned nodes per state.
   const std::vector<int>& prunedPerState() const { return mPrunedPerState; }

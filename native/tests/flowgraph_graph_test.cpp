@@ -282,6 +282,29 @@ TEST(FlowGraphBuild, DeadEndIsPruned) {
   for (int n = 0; n < 16; ++n) EXPECT_TRUE(g.staysInState(n));
 }
 
+TEST(FlowGraphBuild, TrapIsPruned) {
+  // One state of 30 nodes, B = 10, costs 1 but c(3, 15) = c(19, 28) = 0.1: edges 3 -> 16,
+  // 15 -> 4 (the loop 4..15, 12 nodes) and 19 -> 29, 28 -> 20 (the loop 20..28, 9 nodes).
+  // 29 is a dead end. 15 -> 16 leads into the second loop, whose only exit, 28 -> 29, is the
+  // dead end: a walk entering 16 would replay 20..28 forever. The trap 16..28 goes with 29.
+  CostMatrix c(30);
+  for (int i = 0; i < 30; ++i)
+    for (int j = i + 1; j < 30; ++j) c.set(i, j, 1.0);
+  c.set(3, 15, 0.1);
+  c.set(19, 28, 0.1);
+  const FlowGraph g = FlowGraph::build(c, {30}, params(10));
+  expectNoDeadEnd(g);
+  EXPECT_EQ(g.prunedPerState(), std::vector<int>{14});
+  for (int n = 0; n < 30; ++n) EXPECT_EQ(g.pruned(n), n >= 16) << n;
+  ASSERT_EQ(g.outDegree(15), 1);
+  EXPECT_EQ(g.outEdges(15).begin()->to, 4);
+  // Every node left reaches every other one: a walk visits them all.
+  RandomWalk walk(g, 5, WalkBias::Uniform, 0.875, 0);
+  std::vector<int> visits(30, 0);
+  for (int k = 0; k < 20000; ++k) ++visits[std::size_t(walk.next())];
+  for (int n = 4; n < 16; ++n) EXPECT_GT(visits[std::size_t(n)], 100) << n;
+}
+
 TEST(FlowGraphBuild, ReachableStates) {
   EXPECT_EQ(walkGraph().reachableStates(0), (std::vector<int>{0, 1, 2}));
   // Two copies of the dead-end state, far apart: no transition joins them.
