@@ -41,6 +41,7 @@ import bpy  # noqa: E402  (after the checks above)
 from . import operators, properties, ui  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
 from .build import toon_points as _toon_points  # noqa: E402
+from .build import fire_points as _fire_points  # noqa: E402
 
 _classes = operators.classes + ui.classes
 
@@ -51,9 +52,11 @@ def register():
         bpy.utils.register_class(cls)
     _surfaces.register()  # persistent frame_change_pre handler of the streak surfaces
     _toon_points.register()  # persistent frame_change_pre handler of the toon points
+    _fire_points.register()  # persistent frame_change_pre handler of the fire point preview
 
 
 def unregister():
+    _fire_points.unregister()
     _toon_points.unregister()
     _surfaces.unregister()
     for cls in reversed(_classes):

@@ -9,9 +9,11 @@ The graph's nodes are the pathline groups of every state, state by state in file
 n of the graph is group node_steps[n] of state node_states[n]'s pathline file.
 """
 
+import io
 import math
 import os
 import time
+import zipfile
 import zlib
 from dataclasses import dataclass, field
 from typing import Callable, List, Optional, Sequence, Tuple
@@ -37,6 +39,55 @@ def image_path(folder):
 
 def fire_path(folder, frame):
     return os.path.join(folder, FIRE_FOLDER, f"fire_{frame:04d}.vdb")
+
+
+def points_path(folder, frame):
+    """The point preview of a synthesized frame (SynthesisSettings.point_preview)."""
+    return os.path.join(folder, FIRE_FOLDER, f"points_{frame:04d}.npz")
+
+
+#: Range of SynthesisSettings.preview_points (points per frame of the preview).
+PREVIEW_POINTS_RANGE = (100, 1_000_000)
+
+
+def preview_indices(count, cap):
+    """Indices of the particles kept in the point preview: all when count <= cap, else exactly
+    cap of them, every (count / cap)-th (floor(i * count / cap)): deterministic and spread over
+    all live groups (oldest first), so the preview thins the fire evenly."""
+    m = min(int(count), int(cap))
+    return (np.arange(m, dtype=np.int64) * int(count)) // max(m, 1)
+
+
+def write_points(path, particles, cap):
+    """Writes the preview of `particles` (Synthesizer.particles()) to `path` atomically (temp
+    name + rename): positions (M, 3), temperature and density (M,) float32 and live (the number
+    of live particles it was thinned from)."""
+    keep = preview_indices(len(particles["temperature"]), cap)
+    buf = io.BytesIO()
+    np.savez(buf, positions=np.asarray(particles["positions"], np.float32)[keep],
+             temperature=np.asarray(particles["temperature"], np.float32)[keep],
+             density=np.asarray(particles["density"], np.float32)[keep],
+             live=np.int64(len(particles["temperature"])))
+    _write_atomic(path, buf.getvalue())
+
+
+def read_points(path):
+    """dict(positions, temperature, density, live) of a points file; OSError or ValueError when
+    it cannot be read or its arrays do not match (sizes checked, never trusted)."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            p = {name: np.array(data[name]) for name in ("positions", "temperature", "density",
+                                                         "live")}
+    except KeyError as e:
+        raise ValueError(f"{path}: no {e} array") from None
+    except zipfile.BadZipFile as e:
+        raise ValueError(f"{path}: {e}") from None
+    n = len(p["temperature"])
+    if (p["positions"].shape != (n, 3) or p["density"].shape != (n,) or p["live"].shape != ()
+            or int(p["live"]) < n or any(p[k].dtype != np.float32
+                                         for k in ("positions", "temperature", "density"))):
+        raise ValueError(f"{path}: arrays of mismatched sizes or types")
+    return p
 
 
 @dataclass
@@ -68,6 +119,11 @@ class SynthesisSettings:
     max_temperature: float = 4.0
     #: turbulence[f]: the Turbulence force fields of frame f as (strength, size, seed) each
     turbulence: List[List[Tuple[float, float, int]]] = field(default_factory=list)
+    #: also write fire/points_<frame>.npz: at most preview_points live particles per frame
+    point_preview: bool = False
+    preview_points: int = 20000
+    #: MB of pathline groups kept in memory between visits (GroupCache); 0 reads every visit
+    group_cache_mb: int = 1024
 
 
 #: Fourier modes of the turbulence velocity (enough for an irregular, smooth field).
@@ -144,6 +200,13 @@ def validate_synthesis(s: SynthesisSettings, state_count, owner):
     if not (0.0 <= s.ignition_temperature < s.max_temperature):
         raise BakeError(f"Plume: {owner}: the fire needs 0 <= ignition temperature < max "
                         f"temperature (got {s.ignition_temperature}, {s.max_temperature})")
+    lo, hi = PREVIEW_POINTS_RANGE
+    if s.point_preview and not (lo <= s.preview_points <= hi):
+        raise BakeError(f"Plume: {owner}: preview_points must be in [{lo}, {hi}] "
+                        f"(got {s.preview_points})")
+    if not (0 <= s.group_cache_mb <= 65536):
+        raise BakeError(f"Plume: {owner}: group_cache must be in [0, 65536] MB "
+                        f"(got {s.group_cache_mb})")
 
 
 def open_states(native, named_folders: Sequence[Tuple[str, str]]) -> List[State]:
@@ -320,6 +383,36 @@ def load_graph(native, folder, owner):
     return graph, states
 
 
+class GroupCache:
+    """Pathline groups read from the state files, the most recently used kept up to `budget_mb`:
+    a walk revisits nodes (600 campfire frames visit each of its 453 nodes about four times), and
+    reading and checking a 2.9 MB group from its file costs more than integrating it (eq. 13)."""
+
+    def __init__(self, states: List[State], budget_mb: int):
+        from collections import OrderedDict
+        self.states, self.groups = states, OrderedDict()
+        lay = states[0].file.layout
+        # in memory: start positions (12 B) + L samples of velocity, density, temperature (20 B)
+        self.group_bytes = lay.particles * (12 + 20 * lay.samples)
+        self.capacity = int(budget_mb) * 1_000_000 // max(self.group_bytes, 1)
+        self.hits = self.misses = 0
+
+    def get(self, state: int, step: int):
+        key = (state, step)
+        group = self.groups.get(key)
+        if group is not None:
+            self.groups.move_to_end(key)
+            self.hits += 1
+            return group
+        self.misses += 1
+        group = self.states[state].file.read_group(step, state)
+        if self.capacity > 0:
+            self.groups[key] = group
+            while len(self.groups) > self.capacity:
+                self.groups.popitem(last=False)
+        return group
+
+
 @dataclass
 class SynthesisResult:
     frame_start: int
@@ -329,12 +422,14 @@ class SynthesisResult:
     cancelled: bool = False
     step_seconds: float = 0.0   # the walk, reading the groups and integrating eq. 13
     write_seconds: float = 0.0  # rasterizing the particles and writing the frame VDBs
+    group_reads: int = 0        # node visits whose group was read from its file (not cached)
 
 
 class SynthesisRunner:
     """Walks the graph (§5.1) and integrates the visited nodes' particles (§5.2, eq. 13), one
     node per node step, nodes_per_frame steps per frame; writes fire/fire_<frame>.vdb (density,
-    temperature, flame) after each frame. progress(done, total) and cancel() are optional."""
+    temperature, flame) after each frame, and fire/points_<frame>.npz with point_preview.
+    progress(done, total) and cancel() are optional."""
 
     def __init__(self, native, graph, states: List[State], settings: SynthesisSettings,
                  out_folder, progress=None, cancel=None):
@@ -371,11 +466,13 @@ class SynthesisRunner:
     def run(self) -> SynthesisResult:
         s, native = self.s, self.native
         syn = native.Synthesizer(self.states[0].file.layout)
+        groups = GroupCache(self.states, s.group_cache_mb)
         result = SynthesisResult(frame_start=s.frame_start, last_frame=s.frame_start - 1)
         fire_dir = os.path.join(self.out_folder, FIRE_FOLDER)
         os.makedirs(fire_dir, exist_ok=True)
         for name in os.listdir(fire_dir):  # frames of an older synthesis would mix in
-            if name.startswith("fire_") and name.endswith(".vdb"):
+            if ((name.startswith("fire_") and name.endswith(".vdb"))
+                    or (name.startswith("points_") and name.endswith(".npz"))):
                 os.remove(os.path.join(fire_dir, name))
         total = s.frame_end - s.frame_start + 1
         node = self.walk.current
@@ -388,7 +485,7 @@ class SynthesisRunner:
             t0 = time.perf_counter()
             for _ in range(self.steps_per_frame):
                 state = int(self.node_states[node])
-                syn.step_node(self.states[state].file, int(self.node_steps[node]), state, wind)
+                syn.step(groups.get(state, int(self.node_steps[node])), wind)
                 result.nodes_visited.append(int(node))
                 nxt = self.walk.next(target)
                 if nxt != node + 1 or self.node_states[nxt] != state:
@@ -397,9 +494,13 @@ class SynthesisRunner:
             frame = s.frame_start + i
             t1 = time.perf_counter()
             syn.write_vdb(fire_path(self.out_folder, frame), self.raster, frame)
+            if s.point_preview:
+                write_points(points_path(self.out_folder, frame), syn.particles(),
+                             s.preview_points)
             result.step_seconds += t1 - t0
             result.write_seconds += time.perf_counter() - t1
             result.last_frame = frame
             if self.progress is not None:
                 self.progress(i + 1, total)
+        result.group_reads = groups.misses
         return result

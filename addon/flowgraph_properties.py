@@ -56,12 +56,28 @@ class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
         description="Add the scene's force fields to u_ext: a Wind field adds Strength m/s "
                     "along its Z axis, a Turbulence field a divergence-free swirl of RMS speed "
                     "Strength m/s and wavelength Size (falloff ignored)")
+    point_preview: BoolProperty(
+        name="Point Preview", default=False,
+        description="Synthesize Fire also writes the live particles of each frame "
+                    "(fire/points_####.npz) and shows them as the points of a mesh object "
+                    "\"<domain>_fire_points\", coloured by temperature")
+    preview_points: IntProperty(
+        name="Preview Points", default=20000, min=100, max=1000000,
+        description="At most this many points per frame in the point preview: more live "
+                    "particles are thinned evenly (every (live / this)-th); 100 to 1,000,000")
+    group_cache: IntProperty(
+        name="Group Cache (MB)", default=1024, min=0, max=65536,
+        description="Memory kept for pathline groups between visits of the random walk: a "
+                    "revisited node is not read from its pathlines.bin again (0: read every "
+                    "visit); 0 to 65,536 MB")
     # --- Built data ---
     summary: StringProperty(name="Graph", default="", description="Summary of the last build")
     state_names: StringProperty(name="States", default="",
                                 description="The states of the graph, in order")
     fire_object: StringProperty(name="Fire Object", default="",
                                 description="Volume object of the synthesized fire")
+    points_object: StringProperty(name="Points Object", default="",
+                                  description="Mesh object of the fire's point preview")
 
 
 classes = (PlumeFlowGraphSettings,)

@@ -1,7 +1,8 @@
 """Flow-graph fire end to end (graph_fire_synthesis.txt §4-5, issue 6): two 40-frame fire states
 at 32³ (no wind, and a side wind) baked with Record Pathlines, plume.flowgraph_build on both,
 then plume.fire_synthesize for 200 frames with a keyed target state: a Volume object over the
-synthesized VDB frames with grids density, temperature and flame, which renders non-empty. Bad
+synthesized VDB frames with grids density, temperature and flame, which renders non-empty; with
+Point Preview on, a point mesh that follows the frames (test_3). Bad
 input (one state only, B <= 0, ε outside [a, b], a missing or truncated pathline file, states of
 different domain sizes) gives a clear error and changes nothing.
 
@@ -19,6 +20,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
+from mathutils import Vector  # noqa: E402
 
 from helpers import (OUT_DIR, add_domain, add_sphere_source, assert_reports_error,  # noqa: E402
                      image_pixels, native, reset_scene, rmtree, run, select_only, temp_dir,
@@ -196,6 +198,104 @@ class FlowGraphFireTest(unittest.TestCase):
         select_only(other)
         assert_reports_error(self, bpy.ops.plume.fire_synthesize, "has no flow graph yet",
                              self.state)
+
+    def test_3_point_preview(self):
+        """Point Preview: per frame fire/points_####.npz and the "<domain>_fire_points" mesh
+        following the frame; the thinning keeps exactly min(cap, live) particles, every
+        (live / cap)-th of the full set (compared with an uncapped synthesis of the same seed:
+        the walk and eq. 13 are deterministic); with it off no points files and no object."""
+        from plume import flowgraph
+        select_only(self.windy)
+        g = self.windy.plume.domain.flowgraph
+        if not g.summary:
+            self.skipTest("needs the graph of test_1")
+        folder = self.folder(self.windy)
+        scn = bpy.context.scene
+        frames = range(1, 41)
+        g.frame_start, g.frame_end = frames[0], frames[-1]
+        g.use_force_fields = False  # no u_ext: the particles follow the recorded pathlines
+        g.point_preview = True
+        g.preview_points = 1000000  # more than ever live: every particle
+        self.assertEqual(bpy.ops.plume.fire_synthesize(), {'FINISHED'})
+        full = {f: flowgraph.read_points(flowgraph.points_path(folder, f)) for f in frames}
+        live = {f: int(full[f]["live"]) for f in frames}
+        for f in frames:
+            self.assertEqual(len(full[f]["positions"]), live[f])
+        # The group cache only saves file reads: with none, every particle is the same.
+        g.group_cache = 0
+        self.assertEqual(bpy.ops.plume.fire_synthesize(), {'FINISHED'})
+        g.group_cache = 1024
+        for f in (frames[0], frames[-1]):
+            np.testing.assert_array_equal(
+                flowgraph.read_points(flowgraph.points_path(folder, f))["positions"],
+                full[f]["positions"])
+        cap = 5000  # below the live count of most frames, above that of the first ones
+        print(f"  live particles: frame 1 {live[1]}, frame 40 {live[40]}; cap {cap}")
+        self.assertLess(live[1], cap)
+        self.assertGreater(max(live.values()), cap)
+        g.preview_points = cap
+        self.assertEqual(bpy.ops.plume.fire_synthesize(), {'FINISHED'})
+        ob = bpy.data.objects[g.points_object]
+        self.assertEqual((ob.type, ob.name), ('MESH', "Windy_fire_points"))
+        corners = np.array([self.windy.matrix_world @ Vector(c) for c in self.windy.bound_box])
+        # The recorded pathlines stay inside the domain (one leaving an open side is held at its
+        # last position and samples zero velocity); eq. 13 integrates their velocity samples by
+        # the trapezoid rule, which at 2 nodes per frame is off by 0.55 cells on average (the
+        # native reproduction test), more for the fast particles at the open top (1.8 cells
+        # seen). So: inside the box grown by 3 cells, and most of them inside the box itself.
+        margin = 3.0 * 2.0 / RESOLUTION
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        seen, outside = {}, 0
+        for f in frames:
+            scn.frame_set(f)
+            me = ob.data
+            n = len(me.vertices)
+            self.assertEqual(n, min(cap, live[f]), f"frame {f}")
+            co = np.empty(3 * n, np.float32)
+            me.vertices.foreach_get("co", co)
+            co = co.reshape(-1, 3)
+            keep = flowgraph.preview_indices(live[f], cap)
+            np.testing.assert_array_equal(co, full[f]["positions"][keep])
+            t = np.empty(n, np.float32)
+            me.attributes["plume_temperature"].data.foreach_get("value", t)
+            np.testing.assert_array_equal(t, full[f]["temperature"][keep])
+            self.assertTrue(np.all(co >= lo - margin) and np.all(co <= hi + margin), f"frame {f}")
+            outside += int(np.any((co < lo) | (co > hi), axis=1).sum())
+            seen[f] = co
+        total = sum(min(cap, v) for v in live.values())
+        print(f"  points outside the domain box: {outside} of {total} (all within 3 cells)")
+        self.assertLess(outside, 0.2 * total)
+        self.assertNotEqual(len(seen[1]), len(seen[2]))  # the fire grows in its first frames
+        self.assertFalse(np.array_equal(seen[39][:100], seen[40][:100]))  # and moves
+        scn.frame_set(frames[-1] + 1)  # past the synthesized range: no points, as the Volume
+        self.assertEqual(len(ob.data.vertices), 0)
+        # Render the preview alone: emitting points, fire-coloured (red over blue).
+        scn.frame_set(30)
+        fire = bpy.data.objects[g.fire_object]
+        fire.hide_render = True
+        hidden = [o for o in scn.objects if o.type != 'CAMERA' and o != ob and not o.hide_render]
+        for o in hidden:
+            o.hide_render = True
+        try:
+            scn.render.filepath = os.path.join(OUT_DIR, "flowgraph", "fire_points.png")
+            bpy.ops.render.render(write_still=True)
+        finally:
+            for o in hidden + [fire]:
+                o.hide_render = False
+        px = image_pixels(scn.render.filepath)[..., :3]
+        lit = px.max(axis=2) > 0.05
+        print(f"  points render: lit pixels {lit.mean() * 100:.1f}%, mean lit RGB "
+              f"{px[lit].mean(axis=0).round(3) if lit.any() else None}")
+        self.assertGreater(float(lit.mean()), 0.005)
+        self.assertGreater(float(px[lit][:, 0].mean()), float(px[lit][:, 2].mean()))
+        # Off: the old points files go with the old frames, and the object with them.
+        g.point_preview = False
+        self.assertEqual(bpy.ops.plume.fire_synthesize(), {'FINISHED'})
+        names = os.listdir(os.path.join(folder, "fire"))
+        self.assertEqual([n for n in names if n.startswith("points_")], [])
+        self.assertEqual(len([n for n in names if n.startswith("fire_")]), len(frames))
+        self.assertIsNone(bpy.data.objects.get("Windy_fire_points"))
+        self.assertEqual(g.points_object, "")
 
 
 if __name__ == "__main__":

@@ -5,15 +5,17 @@ graph_fire_synthesis.txt (Table 1, Figure 1).
 
 Three fire domains on the same 2 x 1 x 1 m box at 128 x 64 x 64 (Table 1's grid) are the three
 states, in name order: "State0 Calm" (no wind), "State1 Breeze" and "State2 Gale" (the air is
-pulled towards a wind along +x). One fuel Source, a round burner on the floor, feeds all of them.
-Each state is a short fire bake with Record Pathlines on: every node step (half a frame) a group
-of pathlines is seeded at Δx/2 spacing in the burner and followed for t_max (§4.2). Build Flow
-Graph joins the three states into one graph (transition costs of eqs. 9-10 over the pathlines'
-whole lifetime, blocks of B = 32, dead ends pruned; the cost matrix is drawn like Figure 4), and
-Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake),
-steered by keyed target states: calm, then gale from a quarter of the shot, then breeze from
-60% on. Every frame the live particles are rasterized into a VDB (density, temperature, flame)
-that a Volume object with Plume's fire material plays.
+pulled towards a wind along +x). One fuel Source, a round burner on the floor under four logs,
+feeds all of them; its feed flickers (random velocity and fuel keyed to repeat every 8 frames,
+the puffing rate of a fire that size). Each state is a short fire bake with Record Pathlines
+on: every node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the
+burner and followed for t_max (§4.2). Build Flow Graph joins the three states into one graph
+(transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B = 16, ε =
+(a+b)/2, dead ends and traps pruned; the cost matrix is drawn like Figure 4), and Synthesize
+Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake), steered by keyed
+target states: calm, then gale from a quarter of the shot, then breeze from 60% on. Every frame
+the live particles are rasterized into a VDB (density, temperature, flame) that a Volume object
+with Plume's fire material plays.
 
 Writes OUT_DIR/campfire.blend, the caches in OUT_DIR/plume_cache (the graph and the synthesized
 fire/fire_####.vdb with state 0), campfire_cost.png (the cost matrix), campfire_####.png for a
@@ -23,6 +25,7 @@ the synthesis and render times. Needs the Plume add-on installed (README). The s
 split and its ratio to the simulation: examples/flowgraph_speed.py OUT_DIR after this.
 """
 
+import math
 import os
 import sys
 
@@ -36,61 +39,64 @@ USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_
 RESOLUTION = 128               # cells along x: 128 x 64 x 64 (Table 1)
 BOX = (2.0, 1.0, 1.0)          # m; the floor at z = 0
 CENTRE = (0.0, 0.0, 0.5)
-BURNER = (-0.45, 0.0, 0.05)    # upwind of the centre, so the gale's flame stays in the box
-BURNER_SIZE = (0.24, 0.24, 0.03)  # two cell layers: ~370 fuel cells, ~2,900 seeds
-# Memory of the graph build: |Ω| L 20 B per node, nodes = BAKE_FRAMES NODES_PER_FRAME - L + 2
-# per state. About 2,900 seeds x 36 samples: 2.1 MB per node, ~190 nodes per state: ~1.2 GB.
-NODES_PER_FRAME = 2            # Δt_n = 1/48 s
-LIFETIME = 0.75                # t_max, s: the flame has cooled and risen out of the box by then
-BAKE_FRAMES = 112              # 4.7 s per state (>= 2 t_max)
-BLOCK_SIZE = 32                # B (§4.3)
+BURNER = (-0.45, 0.0, 0.0465)  # upwind of the centre, so the gale's flame stays in the box
+BURNER_SIZE = (0.24, 0.24, 0.027)  # two cell layers, 420 fuel cells: |Ω| = 3,360 seeds
+# Memory of the graph build: |Ω| L 20 B per node and BAKE_FRAMES NODES_PER_FRAME - L + 2 nodes
+# per state: 3,360 x 43 x 20 B = 2.9 MB per node, 151 nodes per state, 1.3 GB for three.
+NODES_PER_FRAME = 3            # Δt_n = 1/72 s: the fast gale's particle sheets stay ~1 cell apart
+LIFETIME = 0.6                 # t_max, s: L = 43; the flame has cooled or left the box by then
+BAKE_FRAMES = 64               # 2.7 s per state (>= 2 t_max)
+#: Build Flow Graph (§4.3): 453 nodes in blocks of B = 16, 28 per side as the paper's 868 nodes
+#: in B = 32; transitions between groups at least 16 node steps (5 frames) apart, so no loop
+#: replays the same few groups at a visible rhythm; ε = a + (b - a)/2 instead of (2a + b)/3:
+#: every state starts from the same still air, so their first groups are nearly alike and set
+#: a low a, and (2a + b)/3 then keeps so few transitions that the states hardly join.
+GRAPH = dict(block_size=16, min_node_gap=16, epsilon_share=0.5)
 DEFAULT_FRAMES = 600
-#: (name, wind m/s along +x, wind strength k_w 1/s); names sort in state order.
-STATES = (("State0 Calm", 0.0, 0.0), ("State1 Breeze", 1.0, 2.0), ("State2 Gale", 2.5, 4.0))
+#: (name, wind m/s along +x, wind strength k_w 1/s); names sort in state order. Neighbouring
+#: states must share some similar pathline groups for the graph to join them (§4.3).
+STATES = (("State0 Calm", 0.0, 0.0), ("State1 Breeze", 0.5, 2.0), ("State2 Gale", 1.0, 3.0))
 #: Keyed target states: (fraction of the shot, state).
 TARGETS = ((0.0, 0), (0.25, 2), (0.6, 1))
 SHOW = (0.2, 0.45, 0.55, 0.9)  # rendered frames: calm, gale, gale, breeze
-
-
-def fire_settings(d):
-    """What every state shares: combustion (eqs. 3-5) giving a flame whose hot part is short
-    (strong cooling c: the quartic cooling drops T from T_max to half in ~0.1 s), strong
-    vorticity confinement for the flame's curls, and Mantaflow's faster solver settings
-    (MacCormack, trilinear, Euler back-traces, pressure tolerance 1e-3), about 4x cheaper than
-    Plume's defaults at this grid."""
-    d.vorticity = 0.8
-    d.burn_rate, d.heat_yield, d.soot_yield = 6.0, 6.0, 0.3
-    d.cooling_rate, d.max_temperature = 40.0, 4.0
-    d.advection, d.interpolation, d.trace = 'MACCORMACK', 'LINEAR', 'EULER'
-    d.pressure_tolerance = 1e-3
+LOG_COLOR = (0.012, 0.006, 0.003)
+PUFF_PERIOD = 8                # frames: the feed repeats at ~3 Hz, 1.5/√D for D = 0.24 m
 
 
 def make_states(frames_baked):
     burner = scene_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
                                    BURNER_SIZE)
-    scene_kit.flicker(burner, speed=0.6, fuel_share=0.4, frames_scale=4.0)
+    scene_kit.flicker(burner, speed=1.0, fuel_share=0.4, period=PUFF_PERIOD)
     domains = []
     for name, speed, strength in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, frames_baked,
                                     NODES_PER_FRAME, LIFETIME)
-        d = dom.plume.domain
-        fire_settings(d)
-        d.wind, d.wind_strength = (speed, 0.0, 0.0), strength
+        dom.plume.domain.wind, dom.plume.domain.wind_strength = (speed, 0.0, 0.0), strength
         domains.append(dom)
     return domains
 
 
-def setup(scene, frames, out_dir):
+def logs():
+    """Four dark logs crossed under the burner (only drawn: no Plume objects)."""
+    x, y, _ = BURNER
+    for n, (dx, dy, z, along_x) in enumerate(((0.0, -0.1, 0.035, True), (0.0, 0.1, 0.035, True),
+                                              (-0.1, 0.0, 0.095, False),
+                                              (0.1, 0.0, 0.095, False))):
+        log = scene_kit.flat_box(f"Log{n}", (x + dx, y + dy, z), (0.07, 0.07, 0.42), LOG_COLOR,
+                                 add_primitive=bpy.ops.mesh.primitive_cylinder_add)
+        log.rotation_euler = (0.0, math.radians(90.0), 0.0) if along_x else (
+            math.radians(90.0), 0.0, 0.0)
+
+
+def setup(scene):
     domains = make_states(BAKE_FRAMES)
+    logs()
     scene_kit.camera(scene, (0.0, -3.2, 0.5), (90.0, 0.0, 0.0), lens=50.0)
-    scene_kit.cycles(scene, 400, 220, 64, os.path.join(out_dir, TAG + "_"))
-    scene_kit.plain_world(scene, (0.002, 0.002, 0.003))
-    keys = [(max(1, round(f * frames)), state) for f, state in TARGETS]
-    return domains, keys
+    return domains
 
 
 def main():
-    scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, BLOCK_SIZE)
+    scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup, TARGETS, SHOW, GRAPH)
 
 
 if __name__ == "__main__":

@@ -188,6 +188,14 @@ def render_strip(scene, frames, out_dir, prefix):
     return seconds, strip(paths, os.path.join(out_dir, prefix + "_strip.png"))
 
 
+def run_op_cpu(op, tag, what):
+    """run_op, also returning the CPU time of the process (all threads) it took: (wall s, CPU s).
+    On a shared machine the CPU time is the steadier measure."""
+    c0 = time.process_time()
+    wall = run_op(op, tag, what)
+    return wall, time.process_time() - c0
+
+
 def run_op(op, tag, what):
     """Runs operator `op` (e.g. bpy.ops.plume.bake); exits naming `what` unless it finishes.
     Returns its seconds."""
@@ -286,10 +294,15 @@ def burst(src, frames_on):
     return src
 
 
-def flat_box(name, location, size, color):
+def flat_box(name, location, size, color, add_primitive=None):
     """A box of `size` (m) at `location`, flat `color` (emission only): e.g. a floor or ceiling
-    drawn in a toon picture; it is no Plume object."""
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=location)
+    drawn in a toon picture, or a log under a fire (add_primitive: a bpy.ops.mesh primitive 2 m
+    across, e.g. a cylinder); it is no Plume object."""
+    if add_primitive is None:
+        bpy.ops.mesh.primitive_cube_add(size=1.0, location=location)
+    else:
+        add_primitive(location=location)
+        size = tuple(v / 2.0 for v in size)
     box = bpy.context.active_object
     box.name = name
     box.scale = size
@@ -358,14 +371,23 @@ def select(objects, active):
 
 
 def fire_domain(name, box, location, resolution, frames, nodes_per_frame, lifetime):
-    """A box of `box` (m) centred at `location` made a fire domain (combustion on) recording
-    pathline groups (§4.2): one state of a flow graph. All states of a graph share the box, the
-    resolution, the fuel Sources, nodes per frame and lifetime t_max."""
+    """A box of `box` (m) centred at `location` made a fire domain recording pathline groups
+    (§4.2): one state of a flow graph. All states of a graph share the box, the resolution, the
+    fuel Sources, nodes per frame and lifetime t_max. Combustion (eqs. 3-5) gives a flame whose
+    hot part is short: strong cooling c (the quartic cooling takes T from T_max to half in
+    ~0.1 s); strong vorticity confinement curls it; Mantaflow's faster solver settings
+    (MacCormack, trilinear, Euler back-traces, pressure tolerance 1e-3) cost about a quarter of
+    Plume's defaults."""
     dom = domain_cube(name, 1.0, location, resolution, frames)
     dom.scale = box
     d = dom.plume.domain
     d.combustion = d.pathlines = True
     d.pathline_nodes_per_frame, d.pathline_lifetime = nodes_per_frame, lifetime
+    d.vorticity = 0.8
+    d.burn_rate, d.heat_yield, d.soot_yield = 6.0, 6.0, 0.3
+    d.cooling_rate, d.max_temperature = 40.0, 4.0
+    d.advection, d.interpolation, d.trace = 'MACCORMACK', 'LINEAR', 'EULER'
+    d.pressure_tolerance = 1e-3
     return dom
 
 
@@ -384,23 +406,29 @@ def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
     return src
 
 
-def flicker(src, speed, fuel_share, frames_scale, phase=0.0):
-    """Noise F-curve modifiers on a fuel Source: its horizontal velocity wanders within
-    ±`speed` m/s and its fuel within ±`fuel_share` of itself, over about `frames_scale` frames
-    (a log pile does not burn evenly). The uneven feed breaks the symmetry of the flame, which
-    then flickers as a fire does, so its pathline groups differ over time and the flow graph
-    finds transitions (§4.3)."""
+def flicker(src, speed, fuel_share, period, seed=0):
+    """Keys a fuel Source's feed to repeat every `period` frames: random horizontal velocity
+    within ±`speed` m/s and fuel within ±`fuel_share` of itself, a key every 2 frames, cycled
+    (a log pile does not burn evenly; a fire puffs at a near-constant rate, ~1.5/√D Hz for a
+    pool fire of diameter D m). The uneven feed breaks the symmetry of the flame, which then
+    flickers as a fire does; its repetition lets groups of pathlines recur, so the flow graph
+    finds transitions (§4.3: the exemplars "can be carefully designed ... to provide enough
+    transitions")."""
+    import random
+    rng = random.Random(seed)
     s = src.plume.source
-    src.keyframe_insert("plume.source.velocity", frame=1)
-    src.keyframe_insert("plume.source.fuel", frame=1)
-    for n, fc in enumerate(src.animation_data.action.fcurves):
-        if fc.data_path.endswith("velocity") and fc.array_index == 2:
-            continue
-        m = fc.modifiers.new('NOISE')
-        m.blend_type = 'REPLACE'  # value + (noise - 1/2) strength, noise in [0, 1]
-        m.strength = 2.0 * (speed if fc.data_path.endswith("velocity") else fuel_share * s.fuel)
-        m.scale = frames_scale
-        m.phase = phase + 7.0 * n
+    fuel = s.fuel
+    for frame in range(1, period + 2, 2):
+        last = frame > period
+        s.velocity = (0.0, 0.0, 0.0) if last or frame == 1 else (
+            rng.uniform(-speed, speed), rng.uniform(-speed, speed), 0.0)
+        s.fuel = fuel if last or frame == 1 else fuel * (1.0 + rng.uniform(-fuel_share,
+                                                                             fuel_share))
+        for name in ("velocity", "fuel"):
+            src.keyframe_insert("plume.source." + name, frame=min(frame, period + 1))
+    s.fuel, s.velocity = fuel, (0.0, 0.0, 0.0)
+    for fc in src.animation_data.action.fcurves:
+        fc.modifiers.new('CYCLES')
     return src
 
 
@@ -412,7 +440,7 @@ def bake_fire_states(domains, tag):
     seconds, ram = [], 0
     for dom in domains:
         select([dom], dom)
-        s = run_op(bpy.ops.plume.bake, tag, f"the bake of '{dom.name}'")
+        s, cpu = run_op_cpu(bpy.ops.plume.bake, tag, f"the bake of '{dom.name}'")
         d = dom.plume.domain
         frames = d.frame_end - d.frame_start + 1
         path = cache.pathlines_path(snapshot.cache_folder_of(dom))
@@ -420,25 +448,37 @@ def bake_fire_states(domains, tag):
         lay = f.layout
         node_ram = lay.particles * lay.samples * PATHLINE_SAMPLE_BYTES
         ram += node_ram * f.node_count
-        print(f"{tag}: bake '{dom.name}' {frames} frames in {s:.1f} s ({s / frames:.2f} s/frame); "
+        print(f"{tag}: bake '{dom.name}' {frames} frames in {s:.1f} s ({s / frames:.2f} s/frame, "
+              f"CPU {cpu / frames:.2f} s/frame); "
               f"pathlines.bin {os.path.getsize(path) / 1e6:.0f} MB: {f.node_count} nodes of "
               f"|Ω| = {lay.particles} pathlines x L = {lay.samples} samples "
-              f"({lay.sample_dt * 1e3:.1f} ms apart), {f.bytes_per_node / 1e6:.2f} MB/node on disk, "
-              f"{node_ram / 1e6:.2f} MB/node in RAM", flush=True)
+              f"({lay.sample_dt * 1e3:.1f} ms apart), {f.bytes_per_node / 1e6:.2f} MB/node on "
+              f"disk, {node_ram / 1e6:.2f} MB/node in RAM", flush=True)
         seconds.append(s)
     print(f"{tag}: Build Flow Graph holds {ram / 1e9:.2f} GB of pathline groups", flush=True)
     return seconds
 
 
-def build_flow_graph(domains, keeper, tag, block_size):
+def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, epsilon_share=None):
     """Build Flow Graph (plume.flowgraph_build) over the states `domains` (name order), kept
-    with `keeper`, blocks of B = `block_size`; prints the graph summary; returns the seconds."""
+    with `keeper`, blocks of B = `block_size`; ε = (2a + b)/3 or, with `epsilon_share`,
+    a + epsilon_share (b - a) (a, b: the cheapest and dearest candidate transition, §4.3, which
+    the panel shows after a build, or the error of a build that joins too little). Prints the
+    graph summary; returns the seconds."""
     select(domains, keeper)
     g = keeper.plume.domain.flowgraph
-    g.block_size = block_size
+    g.block_size, g.min_node_gap, g.epsilon = block_size, min_node_gap, 0.0
+    if epsilon_share is not None:
+        flowgraph, native = addon_module("flowgraph"), addon_module("_native")
+        folder = addon_module("snapshot").cache_folder_of
+        states = flowgraph.open_states(native, [(d.name, folder(d)) for d in domains])
+        cost, counts, params = flowgraph.cost_matrix(
+            native, states, addon_module("operators.flowgraph").graph_settings(g))
+        t = native.select_transitions(cost, counts, params)
+        g.epsilon = t["a"] + epsilon_share * (t["b"] - t["a"])
     seconds = run_op(bpy.ops.plume.flowgraph_build, tag, "Build Flow Graph")
-    print(f"{tag}: Build Flow Graph {seconds:.1f} s (B = {block_size}): {g.state_names}; "
-          f"{g.summary}", flush=True)
+    print(f"{tag}: Build Flow Graph {seconds:.1f} s (B = {block_size}, min node gap "
+          f"{min_node_gap}): {g.state_names}; {g.summary}", flush=True)
     return seconds
 
 
@@ -485,27 +525,33 @@ def lit_share(path, level=0.05):
     return float((px.reshape(-1, 4)[:, :3].max(axis=1) > level).mean())
 
 
-def flowgraph_example(tag, usage, default_frames, setup, show, block_size):
-    """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene, frames,
-    out_dir) builds the scene (fuel Sources, the state domains in name order, camera, look) and
-    returns (domains, keys): (frame, target state) keys of the synthesis. Then the .blend is
-    saved to OUT_DIR/TAG.blend, every state is baked, Build Flow Graph (kept with state 0), the
-    target states are keyed, FRAMES frames are synthesized, the cost-matrix picture is copied to
-    OUT_DIR/TAG_cost.png, the frames at fractions `show` are rendered to OUT_DIR/TAG_####.png and
-    OUT_DIR/TAG_strip.png, and the times are printed."""
+def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
+    """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene) builds
+    the scene (fuel Sources, camera) and returns the state domains in name order; the look is a
+    400 x 220 Cycles render on a black world. Then the .blend is saved to OUT_DIR/TAG.blend,
+    every state is baked, Build Flow Graph (kept with state 0; `graph`: the keywords of
+    build_flow_graph), the
+    target state is keyed at the (fraction of the shot, state) pairs `targets`, FRAMES frames
+    are synthesized, the cost-matrix picture is copied to OUT_DIR/TAG_cost.png, the frames at
+    fractions `show` are rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the
+    times are printed."""
     import shutil
     out_dir, frames = parse_args(usage, default_frames)
     scene = new_scene()
-    domains, keys = setup(scene, frames, out_dir)
+    domains = setup(scene)
+    cycles(scene, 400, 220, 64, os.path.join(out_dir, tag + "_"))
+    plain_world(scene, (0.002, 0.002, 0.003))
+    keys = [(max(1, round(f * frames)), state) for f, state in targets]
     scene.frame_start, scene.frame_end = 1, frames
     save_blend(out_dir, tag)
     bake_fire_states(domains, tag)
     keeper = domains[0]
-    build_flow_graph(domains, keeper, tag, block_size)
+    build_flow_graph(domains, keeper, tag, **graph)
     key_target_states(keeper, keys)
     synth_s, fire = synthesize_fire(keeper, frames, tag)
-    print(f"{tag}: Synthesize Fire {frames} frames in {synth_s:.1f} s ({synth_s / frames * 1e3:.0f} "
-          f"ms/frame, VDB writing included) -> '{fire.name}'", flush=True)
+    print(f"{tag}: Synthesize Fire {frames} frames in {synth_s:.1f} s ("
+          f"{synth_s / frames * 1e3:.0f} ms/frame, VDB writing included) -> '{fire.name}'",
+          flush=True)
     hide_bakes(domains)
     bpy.ops.wm.save_mainfile()
     folder = addon_module("snapshot").cache_folder_of(keeper)

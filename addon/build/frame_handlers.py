@@ -1,6 +1,6 @@
 """Adding and removing the persistent frame_change_pre handlers that move built objects (streak
-surfaces, toon points) to the cached data of each frame, once each however often the add-on is
-enabled."""
+surfaces, toon points, fire point preview) to the cached data of each frame, once each however
+often the add-on is enabled."""
 
 import bpy
 

@@ -14,6 +14,7 @@ Also: scene wiring with the Z pass, and the optional Freestyle style."""
 
 import bpy
 
+from . import datablocks
 from .toon_nodes import link_math
 
 GROUP = "Plume Depth Differences"
@@ -37,12 +38,7 @@ INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
 def depth_group():
     """The compositor node group (rebuilt in place when it exists). Outputs: Image (outline
     pixels in Outline Color, others from Image) and Outline (1 on outline pixels, else 0)."""
-    ng = bpy.data.node_groups.get(GROUP)
-    if ng is None or ng.bl_idname != 'CompositorNodeTree':
-        ng = bpy.data.node_groups.new(GROUP, 'CompositorNodeTree')
-    ng.nodes.clear()
-    for sockets in (ng.inputs, ng.outputs):
-        sockets.clear()
+    ng = datablocks.empty_node_group(GROUP, 'CompositorNodeTree')
     for name, kind, default in INPUTS:
         ng.inputs.new(kind, name).default_value = default
     ng.inputs["Gamma"].min_value = 0.0

@@ -6,6 +6,8 @@ only where the stencil is opaque (with the view layer's pass_alpha_threshold).""
 
 import bpy
 
+from . import datablocks
+
 GROUP = "Plume Toon Billboards"
 #: Alpha above which a stencil pixel is opaque (material cut-out and Cycles pass threshold).
 ALPHA_THRESHOLD = 0.5
@@ -37,12 +39,7 @@ def billboard_group():
     Inputs: Geometry (points with size and velocity attributes), Camera (object), Material,
     Stretch Factor (k), Perspective. The orientation is computed here, from the camera as the
     depsgraph evaluates it for the frame drawn, so an animated camera never lags a frame."""
-    ng = bpy.data.node_groups.get(GROUP)
-    if ng is None or ng.bl_idname != 'GeometryNodeTree':
-        ng = bpy.data.node_groups.new(GROUP, 'GeometryNodeTree')
-    ng.nodes.clear()
-    for sockets in (ng.inputs, ng.outputs):
-        sockets.clear()
+    ng = datablocks.empty_node_group(GROUP, 'GeometryNodeTree')
     ng.inputs.new('NodeSocketGeometry', "Geometry")
     ng.inputs.new('NodeSocketObject', "Camera")
     ng.inputs.new('NodeSocketMaterial', "Material")

@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from .. import _native, cache, flowgraph
-from ..build import fire_volume
+from ..build import fire_points, fire_volume
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
 
@@ -133,7 +133,9 @@ class PLUME_OT_fire_synthesize(bpy.types.Operator):
             settings = flowgraph.SynthesisSettings(
                 frame_start=int(g.frame_start), frame_end=int(g.frame_end), seed=int(g.seed),
                 traversal=g.traversal, gamma=float(g.gamma), start_state=int(g.start_state),
-                max_temperature=float(d.max_temperature))
+                max_temperature=float(d.max_temperature),
+                point_preview=bool(g.point_preview), preview_points=int(g.preview_points),
+                group_cache_mb=int(g.group_cache))
             flowgraph.validate_synthesis(settings, graph.state_count, owner)
             settings.targets, settings.winds, settings.turbulence = frame_inputs(
                 context, domain, settings.frame_start, settings.frame_end)
@@ -154,6 +156,12 @@ class PLUME_OT_fire_synthesize(bpy.types.Operator):
         frames = result.last_frame - result.frame_start + 1
         ob = fire_volume.build_fire_volume(domain, folder, result.frame_start, frames,
                                            settings.max_temperature)
+        if settings.point_preview:
+            fire_points.build_object(context.scene, domain, folder, result.frame_start,
+                                     result.last_frame, states[0].file.cell_size,
+                                     settings.max_temperature)
+        else:
+            fire_points.remove_object(domain)
         self.report({'INFO'}, f"Plume: synthesized {frames} frames of fire into '{ob.name}' "
                               f"({len(result.nodes_visited)} nodes, {result.transitions_taken} "
                               f"transitions, {time.perf_counter() - t0:.1f} s)")

@@ -286,11 +286,17 @@ class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
         row.prop(g, "frame_start")
         row.prop(g, "frame_end")
         for name in ("seed", "traversal", "gamma", "start_state", "target_state", "wind",
-                     "use_force_fields"):
+                     "use_force_fields", "point_preview"):
             col.prop(g, name)
+        sub = col.column()
+        sub.active = g.point_preview
+        sub.prop(g, "preview_points")
+        col.prop(g, "group_cache")
         layout.operator("plume.fire_synthesize", icon='PLAY')
         if g.fire_object:
             layout.label(text=f"Fire: {g.fire_object}", icon='OUTLINER_OB_VOLUME')
+        if g.points_object:
+            layout.label(text=f"Points: {g.points_object}", icon='OUTLINER_OB_POINTCLOUD')
 
 
 class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):

@@ -1,0 +1,103 @@
+"""Synthesis against simulation, per frame, at the campfire's 128 x 64 x 64 grid (issue 6,
+Performance: "synthesizing a frame is >= 100x cheaper than simulating it"; the paper's Table 1
+and Figure 7 found ~12x).
+
+    blender -b --factory-startup --python examples/flowgraph_speed.py -- CAMPFIRE_DIR [REPEATS]
+
+Opens CAMPFIRE_DIR/campfire.blend (run examples/campfire.py first) and, REPEATS times (default
+2), best of each:
+- synthesis: Synthesize Fire again with the saved settings (same seed and keys: the same
+  frames are written again), without and with the group cache (1 GB: revisited nodes are not
+  read again), timing the walk with the integration of eq. 13 apart from the rasterization of
+  the particles into VDB grids and the file writing;
+- simulation: the calm state baked again for its frames, as a copy of its domain, without
+  pathline recording and with it (the cost of Plume's solver with and without §4.2).
+Prints seconds per frame and the ratios. The machine may be shared: best-of figures.
+"""
+
+import os
+import sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import campfire  # noqa: E402
+import scene_kit  # noqa: E402
+
+USAGE = ("usage: blender -b --factory-startup --python examples/flowgraph_speed.py -- "
+         "CAMPFIRE_DIR [REPEATS]")
+
+
+def synthesis_seconds(keeper, repeats, group_cache_mb):
+    """Best (walk + integration, rasterization + writing) seconds per frame over `repeats`
+    runs of Synthesize Fire on `keeper` with a group cache of `group_cache_mb` MB, and the
+    groups read from the files per frame, read from the runner's SynthesisResult."""
+    flowgraph = scene_kit.addon_module("flowgraph")
+    results, run = [], flowgraph.SynthesisRunner.run
+
+    def timed_run(runner):
+        results.append(run(runner))
+        return results[-1]
+    flowgraph.SynthesisRunner.run = timed_run
+    try:
+        g = keeper.plume.domain.flowgraph
+        g.group_cache = group_cache_mb
+        frames = g.frame_end - g.frame_start + 1
+        for _ in range(repeats):
+            scene_kit.synthesize_fire(keeper, g.frame_end, "speed")
+    finally:
+        flowgraph.SynthesisRunner.run = run
+    return (min(r.step_seconds for r in results) / frames,
+            min(r.write_seconds for r in results) / frames, frames,
+            results[-1].group_reads / frames)
+
+
+def bake_seconds(state, pathlines, repeats):
+    """Best seconds per frame of baking a copy of domain `state` (its frames and settings), with
+    or without pathline recording; Free Bake after each, then the copy is removed."""
+    import shutil
+    dom = state.copy()
+    dom.name = f"Speed {'with' if pathlines else 'without'} pathlines"
+    bpy.context.scene.collection.objects.link(dom)
+    d = dom.plume.domain
+    d.pathlines, d.volume_object = pathlines, ""
+    frames = d.frame_end - d.frame_start + 1
+    best = float("inf")
+    for _ in range(repeats):
+        scene_kit.select([dom], dom)
+        best = min(best, scene_kit.run_op(bpy.ops.plume.bake, "speed", "the bake") / frames)
+        scene_kit.run_op(bpy.ops.plume.cache_free, "speed", "Free Bake")
+    shutil.rmtree(scene_kit.addon_module("snapshot").cache_folder_of(dom), ignore_errors=True)
+    bpy.data.objects.remove(dom, do_unlink=True)
+    return best, frames
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    if not argv:
+        sys.exit(USAGE)
+    repeats = int(argv[1]) if len(argv) > 1 else 2
+    scene_kit.new_scene()
+    bpy.ops.wm.open_mainfile(filepath=os.path.join(os.path.abspath(argv[0]),
+                                                   campfire.TAG + ".blend"))
+    calm = bpy.data.objects[campfire.STATES[0][0]]
+    for cache_mb in (0, 1024):
+        step_s, write_s, frames, reads = synthesis_seconds(calm, repeats, cache_mb)
+        print(f"speed: synthesis of {frames} frames, group cache {cache_mb} MB ({reads:.2f} "
+              f"groups read from the files per frame): walk + integration "
+              f"{step_s * 1e3:.1f} ms/frame ({step_s / campfire.NODES_PER_FRAME * 1e3:.2f} ms "
+              f"per node step), rasterization + VDB writing {write_s * 1e3:.1f} ms/frame (best "
+              f"of {repeats})", flush=True)
+    sim_s, baked = bake_seconds(calm, False, repeats)
+    rec_s, _ = bake_seconds(calm, True, repeats)
+    print(f"speed: simulation at {campfire.RESOLUTION}x{campfire.RESOLUTION // 2}x"
+          f"{campfire.RESOLUTION // 2}, {baked} frames: {sim_s:.2f} s/frame without pathlines, "
+          f"{rec_s:.2f} s/frame recording them (best of {repeats}; each bake writes its VDB "
+          f"frames)", flush=True)
+    print(f"speed: simulation / synthesis = {sim_s / step_s:.0f}x (walk + integration, 1 GB "
+          f"group cache), "
+          f"{sim_s / (step_s + write_s):.0f}x (with the VDB frames)", flush=True)
+
+
+if __name__ == "__main__":
+    main()
