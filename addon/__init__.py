@@ -42,6 +42,7 @@ from . import operators, properties, ui  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
 from .build import toon_points as _toon_points  # noqa: E402
 from .build import fire_points as _fire_points  # noqa: E402
+from .build import flame_spines as _flame_spines  # noqa: E402
 
 _classes = operators.classes + ui.classes
 
@@ -53,9 +54,11 @@ def register():
     _surfaces.register()  # persistent frame_change_pre handler of the streak surfaces
     _toon_points.register()  # persistent frame_change_pre handler of the toon points
     _fire_points.register()  # persistent frame_change_pre handler of the fire point preview
+    _flame_spines.register()  # persistent frame_change_pre handler of flame spines and lights
 
 
 def unregister():
+    _flame_spines.unregister()
     _fire_points.unregister()
     _toon_points.unregister()
     _surfaces.unregister()

@@ -17,7 +17,7 @@ from typing import List, Optional
 
 import numpy as np
 
-from . import cache
+from . import cache, flame_smoke
 from .point_sources import domain_point_sources, emits_during
 
 #: A checkpoint of the solver state is written when the time since the last one is at least this
@@ -110,6 +110,7 @@ class BakeRunner:
         # Voxelize every emitter of the first frame now, so a bad obstacle is reported before
         # any file is written.
         self._load_emitters(0)
+        self._load_flame_smoke()
         if snap.streaks.enabled:
             self._tracer = self._make_tracer(params)
         if snap.pathlines.enabled:
@@ -143,6 +144,23 @@ class BakeRunner:
                     text = f"{e.role.lower()} '{e.name}': {text}"
                 raise BakeError(f"Plume: {text}") from None
         self._emitter_inputs = inputs
+
+    def _load_flame_smoke(self):
+        """Flame Smoke (structural_flames.txt §6.3): reads the flames cache over the bake's frames
+        and passes every frame's emitters through the solver's validation, so that a missing
+        or bad flames bake is reported before any file is written."""
+        snap = self.snapshot
+        smoke = snap.flame_smoke
+        if smoke is None or not smoke.enabled:
+            return
+        flame_smoke.load_frames(smoke, snap.frame_start, snap.frame_end, snap.solver,
+                                snap.domain_name)
+        for index in range(snap.frame_count):
+            try:
+                flame_smoke.set_frame(self._solver, smoke, index)
+            except ValueError as e:
+                raise BakeError(f"Plume: domain '{snap.domain_name}': {flame_smoke.SETTING} "
+                                f"(frame {snap.frame_start + index}): {e}") from None
 
     def _make_tracer(self, params):
         """StreakTracer with the point sources of every Source (smoke_surfaces.txt §3.2):
@@ -305,6 +323,7 @@ class BakeRunner:
                     result.cancelled = True
                     break
                 self._load_emitters(frame - snap.frame_start)
+                flame_smoke.set_frame(self._solver, snap.flame_smoke, frame - snap.frame_start)
                 tracer = self._tracer
                 if self._recorder is not None:
                     ok = self._recorder.advance_frame(self._solver)

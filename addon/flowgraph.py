@@ -122,7 +122,8 @@ class SynthesisSettings:
     #: also write fire/points_<frame>.npz: at most preview_points live particles per frame
     point_preview: bool = False
     preview_points: int = 20000
-    #: MB of pathline groups kept in memory between visits (GroupCache); 0 reads every visit
+    #: MB of prepared pathline groups the native Synthesizer keeps between visits of the walk
+    #: (least recently used out); 0 reads every visit from its file
     group_cache_mb: int = 1024
 
 
@@ -383,36 +384,6 @@ def load_graph(native, folder, owner):
     return graph, states
 
 
-class GroupCache:
-    """Pathline groups read from the state files, the most recently used kept up to `budget_mb`:
-    a walk revisits nodes (600 campfire frames visit each of its 453 nodes about four times), and
-    reading and checking a 2.9 MB group from its file costs more than integrating it (eq. 13)."""
-
-    def __init__(self, states: List[State], budget_mb: int):
-        from collections import OrderedDict
-        self.states, self.groups = states, OrderedDict()
-        lay = states[0].file.layout
-        # in memory: start positions (12 B) + L samples of velocity, density, temperature (20 B)
-        self.group_bytes = lay.particles * (12 + 20 * lay.samples)
-        self.capacity = int(budget_mb) * 1_000_000 // max(self.group_bytes, 1)
-        self.hits = self.misses = 0
-
-    def get(self, state: int, step: int):
-        key = (state, step)
-        group = self.groups.get(key)
-        if group is not None:
-            self.groups.move_to_end(key)
-            self.hits += 1
-            return group
-        self.misses += 1
-        group = self.states[state].file.read_group(step, state)
-        if self.capacity > 0:
-            self.groups[key] = group
-            while len(self.groups) > self.capacity:
-                self.groups.popitem(last=False)
-        return group
-
-
 @dataclass
 class SynthesisResult:
     frame_start: int
@@ -465,8 +436,8 @@ class SynthesisRunner:
 
     def run(self) -> SynthesisResult:
         s, native = self.s, self.native
-        syn = native.Synthesizer(self.states[0].file.layout)
-        groups = GroupCache(self.states, s.group_cache_mb)
+        syn = native.Synthesizer(self.states[0].file.layout,
+                                 cache_bytes=int(s.group_cache_mb) * 1_000_000)
         result = SynthesisResult(frame_start=s.frame_start, last_frame=s.frame_start - 1)
         fire_dir = os.path.join(self.out_folder, FIRE_FOLDER)
         os.makedirs(fire_dir, exist_ok=True)
@@ -485,7 +456,7 @@ class SynthesisRunner:
             t0 = time.perf_counter()
             for _ in range(self.steps_per_frame):
                 state = int(self.node_states[node])
-                syn.step(groups.get(state, int(self.node_steps[node])), wind)
+                syn.step_node(self.states[state].file, int(self.node_steps[node]), state, wind)
                 result.nodes_visited.append(int(node))
                 nxt = self.walk.next(target)
                 if nxt != node + 1 or self.node_states[nxt] != state:
@@ -502,5 +473,5 @@ class SynthesisRunner:
             result.last_frame = frame
             if self.progress is not None:
                 self.progress(i + 1, total)
-        result.group_reads = groups.misses
+        result.group_reads = syn.cache_misses
         return result

@@ -7,6 +7,7 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from .flame_properties import PlumeFlameSourceSettings, PlumeFlamesSettings
 from .flowgraph_properties import PlumeFlowGraphSettings
 from .toon_properties import PlumeToonSettings
 
@@ -140,6 +141,21 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     expansion: FloatProperty(
         name="Expansion (φ)", default=1.0, soft_min=0.0, soft_max=10.0,
         description="φ: divergence per unit of fuel burnt per second in the reaction zone (eq. 1)")
+    # --- Flame Smoke (structural_flames.txt §6.3, flame_smoke.py) ---
+    flame_smoke: BoolProperty(
+        name="Flame Smoke", default=False,
+        description="Emit smoke above every baked structural flame (Bake Flames first): at the "
+                    "smoke point h above its tip, with its tip's velocity, as much as its "
+                    "radiation (eq. 5) times Smoke Yield, hot enough to rise as the flames do")
+    flame_smoke_yield: FloatProperty(
+        name="Smoke Yield", default=10.0, min=0.0, soft_max=1000.0,
+        description="The paper's arbitrary scale factor: smoke mass (density × m³) per second "
+                    "per unit of flame energy E (eq. 5); 10 gives a torch's flames (E ~ 1e-4) "
+                    "smoke of density ~1 at the smoke points")
+    flame_smoke_temperature: FloatProperty(
+        name="Smoke Temperature", default=0.0, soft_min=0.0, soft_max=10.0,
+        description="Temperature of the smoke above ambient; 0 = automatic: the temperature "
+                    "whose buoyancy β |g| (T − T_amb) equals the flames' eq. 2 buoyancy")
     # --- Streak surfaces (smoke_surfaces.txt §3.2-3.4) ---
     pathlines: BoolProperty(
         name="Record Pathlines", default=False,
@@ -273,9 +289,11 @@ class PlumeObjectSettings(bpy.types.PropertyGroup):
     domain: PointerProperty(type=PlumeDomainSettings)
     source: PointerProperty(type=PlumeSourceSettings)
     obstacle: PointerProperty(type=PlumeObstacleSettings)
+    flame: PointerProperty(type=PlumeFlameSourceSettings)  # role FLAME_SOURCE
 
 
-classes = (PlumeToonSettings, PlumeFlowGraphSettings, PlumeDomainSettings, PlumeSourceSettings,
+classes = (PlumeFlameSourceSettings, PlumeFlamesSettings, PlumeToonSettings,
+           PlumeFlowGraphSettings, PlumeDomainSettings, PlumeSourceSettings,
            PlumeObstacleSettings, PlumeObjectSettings)
 
 
@@ -283,9 +301,11 @@ def register():
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.Object.plume = PointerProperty(type=PlumeObjectSettings, name="Plume")
+    bpy.types.Scene.plume_flames = PointerProperty(type=PlumeFlamesSettings, name="Plume Flames")
 
 
 def unregister():
+    del bpy.types.Scene.plume_flames
     del bpy.types.Object.plume
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

@@ -213,6 +213,8 @@ class BakeSnapshot:
     #: None: Plume simulates.
     mantaflow: Optional[object] = None
     pathlines: PathlineSettings = field(default_factory=PathlineSettings)
+    #: flame_smoke.FlameSmokeSettings: smoke from the flames cache (structural_flames.txt §6.3)
+    flame_smoke: Optional[object] = None
 
     @property
     def frame_count(self):
@@ -240,6 +242,8 @@ class BakeSnapshot:
                 "sources": [e.streak_fingerprint() for e in self.emitters if e.role == "SOURCE"]}
         if self.pathlines.enabled:  # absent when off, so older caches still resume
             data["pathlines"] = dataclasses.asdict(self.pathlines)
+        if self.flame_smoke is not None and self.flame_smoke.enabled:  # absent when off
+            data["flame_smoke"] = self.flame_smoke.fingerprint()
         return data
 
     def frame_input_hash(self, frame):
@@ -255,6 +259,8 @@ class BakeSnapshot:
                 s = emitter.source_at(index)
                 h.update(np.array([s.density, s.temperature, s.fuel, *s.velocity,
                                    s.motion_factor, s.emit_particles], dtype=np.float64).tobytes())
+        if self.flame_smoke is not None and self.flame_smoke.enabled:  # the flames of `frame`
+            h.update(self.flame_smoke.frame_bytes(index))
         return h.hexdigest()
 
 

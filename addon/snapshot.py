@@ -231,6 +231,7 @@ def take_snapshot(context, addon_version="0.1.0"):
         raise BakeError(f"{e} (domain '{domain.name}')") from None
     solver = solver_settings(domain, scene, cells, cell_size, origin)
     validate_python_side(domain.name, resolution, frame_start, frame_end, solver)
+    smoke = flame_smoke_settings(domain, scene)
     return BakeSnapshot(
         domain_name=domain.name, resolution=resolution, frame_start=frame_start,
         frame_end=frame_end, cache_directory=d.cache_directory,
@@ -242,4 +243,21 @@ def take_snapshot(context, addon_version="0.1.0"):
         pathlines=PathlineSettings(enabled=bool(d.pathlines),
                                    nodes_per_frame=int(d.pathline_nodes_per_frame),
                                    lifetime=float(d.pathline_lifetime),
-                                   float16=bool(d.pathline_float16)))
+                                   float16=bool(d.pathline_float16)),
+        flame_smoke=smoke)
+
+
+def flame_smoke_settings(domain, scene):
+    """The domain's Flame Smoke settings (structural_flames.txt §6.3) and the scene's flames
+    cache folder; None when off. The flames cache is read by BakeRunner.prepare()."""
+    d = domain.plume.domain
+    if not d.flame_smoke:
+        return None
+    if d.motion_source == 'MANTAFLOW':
+        raise BakeError(f"Plume: domain '{domain.name}': Flame Smoke feeds the Plume solver: set "
+                        "Motion to Plume Simulation or turn Flame Smoke off")
+    from .flame_smoke import FlameSmokeSettings
+    from .flame_snapshot import cache_folder as flames_folder  # imports this module
+    return FlameSmokeSettings(enabled=True, smoke_yield=float(d.flame_smoke_yield),
+                              temperature=float(d.flame_smoke_temperature),
+                              folder=flames_folder(scene))

@@ -36,8 +36,10 @@ SOURCE_PROPS = ("density", "temperature", "fuel", "velocity", "motion_factor", "
 PANELS = ("PHYSICS_PT_plume", "PHYSICS_PT_plume_settings", "PHYSICS_PT_plume_forces",
           "PHYSICS_PT_plume_advection", "PHYSICS_PT_plume_pressure", "PHYSICS_PT_plume_boundaries",
           "PHYSICS_PT_plume_combustion", "PHYSICS_PT_plume_cache", "PHYSICS_PT_plume_source",
-          "PHYSICS_PT_plume_obstacle")
-OPERATORS = ("PLUME_OT_role_set", "PLUME_OT_bake", "PLUME_OT_cache_free")
+          "PHYSICS_PT_plume_obstacle", "PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames")
+FLAME_PANELS = {"PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames"}
+OPERATORS = ("PLUME_OT_role_set", "PLUME_OT_bake", "PLUME_OT_cache_free", "PLUME_OT_flames_bake",
+             "PLUME_OT_flames_free")
 
 
 class FakeLayout:
@@ -150,9 +152,10 @@ class RolesUiTest(unittest.TestCase):
     def test_panels_draw_for_each_role(self):
         expected = {
             'NONE': {"PHYSICS_PT_plume"},
-            'DOMAIN': set(PANELS) - {"PHYSICS_PT_plume_source", "PHYSICS_PT_plume_obstacle"},
+            'DOMAIN': set(PANELS) - {"PHYSICS_PT_plume_source", "PHYSICS_PT_plume_obstacle"}
+            - FLAME_PANELS,
             'SOURCE': {"PHYSICS_PT_plume", "PHYSICS_PT_plume_source"},
-            'FLAME_SOURCE': {"PHYSICS_PT_plume", "PHYSICS_PT_plume_source"},
+            'FLAME_SOURCE': {"PHYSICS_PT_plume"} | FLAME_PANELS,
             'OBSTACLE': {"PHYSICS_PT_plume", "PHYSICS_PT_plume_obstacle"},
         }
         for role in ROLES:

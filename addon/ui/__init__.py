@@ -1,3 +1,5 @@
 """Panels of the Physics tab."""
 
-from .panels import classes  # noqa: F401
+from . import flame_panels, panels
+
+classes = panels.classes + flame_panels.classes

@@ -150,6 +150,22 @@ class PHYSICS_PT_plume_combustion(PlumeDomainPanel, bpy.types.Panel):
             col.prop(d, name)
 
 
+class PHYSICS_PT_plume_flame_smoke(PlumeDomainPanel, bpy.types.Panel):
+    bl_label = "Flame Smoke"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw_header(self, context):
+        self.layout.prop(context.object.plume.domain, "flame_smoke", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        d = context.object.plume.domain
+        layout.active = d.flame_smoke
+        layout.prop(d, "flame_smoke_yield")
+        layout.prop(d, "flame_smoke_temperature")
+
+
 class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
     bl_label = "Cache"
 
@@ -306,7 +322,7 @@ class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
     @classmethod
     def poll(cls, context):
         p = cls.plume(context)
-        return p is not None and p.role in {'SOURCE', 'FLAME_SOURCE'}
+        return p is not None and p.role == 'SOURCE'  # Flame Sources: flame_panels.py
 
     def draw(self, context):
         layout = self.layout
@@ -352,6 +368,7 @@ classes = (
     PHYSICS_PT_plume_pressure,
     PHYSICS_PT_plume_boundaries,
     PHYSICS_PT_plume_combustion,
+    PHYSICS_PT_plume_flame_smoke,
     PHYSICS_PT_plume_cache,
     PHYSICS_PT_plume_streaks,
     PHYSICS_PT_plume_toon,

@@ -1,8 +1,11 @@
 // Benchmark of flow-graph fire synthesis (issue 6, graph_fire_synthesis.txt §5.2, Table 1):
 // - synthesis per step at 3,200 pathlines per node with L = 48 (issue: <= 1 ms; the paper's
-//   campfire, 3,217 pathlines per node: 35 ms), with a uniform and with a field u_ext, and the
-//   gather of all live particles (positions, density, temperature) a frame's output needs, and
-//   the read of one node from a pathline file (float32 and float16);
+//   campfire, 3,217 pathlines per node: 35 ms), with a uniform and with a field u_ext (the
+//   emitted group prepared at every step), and the gather of all live particles (positions,
+//   density, temperature) a frame's output needs, and the read of one node from a pathline file
+//   (float32 and float16);
+// - a node step of the walk (step_node) emitting a node from the cache of prepared groups (a
+//   hit: O(1)) and one read from its file and prepared (a miss, no cache);
 // - VDB rasterization of those ~150k particles per frame, timed separately;
 // - the pathline recorder's cost per solver step of a 64³ fire bake (3,200 seeds, L = 48).
 // Run: build/native/plume_bench_flowgraph
@@ -20,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace plume {
@@ -103,31 +107,54 @@ void BM_SynthesisGather(benchmark::State& state) {
   state.counters["particles"] = double(out.size());
 }
 
-/// Reading one node from a pathline file (the synthesis streams one per step): the block read,
-/// its checksum and the decoding; Arg: 0 float32, 1 float16.
-void BM_PathlineReadGroup(benchmark::State& state) {
-  const bool half = state.range(0) != 0;
-  const std::string path = std::string("/tmp/plume_bench_pathlines") + (half ? "16" : "32") + ".bin";
-  PathlineFileInfo info;
-  info.layout = groups()[0].layout;
-  info.resolution = glm::ivec3(128, 64, 64);
-  info.cellSize = 1.f / 64.f;
-  info.float16 = half;
-  {
-    PathlineFileWriter w(path, info);
-    for (int k = 0; k < 8; ++k) {
-      PathlineGroup g = groups()[std::size_t(k)];
-      g.step = k;
-      w.append(g);
-    }
+/// The 8 groups in a pathline file (removed at exit); half: float16 samples.
+class BenchFile {
+ public:
+  explicit BenchFile(bool half)
+      : mPath(std::string("/tmp/plume_bench_pathlines") + (half ? "16" : "32") + ".bin") {
+    PathlineFileInfo info;
+    info.layout = groups()[0].layout;
+    info.resolution = glm::ivec3(128, 64, 64);
+    info.cellSize = 1.f / 64.f;
+    info.float16 = half;
+    PathlineFileWriter w(mPath, info);
+    for (const PathlineGroup& g : groups()) w.append(g);
     w.finish();
+    mFile = std::make_unique<PathlineFile>(PathlineFile::open(mPath));
   }
-  const PathlineFile file = PathlineFile::open(path);
+  ~BenchFile() { std::remove(mPath.c_str()); }
+  const PathlineFile& file() const { return *mFile; }
+
+ private:
+  std::string mPath;
+  std::unique_ptr<PathlineFile> mFile;
+};
+
+/// Reading one node from a pathline file (a cache miss of the synthesis): the block read, its
+/// checksum and the decoding; Arg: 0 float32, 1 float16.
+void BM_PathlineReadGroup(benchmark::State& state) {
+  const BenchFile bench(state.range(0) != 0);
   PathlineGroup g;
   int k = 0;
-  for (auto _ : state) file.readGroup(k++ % 8, g);
-  state.counters["bytes_per_node"] = double(file.bytesPerNode());
-  std::remove(path.c_str());
+  for (auto _ : state) bench.file().readGroup(k++ % 8, g);
+  state.counters["bytes_per_node"] = double(bench.file().bytesPerNode());
+}
+
+/// One node step of the walk, step_node() on a full ring with a uniform wind, cycling over the
+/// 8 nodes of a float32 file. Args: threads (0: all), cache: 1 every node is in the cache of
+/// prepared groups (hits: nothing read, nothing copied), 0 no cache (every step reads its node
+/// from the file and prepares it).
+void BM_SynthesisStepNode(benchmark::State& state) {
+  const BenchFile bench(false);
+  const bool cached = state.range(1) != 0;
+  Synthesizer s(groups()[0].layout, int(state.range(0)), cached ? std::size_t(1) << 30 : 0);
+  int n = 0;
+  for (; n < 2 * kSamples; ++n) s.stepNode(bench.file(), n % 8, 0, glm::vec3(0.2f, 0.f, 0.f));
+  const long long misses = s.cache().misses(), hits = s.cache().hits();
+  for (auto _ : state) s.stepNode(bench.file(), n++ % 8, 0, glm::vec3(0.2f, 0.f, 0.f));
+  state.counters["particles"] = double(s.particleCount());
+  state.counters["hit_share"] = double(s.cache().hits() - hits) /
+                                double(s.cache().hits() - hits + s.cache().misses() - misses);
 }
 
 void BM_FireRasterFrame(benchmark::State& state) {
@@ -209,6 +236,9 @@ void BM_RecorderPerSolverStep64(benchmark::State& state) {
 BENCHMARK(plume::BM_SynthesisStepUniformWind)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(plume::BM_SynthesisStepFieldWind)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(plume::BM_SynthesisGather)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_SynthesisStepNode)
+    ->ArgNames({"threads", "cache"})->Args({1, 1})->Args({1, 0})->Args({0, 1})->Args({0, 0})
+    ->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(plume::BM_PathlineReadGroup)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(plume::BM_FireRasterFrame)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(plume::BM_RecorderPerSolverStep64)->Arg(1)->Arg(0)->Iterations(6)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -82,6 +82,21 @@ struct ParticleArrays {
   }
 };
 
+/// Calls f(u) with the GIL released, u the external velocity `ext`: None (zero), (ux, uy, uz)
+/// or a VelocityField.
+template <typename F>
+void withExternalVelocity(const py::object& ext, const F& f) {
+  if (py::isinstance<GridVelocityField>(ext)) {
+    const GridVelocityField& field = ext.cast<const GridVelocityField&>();
+    py::gil_scoped_release release;
+    f(field);
+  } else {
+    const glm::vec3 u = ext.is_none() ? glm::vec3(0.f) : vec3Arg(ext, "external_velocity");
+    py::gil_scoped_release release;
+    f(u);
+  }
+}
+
 py::dict rasterStats(const FireGrids& g) {
   py::dict d;
   d["voxels"] = g.density->activeVoxelCount();
@@ -229,33 +244,37 @@ void bindSynthesizer(py::module_& m) {
       "Synthesis by eq. 13 (§5.2): each step, live particles move by their own pathline's "
       "velocity samples (trapezoid) plus u_ext and age by one, those at the end of their lifetime "
       "(L samples) are removed, then the visited node emits its particles at their start positions.");
-  s.def(py::init<const PathlineLayout&, int>(), py::arg("layout"), py::arg("threads") = 0);
-  auto step = [](Synthesizer& syn, const PathlineGroup& g, const py::object& ext) {
-    if (py::isinstance<GridVelocityField>(ext)) {
-      const GridVelocityField& field = ext.cast<const GridVelocityField&>();
-      py::gil_scoped_release release;
-      syn.step(g, field);
-    } else {
-      const glm::vec3 u = ext.is_none() ? glm::vec3(0.f) : vec3Arg(ext, "external_velocity");
-      py::gil_scoped_release release;
-      syn.step(g, u);
-    }
-  };
-  s.def("step", step, py::arg("group"), py::arg("external_velocity") = py::none(),
-        "One step emitting `group`; external_velocity: None, (ux, uy, uz) m/s constant over the "
-        "step, or a VelocityField. ValueError when the group's layout differs.");
+  s.def(py::init([](const PathlineLayout& layout, int threads, std::size_t cacheBytes) {
+          return std::make_unique<Synthesizer>(layout, threads, cacheBytes);
+        }),
+        py::arg("layout"), py::arg("threads") = 0, py::arg("cache_bytes") = 0,
+        "cache_bytes: budget of the least-recently-used cache of prepared groups step_node() keeps "
+        "between visits (0: every visit reads its file). ValueError on a bad layout or threads < 0.");
+  s.def(
+      "step",
+      [](Synthesizer& syn, const PathlineGroup& g, const py::object& ext) {
+        withExternalVelocity(ext, [&](const auto& u) { syn.step(g, u); });
+      },
+      py::arg("group"), py::arg("external_velocity") = py::none(),
+      "One step emitting `group`; external_velocity: None, (ux, uy, uz) m/s constant over the "
+      "step, or a VelocityField. ValueError when the group's layout differs.");
   s.def(
       "step_node",
-      [step](Synthesizer& syn, const PathlineFile& file, int node, int state, const py::object& ext) {
-        PathlineGroup g;
-        {
-          py::gil_scoped_release release;
-          file.readGroup(node, g, state);
-        }
-        step(syn, g, ext);
+      [](Synthesizer& syn, const PathlineFile& file, int node, int state, const py::object& ext) {
+        withExternalVelocity(ext, [&](const auto& u) { syn.stepNode(file, node, state, u); });
       },
       py::arg("file"), py::arg("node"), py::arg("state") = 0, py::arg("external_velocity") = py::none(),
-      "step() with node `node` read from a pathline file.");
+      "step() emitting node `node` of `file` (the pathline file of state `state`): from the cache "
+      "of prepared groups (a hit, no copy) or read from the file (a miss, then cached). Keep one "
+      "file per state: (state, node) is the cache key. Same particles with or without the cache.");
+  s.def_property_readonly("cache_hits", [](const Synthesizer& syn) { return syn.cache().hits(); },
+                          "step_node() calls that found their group in the cache.");
+  s.def_property_readonly("cache_misses", [](const Synthesizer& syn) { return syn.cache().misses(); },
+                          "step_node() calls that read their group from its file.");
+  s.def_property_readonly("cache_bytes", [](const Synthesizer& syn) { return syn.cache().bytes(); },
+                          "Bytes of prepared groups held by the cache (<= cache_budget).");
+  s.def_property_readonly("cache_budget", [](const Synthesizer& syn) { return syn.cache().budget(); });
+  s.def_property_readonly("cached_groups", [](const Synthesizer& syn) { return syn.cache().size(); });
   s.def_property_readonly("layout", &Synthesizer::layout);
   s.def_property_readonly("steps", &Synthesizer::steps);
   s.def_property_readonly("time", &Synthesizer::time, "Synthesis time of the particles, s.");

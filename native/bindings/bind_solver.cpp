@@ -24,6 +24,7 @@ namespace plume::bindings {
 namespace {
 
 using FArray = py::array_t<float, py::array::f_style | py::array::forcecast>;
+using CArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
 // --- small conversions -------------------------------------------------------------------
 
@@ -337,6 +338,45 @@ void bindSmokeSolver(py::module_& m) {
       py::arg("wind"),
       "Per-cell wind velocity u_wind, shape (nx, ny, nz, 3), replacing the constant `wind`; "
       "None restores the constant.");
+  c.def(
+      "set_point_emitters",
+      [](SmokeSolver& s, const CArray& positions, const CArray& radii, const CArray& rates,
+         const CArray& velocities, const CArray& temperatures) {
+        const py::ssize_t count = positions.ndim() == 2 ? positions.shape(0) : 0;
+        const auto rows = [count](const CArray& a, const char* name) {
+          if (a.ndim() != 2 || a.shape(0) != count || a.shape(1) != 3)
+            throw py::value_error(std::string(name) + " must have shape (N, 3) with N = " +
+                                  std::to_string(count) + ", got " + shapeText(a));
+        };
+        const auto column = [count](const CArray& a, const char* name) {
+          if (a.ndim() != 1 || a.shape(0) != count)
+            throw py::value_error(std::string(name) + " must have shape (N,) with N = " +
+                                  std::to_string(count) + ", got " + shapeText(a));
+        };
+        rows(positions, "positions");
+        column(radii, "radii");
+        column(rates, "density_rates");
+        rows(velocities, "velocities");
+        column(temperatures, "temperatures");
+        std::vector<PointEmitter> emitters(static_cast<std::size_t>(count));
+        for (py::ssize_t n = 0; n < count; ++n) {
+          PointEmitter& e = emitters[std::size_t(n)];
+          for (int a = 0; a < 3; ++a) {
+            e.position[a] = positions.at(n, a);
+            e.velocity[a] = velocities.at(n, a);
+          }
+          e.radius = radii.at(n);
+          e.densityRate = rates.at(n);
+          e.temperature = temperatures.at(n);
+        }
+        s.setPointEmitters(std::move(emitters));
+      },
+      py::arg("positions"), py::arg("radii"), py::arg("density_rates"), py::arg("velocities"),
+      py::arg("temperatures"),
+      "Replaces the point emitters (structural_flames.txt §6.3 smoke): centres (N, 3) m, sphere "
+      "radii (N,) m (at least one cell is used), mass rates (N,) in density x m^3 per second, "
+      "face velocities (N, 3) m/s, temperatures (N,) above ambient. Applied every step until "
+      "replaced or clear_emitters(); ValueError on bad shapes or values.");
 
   c.def("advance_frame", [](SmokeSolver& s) { return s.advanceFrame(); }, py::call_guard<py::gil_scoped_release>(),
         "Advances one frame (substeps, more if the CFL condition needs them). Releases the GIL. "

@@ -30,6 +30,14 @@ void bindFlowgraphSynth(pybind11::module_& m);
 /// Flow graph: FlowGraphParams, cost_matrix, FlowGraph, RandomWalk, cost_matrix_image
 /// (bind_flowgraph_graph.cpp).
 void bindFlowgraphGraph(pybind11::module_& m);
+/// Flame bake helpers: mesh_signed_distance for obstacles (bind_flames_bake.cpp).
+void bindFlamesBake(pybind11::module_& m);
+/// Structural flames, structure: FlameParams, FlameSource, wind fields, obstacle SDFs,
+/// FlameSystem, Spine, spine_resample (bind_flames_structure.cpp).
+void bindFlamesStructure(pybind11::module_& m);
+/// Structural flames, shape and render: FlameProfile, FlameCamera, FlameShaper, write_flames_vdb
+/// (bind_flames_shape.cpp).
+void bindFlamesShape(pybind11::module_& m);
 
 /// A path argument given as str or os.PathLike, as a std::string (needs the GIL).
 inline std::string pathArg(const pybind11::object& path) {

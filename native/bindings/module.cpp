@@ -47,4 +47,7 @@ PYBIND11_MODULE(_native, m) {
   plume::bindings::bindPathlineGroup(m);
   plume::bindings::bindFlowgraphSynth(m);
   plume::bindings::bindFlowgraphGraph(m);
+  plume::bindings::bindFlamesBake(m);
+  plume::bindings::bindFlamesStructure(m);
+  plume::bindings::bindFlamesShape(m);
 }

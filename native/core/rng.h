@@ -3,6 +3,7 @@
 /// Explicitly seeded random numbers: every random choice in Plume comes from one of these, so
 /// the same settings and seed give the same result at any thread count.
 
+#include <cmath>
 #include <cstdint>
 
 namespace plume {
@@ -25,6 +26,12 @@ class Rng {
   double uniform() { return double(next() >> 11) * (1.0 / 9007199254740992.0); }
   /// Uniform in [a, b).
   double uniform(double a, double b) { return a + (b - a) * uniform(); }
+  /// Standard normal N(0, 1) (Box–Muller, two uniforms per draw: no cached state, so the
+  /// sequence depends only on the seed and the number of draws).
+  double normal() {
+    const double u1 = 1.0 - uniform(), u2 = uniform();  // u1 in (0, 1]: log(u1) finite
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+  }
 
  private:
   std::uint64_t mState;

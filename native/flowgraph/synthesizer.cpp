@@ -1,11 +1,13 @@
 #include "flowgraph/synthesizer.h"
 
 #include "core/parallel.h"
+#include "io/pathline_file.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace plume {
 namespace {
@@ -15,8 +17,8 @@ constexpr int kChunk = 512;
 
 }  // namespace
 
-Synthesizer::Synthesizer(const PathlineLayout& layout, int threads)
-    : mLayout(layout), mThreads(threads) {
+Synthesizer::Synthesizer(const PathlineLayout& layout, int threads, std::size_t cacheBytes)
+    : mLayout(layout), mThreads(threads), mCache(cacheBytes) {
   if (layout.particles < 1)
     throw std::invalid_argument("synthesis needs pathline groups of >= 1 particle (got " +
                                 std::to_string(layout.particles) + ")");
@@ -51,14 +53,62 @@ void Synthesizer::step(const PathlineGroup& emitted, glm::vec3 externalVelocity)
   checkGroup(emitted);
   ThreadLimit limit(mThreads);
   advance(externalVelocity, nullptr);
-  emit(emitted);
+  emit(prepare(emitted));
 }
 
 void Synthesizer::step(const PathlineGroup& emitted, const ExternalVelocity& field) {
   checkGroup(emitted);
   ThreadLimit limit(mThreads);
   advance(glm::vec3(0.f), &field);
-  emit(emitted);
+  emit(prepare(emitted));
+}
+
+void Synthesizer::stepNode(const PathlineFile& file, int node, int state, glm::vec3 externalVelocity) {
+  std::shared_ptr<const PreparedGroup> cached = findOrRead(file, node, state);
+  ThreadLimit limit(mThreads);
+  advance(externalVelocity, nullptr);
+  emitNode(std::move(cached));
+}
+
+void Synthesizer::stepNode(const PathlineFile& file, int node, int state, const ExternalVelocity& field) {
+  std::shared_ptr<const PreparedGroup> cached = findOrRead(file, node, state);
+  ThreadLimit limit(mThreads);
+  advance(glm::vec3(0.f), &field);
+  emitNode(std::move(cached));
+}
+
+std::shared_ptr<const PreparedGroup> Synthesizer::findOrRead(const PathlineFile& file, int node, int state) {
+  std::shared_ptr<const PreparedGroup> cached = mCache.find(state, node);
+  if (!cached) {
+    file.readGroup(node, mRead, state);
+    checkGroup(mRead);
+  }
+  return cached;
+}
+
+void Synthesizer::emitNode(std::shared_ptr<const PreparedGroup> cached) {
+  if (!cached) {
+    cached = prepare(mRead);
+    mCache.insert(cached);
+  }
+  emit(std::move(cached));
+}
+
+void Synthesizer::recycle(std::shared_ptr<const PreparedGroup>&& g) {
+  // Every prepared group is made non-const by prepare(); one no slot and no cache entry
+  // references any more may be written again.
+  if (g && g.use_count() == 1) mSpare = std::const_pointer_cast<PreparedGroup>(std::move(g));
+  g.reset();
+}
+
+std::shared_ptr<const PreparedGroup> Synthesizer::prepare(const PathlineGroup& g) {
+  // The slot emit() fills holds the group whose lifetime advance() ended: its buffers are free
+  // unless the cache or a younger slot shares them. So no allocation once the ring is full.
+  recycle(std::move(slotOf(mSteps - 1).group));
+  std::shared_ptr<PreparedGroup> out = mSpare ? std::move(mSpare) : std::make_shared<PreparedGroup>();
+  mSpare.reset();
+  prepareGroup(g, *out);
+  return out;
 }
 
 void Synthesizer::advance(glm::vec3 uniform, const ExternalVelocity* field) {
@@ -93,7 +143,7 @@ void Synthesizer::advance(glm::vec3 uniform, const ExternalVelocity* field) {
     // Heun: e0 = u_ext(x_k, t_k), x* = x_k + Δx_path + h e0, e1 = u_ext(x*, t_k + h),
     // ∫ u_ext ≈ h (e0 + e1) / 2.
     glm::vec3 x[kChunk] = {}, u0[kChunk], u1[kChunk];
-    const glm::vec3* now = s.path.data() + age * std::size_t(P) + std::size_t(begin);
+    const glm::vec3* now = s.group->path.data() + age * std::size_t(P) + std::size_t(begin);
     const glm::vec3* next = now + P;
     glm::vec3* offset = s.fieldOffset.data() + begin;
     for (int m = 0; m < n; ++m) x[m] = now[m] + s.uniformOffset + offset[m];
@@ -105,35 +155,13 @@ void Synthesizer::advance(glm::vec3 uniform, const ExternalVelocity* field) {
   ++mSteps;
 }
 
-void Synthesizer::emit(const PathlineGroup& g) {
-  const int L = mLayout.samples, P = mLayout.particles;
-  const float half = 0.5f * mLayout.sampleDt;
+void Synthesizer::emit(std::shared_ptr<const PreparedGroup> g) {
   Slot& s = slotOf(mSteps - 1);
+  recycle(std::move(s.group));
+  s.group = std::move(g);
   s.emittedAt = mSteps - 1;
   s.uniformOffset = glm::vec3(0.f);
   if (s.hasField) std::fill(s.fieldOffset.begin(), s.fieldOffset.end(), glm::vec3(0.f));
-  const std::size_t values = mLayout.values();
-  s.path.resize(values);  // allocates on the first L steps only
-  s.density.resize(values);
-  s.temperature.resize(values);
-  const int chunks = (P + kChunk - 1) / kChunk;
-  parallelFor(0, chunks, [&](int c) {
-    const int begin = c * kChunk, end = std::min(P, begin + kChunk);
-    // Particle-major samples in, sample-major out: gather() and the steps then stream.
-    for (int p = begin; p < end; ++p) {
-      const std::size_t row = std::size_t(p) * std::size_t(L);
-      const glm::vec3* u = g.velocity.data() + row;
-      glm::vec3 x = g.start[std::size_t(p)];
-      for (int a = 0; a < L; ++a) {
-        const std::size_t out = std::size_t(a) * std::size_t(P) + std::size_t(p);
-        s.path[out] = x;
-        s.density[out] = g.density[row + std::size_t(a)];
-        s.temperature[out] = g.temperature[row + std::size_t(a)];
-        // Eq. 13, pathline part, by the trapezoid rule between samples a and a + 1.
-        if (a + 1 < L) x += half * (u[a] + u[a + 1]);
-      }
-    }
-  });
 }
 
 void Synthesizer::gather(SynthParticles& out) const {
@@ -149,15 +177,16 @@ void Synthesizer::gather(SynthParticles& out) const {
   parallelFor(0, groups * chunks, [&](int task) {
     const int gi = task / chunks;
     const Slot& s = slotOf(first + gi);
+    const PreparedGroup& g = *s.group;
     const std::size_t age = std::size_t(mSteps - 1 - (first + gi));
     const int begin = (task % chunks) * kChunk, end = std::min(P, begin + kChunk);
     const std::size_t in = age * std::size_t(P), at = std::size_t(gi) * std::size_t(P);
     for (int p = begin; p < end; ++p) {
-      glm::vec3 x = s.path[in + std::size_t(p)] + s.uniformOffset;
+      glm::vec3 x = g.path[in + std::size_t(p)] + s.uniformOffset;
       if (s.hasField) x += s.fieldOffset[std::size_t(p)];
       out.positions[at + std::size_t(p)] = x;
-      out.density[at + std::size_t(p)] = s.density[in + std::size_t(p)];
-      out.temperature[at + std::size_t(p)] = s.temperature[in + std::size_t(p)];
+      out.density[at + std::size_t(p)] = g.density[in + std::size_t(p)];
+      out.temperature[at + std::size_t(p)] = g.temperature[in + std::size_t(p)];
     }
   });
 }

@@ -17,21 +17,29 @@
 /// Heun's method (trapezoid with an Euler predictor), also second order.
 ///
 /// Layout and cost. The pathline part of a particle's position does not depend on u_ext, so it
-/// is summed once when its group is emitted (sample-major arrays of positions, density and
-/// temperature per group, in a ring of L slots); what u_ext adds is kept apart: one vector per
-/// group for a uniform u_ext, one per particle once a field is used. A step with a uniform
-/// u_ext therefore costs the emission of one group (|Ω| L values) plus O(L); positions are
-/// formed (pathline part + external part) by gather(). No allocation once the ring is full;
-/// parallel over particles with fixed chunks, so results do not depend on the thread count.
+/// is summed once per group (prepared_group.h: sample-major positions, density and temperature)
+/// and the ring of L slots only references that immutable prepared group; what u_ext adds is
+/// kept per slot: one vector for a uniform u_ext, one per particle once a field is used. A step
+/// with a uniform u_ext therefore costs O(L) plus, for a node not in the cache of prepared
+/// groups (prepared_group_cache.h), its read and preparation (|Ω| L values); a cached node is
+/// emitted in O(1), and a node visited twice within L steps is shared by both slots. Positions
+/// are formed (pathline part + external part) by gather(). Parallel over particles with fixed
+/// chunks, so results do not depend on the thread count, nor on the cache.
 
 #include "flowgraph/pathline_group.h"
+#include "flowgraph/prepared_group.h"
+#include "flowgraph/prepared_group_cache.h"
 
 #include <glm/glm.hpp>
 
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace plume {
+
+class PathlineFile;
 
 /// An external velocity field u_ext(x, t) (§5.2: "velocity introduced by (optional) external
 /// forces, useful for fire deformation"), evaluated in batches.
@@ -56,8 +64,9 @@ struct SynthParticles {
 class Synthesizer {
  public:
   /// Every emitted group must have `layout` (|Ω| >= 1, L >= 2, Δt_n > 0: std::invalid_argument
-  /// otherwise). `threads`: worker threads (0: all cores).
-  explicit Synthesizer(const PathlineLayout& layout, int threads = 0);
+  /// otherwise). `threads`: worker threads (0: all cores). `cacheBytes`: budget of the cache of
+  /// prepared groups stepNode() keeps between visits (0: every visit reads its file).
+  explicit Synthesizer(const PathlineLayout& layout, int threads = 0, std::size_t cacheBytes = 0);
 
   const PathlineLayout& layout() const { return mLayout; }
 
@@ -69,6 +78,16 @@ class Synthesizer {
   void step(const PathlineGroup& emitted, glm::vec3 externalVelocity = glm::vec3(0.f));
   /// The same with u_ext(x, t) from a field (Heun's method per particle).
   void step(const PathlineGroup& emitted, const ExternalVelocity& field);
+
+  /// step() emitting node `node` of `file`, the pathline file of state `state`: taken from the
+  /// cache of prepared groups (a hit: O(1)) or read, prepared and cached (a miss). The same
+  /// particles as step(file.readGroup(node, state), ...). (state, node) is the cache key: use
+  /// one file per state for the synthesizer's life. Throws as readGroup() and step() do, before
+  /// anything changes.
+  void stepNode(const PathlineFile& file, int node, int state, glm::vec3 externalVelocity = glm::vec3(0.f));
+  void stepNode(const PathlineFile& file, int node, int state, const ExternalVelocity& field);
+  /// The cache stepNode() uses: its hits, misses (file reads) and bytes.
+  const PreparedGroupCache& cache() const { return mCache; }
 
   /// Steps taken. After step n (counting from 0) the particles are at synthesis time n Δt_n.
   long long steps() const { return mSteps; }
@@ -86,14 +105,21 @@ class Synthesizer {
  private:
   struct Slot {
     long long emittedAt = -1;
-    std::vector<glm::vec3> path;          ///< [age][particle]: start + Σ trapezoids (eq. 13 without u_ext)
-    std::vector<float> density, temperature;  ///< [age][particle]
-    glm::vec3 uniformOffset{0.f};         ///< ∫ of the uniform u_ext since emission
-    std::vector<glm::vec3> fieldOffset;   ///< ∫ of field u_ext since emission, per particle
+    std::shared_ptr<const PreparedGroup> group;  ///< eq. 13 without u_ext, shared, immutable
+    glm::vec3 uniformOffset{0.f};          ///< ∫ of the uniform u_ext since emission
+    std::vector<glm::vec3> fieldOffset;    ///< ∫ of field u_ext since emission, per particle
     bool hasField = false;
   };
   void advance(glm::vec3 uniform, const ExternalVelocity* field);
-  void emit(const PathlineGroup& g);
+  /// The group to emit at step `node` of `file`: cached, or read into mRead (nullptr: a miss).
+  std::shared_ptr<const PreparedGroup> findOrRead(const PathlineFile& file, int node, int state);
+  /// After advance(): prepares `g` into a buffer no longer referenced (or a new one).
+  std::shared_ptr<const PreparedGroup> prepare(const PathlineGroup& g);
+  /// After advance(): mRead prepared and cached when `cached` is null; emitted.
+  void emitNode(std::shared_ptr<const PreparedGroup> cached);
+  void emit(std::shared_ptr<const PreparedGroup> g);
+  /// Keeps `g` as the spare buffer of prepare() when nothing else references it.
+  void recycle(std::shared_ptr<const PreparedGroup>&& g);
   void checkGroup(const PathlineGroup& g) const;
   Slot& slotOf(long long emittedAt) { return mSlots[std::size_t(emittedAt % mLayout.samples)]; }
   const Slot& slotOf(long long emittedAt) const {
@@ -104,6 +130,9 @@ class Synthesizer {
   int mThreads;
   std::vector<Slot> mSlots;  ///< ring of L: the group emitted at step n lives in slot n mod L
   long long mSteps = 0;
+  PreparedGroupCache mCache;
+  PathlineGroup mRead;                   ///< buffers of stepNode()'s file reads
+  std::shared_ptr<PreparedGroup> mSpare;  ///< a prepared group no slot or cache references
 };
 
 }  // namespace plume

@@ -78,6 +78,7 @@ GridFrame SmokeSolver::gridFrame() const {
 
 void SmokeSolver::clearEmitters() {
   mSources.clear();
+  mPointEmitters.clear();
   if (!mObstacles.empty()) mCellTypesDirty = true;
   mObstacles.clear();
 }
@@ -92,6 +93,19 @@ void SmokeSolver::addObstacle(const CellSet& cells, Slip slip) {
   checkCells(cells, mDensity.count(), "obstacle");
   mObstacles.push_back({cells, slip});
   mCellTypesDirty = true;
+}
+
+void SmokeSolver::setPointEmitters(std::vector<PointEmitter> emitters) {
+  const glm::vec3 size = mParams.size();
+  const float longest = std::max({size.x, size.y, size.z});
+  for (const PointEmitter& e : emitters) {
+    e.validate();
+    if (e.radius > longest)
+      throw std::invalid_argument("point emitter: radius must be at most the domain's longest "
+                                  "side, " + std::to_string(longest) + " m (got " +
+                                  std::to_string(e.radius) + ")");
+  }
+  mPointEmitters = std::move(emitters);
 }
 
 void SmokeSolver::setWindField(const VectorGrid& wind) {
@@ -187,8 +201,13 @@ void SmokeSolver::step(float dt) {
   for (const auto& stage : kStages) (this->*stage.second)(dt);
 }
 
-void SmokeSolver::applySources(float /*dt*/) {
+void SmokeSolver::applySources(float dt) {
   const glm::ivec3 n = mParams.resolution;
+  if (!mPointEmitters.empty()) {
+    rebuildCellTypes();  // no smoke into the obstacles of this frame
+    emitPoints(mPointEmitters, gridFrame(), mParams.ambientTemperature,
+               mHasSolids ? &mCellTypes : nullptr, dt, mDensity, mTemperature, mVelocity);
+  }
   for (const Source& src : mSources) {
     const SourceSettings& s = src.settings;
     const float temperature = mParams.ambientTemperature + s.temperature;

@@ -7,6 +7,7 @@
 #include "core/mac_grid3.h"
 #include "solver/advection.h"
 #include "solver/emitters.h"
+#include "solver/point_emitters.h"
 #include "solver/pressure.h"
 #include "solver/smoke_params.h"
 
@@ -63,9 +64,13 @@ class SmokeSolver {
   GridFrame gridFrame() const;
 
   // --- Emitters of the coming frame ---
-  void clearEmitters();
+  void clearEmitters();  ///< sources, obstacles and point emitters
   void addSource(const CellSet& cells, const SourceSettings& settings);
   void addObstacle(const CellSet& cells, Slip slip);
+  /// Replaces the point emitters (structural_flames.txt §6.3 smoke) applied every step from now
+  /// on; validates each (std::invalid_argument), radius at most the domain's longest side.
+  void setPointEmitters(std::vector<PointEmitter> emitters);
+  const std::vector<PointEmitter>& pointEmitters() const { return mPointEmitters; }
   /// Per-cell wind velocity (cell-centred), replacing the constant params().wind; empty = constant.
   void setWindField(const VectorGrid& wind);
 
@@ -143,6 +148,7 @@ class SmokeSolver {
   FlagGrid mNoSlip;           ///< 1 where a solid cell belongs to a no-slip obstacle
   std::vector<Source> mSources;
   std::vector<Obstacle> mObstacles;
+  std::vector<PointEmitter> mPointEmitters;
   bool mCellTypesDirty = true;
   bool mHasSolids = false;  ///< some cell is solid (else the boundary stages take a fast path)
   PressureSolver mPressureSolver;

@@ -102,6 +102,31 @@ def test_temporal_walk_and_external_velocity(tmp_path):
         still.step(wrong)
 
 
+def test_step_node_cache_only_saves_reads(tmp_path):
+    """step_node() through the cache of prepared groups: the same particles as step() with each
+    group read anew, hits and misses counted, the cache within its budget."""
+    path, _, _ = recorded_bake(tmp_path)
+    f = _native.PathlineFile.open(path)
+    walk = [0, 1, 2, 3, 1, 2, 3, 4, 5, 2, 2, 6]  # revisits, one within a lifetime of L steps
+    group_bytes = f.layout.particles * f.layout.samples * 20  # path 12 B + density + temperature
+    cached = _native.Synthesizer(f.layout, cache_bytes=3 * group_bytes)
+    copies = _native.Synthesizer(f.layout)
+    for n, k in enumerate(walk):
+        wind = (0.1 * n, 0.0, 0.0)
+        cached.step_node(f, k, 0, wind)
+        copies.step(f.read_group(k), wind)
+        assert cached.cache_bytes <= cached.cache_budget == 3 * group_bytes
+    a, b = cached.particles(), copies.particles()
+    for name in ("positions", "density", "temperature"):
+        np.testing.assert_array_equal(a[name], b[name])
+    assert cached.cache_hits + cached.cache_misses == len(walk)
+    assert cached.cache_hits == 4 and cached.cache_misses == 8  # LRU of 3: 1, 2, 3, 2 hit
+    assert cached.cached_groups == 3
+    assert copies.cache_misses == 0  # step() does not use the cache
+    with pytest.raises(IndexError):
+        cached.step_node(f, f.node_count)
+
+
 def test_rasterized_frame_vdb(tmp_path):
     path, _, _ = recorded_bake(tmp_path)
     f = _native.PathlineFile.open(path)

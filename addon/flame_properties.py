@@ -1,0 +1,182 @@
+"""Structural flames settings (structural_flames.txt): ``obj.plume.flame`` on a Flame Source and
+``scene.plume_flames`` for the whole bake, read frame by frame by plume.flames_bake, so every
+number is keyable. Soft limits only: the bake validates with messages naming the setting and its
+range (flames.validate_*)."""
+
+import bpy
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
+                       IntProperty, PointerProperty, StringProperty)
+
+PROFILE_ITEMS = (
+    ('CANDLE', "Candle", "Figure 3, left: a slim candle flame"),
+    ('TORCH', "Torch", "Figure 3, middle: a torch flame"),
+    ('CAMPFIRE', "Campfire", "Figure 3, right: a broad campfire flame"),
+    ('CUSTOM', "Custom Curve", "The profile r(s) drawn as a curve object (Profile Curve)"),
+)
+SPREAD_ITEMS = (
+    ('NONE', "Always Burning", "Every flame of the source burns from the first frame"),
+    ('MAPS', "Maps", "§6.2: greyscale images on the mesh's UVs give each flame's activation "
+                     "time (and optionally burn duration, intensity, diameter, height)"),
+    ('MODEL', "Spread Model", "§6.2 eq. 7: the flame front leaves the ignition point at "
+                              "v_s = T_f / L (cos θ + h sin θ)"),
+)
+
+
+def _image(name, what):
+    return PointerProperty(name=name, type=bpy.types.Image, description=what)
+
+
+class PlumeFlameSourceSettings(bpy.types.PropertyGroup):
+    # --- Shape (§4.4, §5.1) ---
+    profile: EnumProperty(name="Profile", items=PROFILE_ITEMS, default='CANDLE',
+                          description="§4.4, Figure 3: the normalized profile r(s) whose surface "
+                                      "of revolution around the spine is the visible flame")
+    profile_curve: PointerProperty(
+        name="Profile Curve", type=bpy.types.Object, poll=lambda _s, ob: ob.type == 'CURVE',
+        description="Custom profile (§4.4): the first spline of this curve, drawn from the base "
+                    "to the tip; local X is the radius, the longer of local Y and Z the height")
+    color_image: _image("Colour Image", "§5.1: a reference photograph mapped on the 2D profile "
+                                        "gives each particle its base colour (none: white)")
+    flames: IntProperty(
+        name="Flames", default=1, soft_min=1, soft_max=64,
+        description="Flames on this source: 1 at the centre of its up-facing faces, more spread "
+                    "evenly over them (area-weighted, deterministic); in [1, 1024]")
+    radius: FloatProperty(
+        name="Radius (r)", default=0.01, soft_min=0.001, soft_max=1.0, unit='LENGTH',
+        precision=4, description="r: radius of each flame's source (m): the profile's width and "
+                                 "the breakaway frequency f = 0.50 (g/2r)^½ (§4.3); > 0")
+    intensity: FloatProperty(name="Intensity (I)", default=1.0, soft_min=0.0, soft_max=10.0,
+                             description="I of eq. 4: density of the flame's light; >= 0")
+    temperature: FloatProperty(
+        name="Temperature (T_p)", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="T_p of eq. 1-2 (normalized, ambient T_0 = 0): scales the Brownian "
+                    "diffusion and the buoyancy of the spine's points; >= 0")
+    # --- Spread (§6.2) ---
+    spread: EnumProperty(name="Spread", items=SPREAD_ITEMS, default='NONE',
+                         description="§6.2: when each flame of the source starts to burn")
+    activation_map: _image("Activation Map", "§6.2: greyscale on the UVs; value v starts the "
+                                              "flame there at v × Time Scale seconds")
+    time_scale: FloatProperty(name="Time Scale", default=2.0, soft_min=0.0, soft_max=60.0,
+                              unit='TIME_ABSOLUTE',
+                              description="Seconds for an activation-map value of 1; >= 0")
+    duration_map: _image("Duration Map", "§6.2: greyscale; the flame burns v × Duration Scale "
+                                          "seconds (none: until the end)")
+    duration_scale: FloatProperty(name="Duration Scale", default=5.0, soft_min=0.0,
+                                  soft_max=60.0, unit='TIME_ABSOLUTE',
+                                  description="Seconds of burning for a duration value of 1")
+    intensity_map: _image("Intensity Map", "§6.2: greyscale; multiplies the flame's intensity")
+    diameter_map: _image("Diameter Map", "§6.2: greyscale; multiplies the flame's radius r")
+    height_map: _image("Height Map", "§6.2: greyscale; multiplies H_p, H_i and H_max")
+    ignition: PointerProperty(
+        name="Ignition", type=bpy.types.Object,
+        description="Spread model: where the fire starts (none: the source's origin)")
+    spread_temperature: FloatProperty(
+        name="Flame Temperature (T_f)", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="T_f of eq. 7 (v_s = T_f / L (cos θ + h sin θ)); > 0")
+    spread_thickness: FloatProperty(
+        name="Thermal Thickness (L)", default=10.0, soft_min=0.01, soft_max=1000.0,
+        description="L of eq. 7: thermal thickness of the burning material (larger: slower "
+                    "spread); > 0")
+
+
+class PlumeFlamesSettings(bpy.types.PropertyGroup):
+    # --- Bake ---
+    frame_start: IntProperty(name="Start", default=1, description="First baked frame")
+    frame_end: IntProperty(name="End", default=48, description="Last baked frame")
+    seed: IntProperty(name="Seed", default=0, soft_min=0,
+                      description="Seed of every random choice: same seed, same flames")
+    substeps: IntProperty(name="Substeps", default=2, soft_min=1, soft_max=16,
+                          description="Steps of eq. 1 per frame (§4.1); in [1, 64]")
+    # --- Structure (§4.1-4.3) ---
+    points: IntProperty(name="Control Points (n)", default=16, soft_min=2, soft_max=64,
+                        description="n: points of a flame's spine (§4.1); in [2, 256]")
+    height_persistent: FloatProperty(
+        name="Persistent Height (H_p)", default=0.03, soft_min=0.0, soft_max=10.0,
+        unit='LENGTH', description="H_p: top of the continuous region (Figure 2, §4.3); "
+                                   "0 <= H_p < H_i")
+    height_intermittent: FloatProperty(
+        name="Intermittent Height (H_i)", default=0.06, soft_min=0.0, soft_max=10.0,
+        unit='LENGTH', description="H_i: top of the intermittent region; longer flames may "
+                                   "flicker or break (§4.3); H_p < H_i <= H_max")
+    height_max: FloatProperty(
+        name="Max Height (H_max)", default=0.12, soft_min=0.0, soft_max=20.0, unit='LENGTH',
+        description="H_max: artistic limit on flame length, D(h) = 1 past it (§4.3); >= H_i")
+    lifespan_scale: FloatProperty(
+        name="Lifespan Scale (A)", default=0.25, soft_min=1.0 / 24.0, soft_max=2.0,
+        unit='TIME_ABSOLUTE', description="A: a separated flame lives A·i³, i uniform in [0,1] "
+                                          "(§4.3); in [1/24, 2] s")
+    breakaway_frequency: FloatProperty(
+        name="Breakaway Frequency (f)", default=0.0, soft_min=0.0, soft_max=50.0,
+        description="f: breakaway rate past H_i in Hz (§4.3); 0 = automatic, 0.50 (g/2r)^½")
+    buoyancy: FloatProperty(name="Buoyancy (β)", default=0.5, soft_min=0.0, soft_max=10.0,
+                            description="β of eq. 2: thermal buoyancy c = β |g| (T_p − T_0) t_p; "
+                                        "in [0, 100]")
+    diffusion: FloatProperty(
+        name="Diffusion", default=1e-4, soft_min=0.0, soft_max=0.01, precision=5,
+        description="d(T_p) of eq. 1: Brownian diffusion coefficient (m²/s) scaled by T_p; "
+                    "in [0, 10]")
+    # --- Shape and detail (§4.4-4.5) ---
+    particles_per_pixel: FloatProperty(
+        name="Particles per Pixel", default=10.0, soft_min=0.1, soft_max=100.0,
+        description="§5.3: particles per pixel of the flame's projected area on the scene "
+                    "camera (the paper: about ten); > 0")
+    max_particles: IntProperty(name="Max Particles", default=50000, soft_min=100,
+                               soft_max=1000000,
+                               description="Most particles per flame (the paper: 1,000 to 50,000)")
+    merging: BoolProperty(name="Merging", default=True,
+                          description="§4.5: drop particles inside a neighbouring flame and "
+                                      "outside their own (flames appear to merge)")
+    flow_noise: FloatProperty(name="Flow Noise", default=0.15, soft_min=0.0, soft_max=1.0,
+                              description="§4.5: buoyancy (flow) noise amplitude, in widest "
+                                          "radii of the profile; 0 turns it off")
+    kolmogorov: FloatProperty(name="Kolmogorov Noise", default=0.003, soft_min=0.0,
+                              soft_max=0.1, unit='LENGTH', precision=4,
+                              description="§4.5: RMS displacement of the Kolmogorov-spectrum "
+                                          "turbulence (m); 0 turns it off")
+    # --- Wind (§4.2, §6, §6.1) ---
+    wind: FloatVectorProperty(name="Wind", size=3, subtype='VELOCITY', unit='VELOCITY',
+                              default=(0.0, 0.0, 0.0),
+                              description="w of eq. 1: a uniform wind (m/s)")
+    use_force_fields: BoolProperty(
+        name="Force Fields", default=True,
+        description="Add the scene's Wind (Strength m/s along its Z), Vortex (tangential "
+                    "Strength m/s about its Z) and Turbulence (RMS Strength m/s, Size, Flow) "
+                    "force fields to w (falloff ignored)")
+    wind_domain: PointerProperty(
+        name="Wind Domain", type=bpy.types.Object,
+        poll=lambda _s, ob: getattr(ob, "plume", None) is not None and ob.plume.role == 'DOMAIN',
+        description="§6.1: a baked Plume domain whose velocity (where it holds smoke) adds to w, "
+                    "frame by frame (the paper used a 40³ solver around obstacles)")
+    use_obstacles: BoolProperty(
+        name="Obstacles", default=True,
+        description="§6.1: spine points are pushed out of the scene's Obstacle objects (closed "
+                    "meshes, voxelized at Voxel Size at the first frame)")
+    # --- Rendering (§5) ---
+    voxel_size: FloatProperty(name="Voxel Size", default=0.002, soft_min=0.0005, soft_max=0.1,
+                              unit='LENGTH', precision=4,
+                              description="Δx of the flame VDB grids (m); > 0")
+    temperature_scale: FloatProperty(
+        name="Temperature (K)", default=1500.0, soft_min=500.0, soft_max=4000.0,
+        description="Kelvin of the temperature grid where d = I: blackbody colour (§5.1-5.2)")
+    emission: FloatProperty(name="Emission", default=8.0, soft_min=0.0, soft_max=1000.0,
+                            description="Emission strength of the flame grid in the material")
+    heat_of_combustion: FloatProperty(
+        name="Heat of Combustion (H_c)", default=15.0, soft_min=1.0, soft_max=60.0,
+        description="H_c of eq. 5 in MJ/kg (15 wood, 48 gasoline)")
+    light_watts: FloatProperty(
+        name="Light Watts", default=1e5, soft_min=0.0, soft_max=1e12,
+        description="§5.2: a point light of radius h/3 per flame, of eq. 5's E × this (W). "
+                    "E = ½ k 0.3 m H_c 2 A_f r³ / h is tiny in SI units and grows as r^7 (about "
+                    "2e-8 for a 6 mm candle, 7e-5 for a 2 cm torch flame): the default gives a "
+                    "torch flame 7 W; raise it for candles (5e6 gives 0.1 W); 0: no lights")
+    cache_directory: StringProperty(
+        name="Cache", subtype='DIR_PATH', default="//plume_cache/flames/",
+        description="Folder of flames_####.vdb and spines_####.npz ('//' = next to the .blend)")
+    # --- Built data ---
+    volume_object: StringProperty(name="Volume Object", default="")
+    spines_object: StringProperty(name="Spines Object", default="")
+    frames_baked: IntProperty(name="Frames Baked", default=0, min=0)
+    summary: StringProperty(name="Summary", default="")
+
+
+classes = (PlumeFlameSourceSettings, PlumeFlamesSettings)

@@ -1,0 +1,206 @@
+"""Structural flames end to end (structural_flames.txt, issue 7), through the operators: a candle
+(1 flame, CANDLE profile) and a torch (5 flames, TORCH profile) bake 12 frames with
+plume.flames_bake; the VDBs hold the named grids, the spines curve has one spline per live flame
+through that flame's points, the lights exist with energy > 0, and Cycles renders the flames
+non-empty. Bad input (no flame source, n < 2, H_p >= H_i, a Custom profile with no curve, a
+missing image file) gives an error naming the setting and changes nothing.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_flames.py
+"""
+
+import os
+import sys
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (OUT_DIR, assert_reports_error, image_pixels, native,  # noqa: E402
+                     reset_scene, rmtree, run, select_only, temp_dir, tree_listing)
+
+FRAMES = 12
+GRIDS = {"density", "temperature", "flame", "color", "velocity"}
+
+
+def flame_scene(tmp, flames=1, profile='CANDLE'):
+    """A wick (candle) or a torch head as a Flame Source, a camera looking at it, black world."""
+    reset_scene()
+    scn = bpy.context.scene
+    if flames == 1:
+        bpy.ops.mesh.primitive_cylinder_add(radius=0.002, depth=0.01, location=(0, 0, 0.005))
+    else:
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.04, location=(0, 0, 0.0))
+    src = bpy.context.active_object
+    src.name = "Candle" if flames == 1 else "Torch"
+    bpy.ops.plume.role_set(role='FLAME_SOURCE')
+    fl = src.plume.flame
+    fl.profile, fl.flames = profile, flames
+    fl.radius = 0.006 if flames == 1 else 0.02
+    f = scn.plume_flames
+    f.frame_start, f.frame_end = 1, FRAMES
+    f.cache_directory = tmp + "/"
+    if flames == 1:
+        f.height_persistent, f.height_intermittent, f.height_max = 0.03, 0.05, 0.08
+        f.voxel_size = 0.001
+    else:
+        f.height_persistent, f.height_intermittent, f.height_max = 0.08, 0.16, 0.3
+        f.voxel_size = 0.003
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    scn.collection.objects.link(cam)
+    dist = 0.35 if flames == 1 else 1.0
+    cam.location = (0.0, -dist, 0.04 if flames == 1 else 0.12)
+    cam.rotation_euler = (np.pi / 2, 0.0, 0.0)
+    scn.camera = cam
+    r = scn.render
+    r.engine = 'CYCLES'
+    r.resolution_x, r.resolution_y, r.resolution_percentage = 120, 160, 100
+    scn.cycles.samples = 8
+    scn.cycles.use_denoising = False
+    if scn.world is None:
+        scn.world = bpy.data.worlds.new("World")
+    scn.world.use_nodes = True
+    scn.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
+    src.hide_render = True
+    select_only(src)
+    return src
+
+
+class FlamesTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = temp_dir("plume_flames_")
+
+    @classmethod
+    def tearDownClass(cls):
+        rmtree(cls.tmp)
+
+    def bake_and_check(self, name, flames):
+        folder = os.path.join(self.tmp, name)
+        flame_scene(folder, flames=flames, profile='CANDLE' if flames == 1 else 'TORCH')
+        scn = bpy.context.scene
+        t0 = time.perf_counter()
+        self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})
+        seconds = time.perf_counter() - t0
+        print(f"  {name}: {seconds / FRAMES:.3f} s/frame; {scn.plume_flames.summary}")
+        files = sorted(os.listdir(folder))
+        for frame in range(1, FRAMES + 1):
+            self.assertIn(f"flames_{frame:04d}.vdb", files)
+            self.assertIn(f"spines_{frame:04d}.npz", files)
+        self.assertFalse([n for n in files if n.endswith(".tmp")])
+        vdb = os.path.join(folder, f"flames_{FRAMES:04d}.vdb")
+        self.assertTrue(GRIDS <= set(native().vdb_grid_names(vdb)))
+        density = native().read_vdb_grid(vdb, "density")
+        self.assertGreater(float(np.asarray(density["values"]).max()), 0.0)
+        # The spines curve at the last frame: one spline per live flame through its points.
+        scn.frame_set(FRAMES)
+        from plume import flames as flames_mod
+        sp = flames_mod.read_spines(os.path.join(folder, f"spines_{FRAMES:04d}.npz"))
+        live = len(sp["ids"])
+        self.assertGreaterEqual(live, flames)  # every source has its attached flame
+        attached = sp["counts"][~sp["separated"]]
+        self.assertTrue(np.all(attached == scn.plume_flames.points))
+        curve = bpy.data.objects[scn.plume_flames.spines_object]
+        self.assertEqual(len(curve.data.splines), live)
+        start = 0
+        for spline, count in zip(curve.data.splines, sp["counts"]):
+            co = np.array([p.co[:3] for p in spline.points])
+            np.testing.assert_allclose(co, sp["points"][start:start + count], atol=1e-6)
+            start += count
+        # A spine rises from its source (buoyancy, eq. 2): the tip is above the base.
+        base, tip = sp["points"][0], sp["points"][sp["counts"][0] - 1]
+        self.assertGreater(tip[2], base[2] + 0.01)
+        # Lights (§5.2): one per live flame, radius h/3, energy of eq. 5 > 0.
+        lights = [o for o in scn.objects if o.type == 'LIGHT' and "plume_flame_light" in o]
+        on = [o for o in lights if o.data.energy > 0.0]
+        self.assertEqual(len(on), live)
+        self.assertTrue(all(o.data.shadow_soft_size > 0.0 for o in on))
+        # Render: the flames show.
+        out = os.path.join(OUT_DIR, "flames")
+        os.makedirs(out, exist_ok=True)
+        scn.render.filepath = os.path.join(out, f"{name}.png")
+        bpy.ops.render.render(write_still=True)
+        px = image_pixels(scn.render.filepath)[..., :3]
+        lit = float((px.max(axis=2) > 0.05).mean())
+        print(f"  {name} render: max {px.max():.3f}, lit pixels {lit * 100:.1f}%")
+        self.assertGreater(lit, 0.005)
+        return sp
+
+    def test_candle(self):
+        self.bake_and_check("candle", 1)
+
+    def test_torch(self):
+        sp = self.bake_and_check("torch", 5)
+        self.assertEqual(len(set(sp["sources"][~sp["separated"]])), 5)
+
+    def test_free(self):
+        folder = os.path.join(self.tmp, "free")
+        flame_scene(folder)
+        bpy.context.scene.plume_flames.frame_end = 2
+        self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})
+        self.assertEqual(bpy.ops.plume.flames_free(), {'FINISHED'})
+        self.assertEqual(tree_listing(folder), [])
+        self.assertIsNone(bpy.data.objects.get("Plume Flames"))
+        self.assertIsNone(bpy.data.objects.get("Plume Flame Spines"))
+
+    def test_placement(self):
+        """Flames are placed on the mesh's up-facing faces, apart, the same for a seed."""
+        from plume import flame_placement as place
+        reset_scene()
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0)
+        from plume.snapshot import mesh_arrays
+        v, t = mesh_arrays(bpy.context.active_object, bpy.context.evaluated_depsgraph_get())
+        v = v.astype(np.float64)
+        faces, bary = place.place_flames(v, t, 5, seed=3)
+        again = place.place_flames(v, t, 5, seed=3)
+        np.testing.assert_array_equal(faces, again[0])
+        pts = place.interpolate(v[t], faces, bary)
+        self.assertTrue(np.all(pts[:, 2] > 0.0))  # upper half
+        gaps = np.linalg.norm(pts[:, None] - pts[None], axis=2) + np.eye(5) * 9
+        self.assertGreater(gaps.min(), 0.3)
+        # The same places whatever order Blender lists the faces in (canonical order).
+        perm = np.random.default_rng(1).permutation(len(t))
+        a, b = t[place.canonical_order(t)], t[perm][place.canonical_order(t[perm])]
+        np.testing.assert_allclose(place.interpolate(v[a], *place.place_flames(v, a, 5, 3)),
+                                   place.interpolate(v[b], *place.place_flames(v, b, 5, 3)))
+        one = place.interpolate(v[t], *place.place_flames(v, t, 1, seed=0))[0]
+        self.assertGreater(one[2], 0.95)  # the top of the sphere
+
+    def test_bad_input(self):
+        folder = os.path.join(self.tmp, "bad")
+        src = flame_scene(folder)
+        scn = bpy.context.scene
+        f = scn.plume_flames
+        op = bpy.ops.plume.flames_bake
+
+        def state():
+            return (len(bpy.data.objects), len(bpy.data.volumes), len(bpy.data.curves),
+                    len(bpy.data.lights), tuple(tree_listing(self.tmp)))
+        f.points = 1
+        assert_reports_error(self, op, r"Control Points \(n\) must be in \[2, 256\]", state)
+        f.points = 16
+        f.height_persistent = f.height_intermittent
+        assert_reports_error(self, op, r"Persistent Height \(H_p.*below Intermittent Height",
+                             state)
+        f.height_persistent = 0.03
+        f.height_max = 0.01
+        assert_reports_error(self, op, r"Max Height \(H_max.*Intermittent Height", state)
+        f.height_max = 0.08
+        src.plume.flame.profile = 'CUSTOM'
+        assert_reports_error(self, op, r"'Candle'.*Profile Curve is empty", state)
+        src.plume.flame.profile = 'CANDLE'
+        img = bpy.data.images.new("Gone", 4, 4)
+        img.source = 'FILE'
+        img.filepath = os.path.join(self.tmp, "no_such_image.png")
+        src.plume.flame.color_image = img
+        assert_reports_error(self, op, r"'Candle'.*Colour Image 'Gone' cannot be read", state)
+        src.plume.flame.color_image = None
+        src.plume.role = 'NONE'
+        assert_reports_error(self, op, r"no Flame Source", state)
+
+
+if __name__ == "__main__":
+    run(FlamesTest)

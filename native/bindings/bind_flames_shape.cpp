@@ -1,0 +1,257 @@
+/// \file bind_flames_shape.cpp
+/// Structural flames, shape and render side (structural_flames.txt §4.4–4.5, §5): profiles,
+/// the camera, the shaper (samples, noises, mapping, merging, incandescence, lights) and the
+/// flame VDB. Flames are dicts: points (N, 3) base to tip, optional velocities (N, 3), ages (N,),
+/// radius, intensity, temperature, id, source, separated. Conversions and docstrings only;
+/// shaping and rasterization release the GIL.
+
+#include "bindings/bindings.h"
+
+#include "flames/flame_raster.h"
+#include "flames/flame_shape.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+
+namespace py = pybind11;
+
+namespace plume::bindings {
+namespace {
+
+using DoubleC = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using FloatC = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+/// An (N, k) array (ValueError naming `what` otherwise).
+DoubleC rowsArg(const py::handle& o, py::ssize_t k, const char* what) {
+  const DoubleC a = DoubleC::ensure(o);
+  if (!a || a.ndim() != 2 || a.shape(1) != k)
+    throw py::value_error(std::string(what) + " must be an array of shape (N, " + std::to_string(k) + ")");
+  return a;
+}
+
+Flame flameArg(const py::handle& h, std::size_t index) {
+  const py::dict d = py::reinterpret_borrow<py::dict>(h);
+  const std::string name = "flames[" + std::to_string(index) + "]";
+  if (!d.contains("points")) throw py::value_error(name + " needs 'points'");
+  const DoubleC x = rowsArg(d["points"], 3, (name + ".points").c_str());
+  const py::ssize_t n = x.shape(0);
+  Flame f;
+  f.points.resize(std::size_t(n));
+  for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].x = {x.at(k, 0), x.at(k, 1), x.at(k, 2)};
+  if (d.contains("velocities")) {
+    const DoubleC v = rowsArg(d["velocities"], 3, (name + ".velocities").c_str());
+    if (v.shape(0) != n) throw py::value_error(name + ".velocities must have one row per point");
+    for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].v = {v.at(k, 0), v.at(k, 1), v.at(k, 2)};
+  }
+  if (d.contains("ages")) {
+    const DoubleC a = DoubleC::ensure(d["ages"]);
+    if (!a || a.ndim() != 1 || a.shape(0) != n) throw py::value_error(name + ".ages must have shape (N,)");
+    for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].age = a.at(k);
+  }
+  f.radius = d.contains("radius") ? d["radius"].cast<double>() : 0.0;
+  if (d.contains("intensity")) f.intensity = d["intensity"].cast<double>();
+  if (d.contains("temperature")) f.temperature = d["temperature"].cast<double>();
+  f.id = d.contains("id") ? d["id"].cast<std::uint32_t>() : std::uint32_t(index + 1);
+  if (d.contains("source")) f.source = d["source"].cast<int>();
+  if (d.contains("separated")) f.separated = d["separated"].cast<bool>();
+  return f;
+}
+
+template <typename T>
+py::array_t<float> floatRows(const std::vector<T>& v, py::ssize_t k) {
+  py::array_t<float> a({py::ssize_t(v.size()), k});
+  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
+  return a;
+}
+
+template <typename T>
+py::array_t<T> flat(const std::vector<T>& v) {
+  py::array_t<T> a(py::ssize_t(v.size()));
+  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
+  return a;
+}
+
+glm::dvec3 vec3Arg(const py::object& o, const char* name) {
+  const auto v = o.cast<std::vector<double>>();
+  if (v.size() != 3) throw py::value_error(std::string(name) + " must hold 3 numbers");
+  return {v[0], v[1], v[2]};
+}
+
+ColorImage imageArg(const py::handle& o) {
+  const FloatC a = FloatC::ensure(o);
+  if (!a || a.ndim() != 3 || a.shape(2) != 3)
+    throw py::value_error("color images must be float arrays of shape (height, width, 3), row 0 at the bottom");
+  ColorImage image;
+  image.height = int(a.shape(0));
+  image.width = int(a.shape(1));
+  image.rgb.assign(a.data(), a.data() + a.size());
+  return image;
+}
+
+/// The particle arrays of a shape() result dict, for the rasterizer.
+FlameParticles particlesArg(const py::dict& d) {
+  FlameParticles p;
+  auto vec3s = [&](const char* key, std::vector<glm::vec3>& out) {
+    const FloatC a = FloatC::ensure(d[key]);
+    if (!a || a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string(key) + " must have shape (N, 3)");
+    out.resize(std::size_t(a.shape(0)));
+    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
+  };
+  auto floats = [&](const char* key, std::vector<float>& out) {
+    const FloatC a = FloatC::ensure(d[key]);
+    if (!a || a.ndim() != 1) throw py::value_error(std::string(key) + " must have shape (N,)");
+    out.assign(a.data(), a.data() + a.size());
+  };
+  vec3s("positions", p.positions);
+  vec3s("velocities", p.velocities);
+  vec3s("colors", p.colors);
+  floats("density", p.density);
+  floats("mass", p.mass);
+  const std::size_t n = p.positions.size();
+  if (p.velocities.size() != n || p.colors.size() != n || p.density.size() != n || p.mass.size() != n)
+    throw py::value_error("particle arrays must all have the same length");
+  return p;
+}
+
+}  // namespace
+
+void bindFlamesShape(py::module_& m) {
+  py::class_<FlameProfile> profile(m, "FlameProfile",
+                                   "Normalized flame profile r(s) (structural_flames §4.4, Figure 3).");
+  profile.def_static("library", [](const std::string& name) { return FlameProfile::library(profileShapeFromName(name)); },
+                     py::arg("name"), "'candle', 'torch' or 'campfire'; ValueError otherwise.");
+  profile.def_static(
+      "from_curve",
+      [](const py::object& points) {
+        const DoubleC a = rowsArg(points, 2, "points");
+        std::vector<glm::dvec2> p;
+        for (py::ssize_t k = 0; k < a.shape(0); ++k) p.push_back({a.at(k, 0), a.at(k, 1)});
+        return FlameProfile::fromCurve(p);
+      },
+      py::arg("points"), "From (radius, height) points base to tip (a Blender curve); ValueError on bad curves.");
+  profile.def("radius", &FlameProfile::radius, py::arg("s"), "r(s), max 1.");
+  profile.def_property_readonly("aspect", &FlameProfile::aspect, "Height / widest radius.");
+
+  py::class_<FlameCamera> camera(m, "FlameCamera", "Camera for sample counts (§5.3) and eq. 6's distance.");
+  camera.def(py::init([](const py::object& position, double focal, double sensor, int width, int height) {
+               FlameCamera c;
+               c.position = vec3Arg(position, "position");
+               c.focalLength = focal;
+               c.sensorWidth = sensor;
+               c.width = width;
+               c.height = height;
+               c.validate();
+               return c;
+             }),
+             py::arg("position"), py::arg("focal_length") = 50.0, py::arg("sensor_width") = 36.0,
+             py::arg("width") = 1920, py::arg("height") = 1080, "focal_length, sensor_width in mm.");
+
+  py::class_<FlameShaper> shaper(m, "FlameShaper",
+                                 "Shape stage of structural flames: eq. 4 samples, flow noise, Figure 4 mapping, "
+                                 "Kolmogorov noise, merging, eq. 5-6, lights.");
+  shaper.def(
+      py::init([](const std::vector<FlameProfile>& profiles, const py::object& images, std::uint64_t seed,
+                  double falloff, double cutoff, double ppp, int minCount, int maxCount, int fixedCount,
+                  double flowAmplitude, double flowScale, double flowFrequency, double flowRotation,
+                  double kAmplitude, double kScale, const py::object& kDrift, double kFrequency, int kResolution,
+                  double energyScale, double heat, double fuelArea, double width, bool merging, int threads) {
+        FlameShapeParams p;
+        p.seed = seed;
+        p.density.falloff = falloff;
+        p.density.cutoff = cutoff;
+        p.sampling.particlesPerPixel = ppp;
+        p.sampling.minParticles = minCount;
+        p.sampling.maxParticles = maxCount;
+        p.sampling.fixedCount = fixedCount;
+        p.flowNoise = {flowAmplitude, flowScale, flowFrequency, flowRotation};
+        p.kolmogorov.amplitude = kAmplitude;
+        p.kolmogorov.scale = kScale;
+        p.kolmogorov.drift = vec3Arg(kDrift, "kolmogorov_drift");
+        p.kolmogorov.frequency = kFrequency;
+        p.kolmogorov.resolution = kResolution;
+        p.incandescence = {energyScale, heat, fuelArea};
+        p.width = width;
+        p.merging = merging;
+        p.threads = threads;
+        std::vector<ColorImage> list;
+        if (!images.is_none())
+          for (const py::handle& h : images) list.push_back(imageArg(h));
+        py::gil_scoped_release release;
+        return std::make_unique<FlameShaper>(profiles, p, std::move(list));
+      }),
+      py::arg("profiles"), py::arg("images") = py::none(), py::arg("seed") = 0, py::arg("falloff") = 0.5,
+      py::arg("cutoff") = 2.0, py::arg("particles_per_pixel") = 10.0, py::arg("min_particles") = 64,
+      py::arg("max_particles") = 100000, py::arg("fixed_count") = 0, py::arg("flow_noise_amplitude") = 0.15,
+      py::arg("flow_noise_scale") = 0.8, py::arg("flow_noise_frequency") = 3.0, py::arg("flow_noise_rotation") = 0.5,
+      py::arg("kolmogorov_amplitude") = 0.01, py::arg("kolmogorov_scale") = 0.5,
+      py::arg("kolmogorov_drift") = py::make_tuple(0.0, 0.0, 0.5), py::arg("kolmogorov_frequency") = 0.5,
+      py::arg("kolmogorov_resolution") = 32, py::arg("energy_scale") = 1.0, py::arg("heat_of_combustion") = 15.0e6,
+      py::arg("fuel_area") = 0.0, py::arg("width") = 1.0, py::arg("merging") = true, py::arg("threads") = 0,
+      "profiles: flame f uses profiles[min(source, len-1)]; images: None, one, or one per profile, float "
+      "(height, width, 3) row 0 at the bottom. ValueError on bad settings.");
+  shaper.def(
+      "shape",
+      [](const FlameShaper& s, const py::list& flames, double time, const FlameCamera& camera) {
+        std::vector<Flame> list;
+        for (std::size_t k = 0; k < flames.size(); ++k) list.push_back(flameArg(flames[k], k));
+        FlameShapeFrame frame;
+        {
+          py::gil_scoped_release release;
+          s.shape(list, time, camera, frame);
+        }
+        const FlameParticles& p = frame.particles;
+        py::dict d;
+        d["positions"] = floatRows(p.positions, 3);
+        d["velocities"] = floatRows(p.velocities, 3);
+        d["colors"] = floatRows(p.colors, 3);
+        d["density"] = flat(p.density);
+        d["incandescence"] = flat(p.incandescence);
+        d["mass"] = flat(p.mass);
+        d["flame"] = flat(p.flame);
+        d["sampled"] = frame.sampled;
+        d["energy"] = frame.energy;
+        d["merged"] = frame.merged;
+        py::list lights;
+        for (const FlameLight& l : frame.lights) {
+          py::dict ld;
+          ld["flame_id"] = l.flameId;
+          ld["centre"] = py::make_tuple(l.centre.x, l.centre.y, l.centre.z);
+          ld["radius"] = l.radius;
+          ld["energy"] = l.energy;
+          ld["color"] = py::make_tuple(l.color.x, l.color.y, l.color.z);
+          lights.append(ld);
+        }
+        d["lights"] = lights;
+        return d;
+      },
+      py::arg("flames"), py::arg("time"), py::arg("camera"),
+      "dict: positions, velocities, colors (N, 3) float32; density (eq. 4), incandescence (eq. 6), mass (N,); "
+      "flame (N,) input index; sampled, energy (eq. 5) per flame; merged; lights [dict(flame_id, centre, "
+      "radius h/3, energy, color)].");
+
+  m.def(
+      "write_flames_vdb",
+      [](const py::object& path, const py::dict& particles, float voxelSize, const py::object& origin,
+         float temperatureScale, int frame, int threads) {
+        FlameRasterParams r;
+        r.voxelSize = voxelSize;
+        r.origin = glm::vec3(vec3Arg(origin, "origin"));
+        r.temperatureScale = temperatureScale;
+        r.threads = threads;
+        r.validate();
+        const FlameParticles p = particlesArg(particles);
+        return withPath(path, [&](const std::string& file) {
+          const FlameGrids grids = rasterizeFlames(p, r);
+          writeFlameVdb(file, grids, frame);
+          return std::size_t(grids.density->activeVoxelCount());
+        });
+      },
+      py::arg("path"), py::arg("particles"), py::arg("voxel_size"), py::arg("origin") = py::make_tuple(0, 0, 0),
+      py::arg("temperature_scale") = 1500.f, py::arg("frame") = 0, py::arg("threads") = 0,
+      "Rasterizes a FlameShaper.shape() result into grids density, temperature, flame, color, velocity and "
+      "writes them atomically; returns the active voxel count.");
+}
+
+}  // namespace plume::bindings

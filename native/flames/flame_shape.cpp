@@ -1,0 +1,246 @@
+/// \file flame_shape.cpp
+/// One frame of the shape stage: per-flame set-up, per-particle transforms in parallel chunks,
+/// merging, compaction in input order, lights.
+
+#include "flames/flame_shape.h"
+
+#include "core/huge_pages.h"
+#include "core/parallel.h"
+#include "flames/merging.h"
+#include "flames/spine_mapping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace plume {
+namespace {
+
+constexpr int kChunk = 2048;  ///< particles per parallel task
+
+/// A run of particles of one flame.
+struct Chunk {
+  int flame, begin, end;
+};
+
+std::string flameName(std::size_t f) { return "flame " + std::to_string(f); }
+
+void checkFlame(const Flame& flame, std::size_t f) {
+  if (flame.points.size() < 2) throw std::invalid_argument(flameName(f) + " needs at least 2 spine points");
+  if (!(flame.radius > 0.0) || !std::isfinite(flame.radius))
+    throw std::invalid_argument(flameName(f) + ": radius must be a finite number > 0 m");
+  if (!(flame.intensity >= 0.0) || !std::isfinite(flame.intensity))
+    throw std::invalid_argument(flameName(f) + ": intensity must be a finite number >= 0");
+  for (const SpinePoint& p : flame.points)
+    if (!std::isfinite(p.x.x + p.x.y + p.x.z + p.v.x + p.v.y + p.v.z + p.age))
+      throw std::invalid_argument(flameName(f) + ": spine points must be finite");
+}
+
+}  // namespace
+
+void FlameShapeParams::validate() const {
+  density.validate();
+  sampling.validate();
+  flowNoise.validate();
+  kolmogorov.validate();
+  incandescence.validate();
+  if (!(width > 0.0 && width <= 1000.0))
+    throw std::invalid_argument("width must be in (0, 1000] times the source radius (got " + std::to_string(width) + ")");
+  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all cores)");
+}
+
+void FlameParticles::resize(std::size_t n) {
+  // A dragon frame is ~80 MB: on huge pages its first touch is ~20× cheaper (core/huge_pages.h).
+  reserveHugePages(positions, n);
+  reserveHugePages(velocities, n);
+  reserveHugePages(colors, n);
+  reserveHugePages(density, n);
+  reserveHugePages(incandescence, n);
+  reserveHugePages(mass, n);
+  reserveHugePages(flame, n);
+  positions.resize(n);
+  velocities.resize(n);
+  colors.resize(n);
+  density.resize(n);
+  incandescence.resize(n);
+  mass.resize(n);
+  flame.resize(n);
+}
+
+FlameShaper::FlameShaper(const std::vector<FlameProfile>& profiles, const FlameShapeParams& params,
+                         std::vector<ColorImage> images)
+    : mParams(params), mImages(std::move(images)), mFlow(params.flowNoise, params.seed ^ 0xF10A5E11ull) {
+  params.validate();
+  if (profiles.empty()) throw std::invalid_argument("at least one flame profile is needed");
+  if (mImages.size() > 1 && mImages.size() != profiles.size())
+    throw std::invalid_argument("color images: give none, one, or one per profile (" +
+                                std::to_string(profiles.size()) + ")");
+  for (const ColorImage& image : mImages) image.validate();
+  for (const FlameProfile& p : profiles) mDensities.push_back(std::make_unique<ProfileDensity>(p, params.density));
+  mKolmogorov = std::make_unique<KolmogorovNoise>(params.kolmogorov, params.seed);
+}
+
+int FlameShaper::profileIndex(const Flame& flame) const {
+  return std::clamp(flame.source, 0, int(mDensities.size()) - 1);
+}
+
+const ProfileDensity& FlameShaper::density(int source) const {
+  return *mDensities[std::size_t(std::clamp(source, 0, int(mDensities.size()) - 1))];
+}
+
+FlameShapeFrame FlameShaper::shape(const std::vector<Flame>& flames, double time, const FlameCamera& camera) const {
+  FlameShapeFrame out;
+  shape(flames, time, camera, out);
+  return out;
+}
+
+void FlameShaper::shape(const std::vector<Flame>& flames, double time, const FlameCamera& camera,
+                        FlameShapeFrame& out) const {
+  camera.validate();
+  if (!std::isfinite(time)) throw std::invalid_argument("time must be finite");
+  for (std::size_t f = 0; f < flames.size(); ++f) checkFlame(flames[f], f);
+  ThreadLimit limit(mParams.threads);
+  const int count = int(flames.size());
+  const std::size_t nf = flames.size();
+  out.merged = out.obstructed = 0;
+  out.sampled.assign(nf, 0);
+  out.energy.assign(nf, 0.0);
+  out.lights.assign(nf, FlameLight{});
+  std::vector<std::unique_ptr<SpineFrame>> spines(nf);
+  std::vector<double> factor(nf), mass(nf);
+
+  // Per flame: spine frame, sample count, eq. 5 and the eq. 6 factor, the mass per particle.
+  parallelFor(0, count, [&](int f) {
+    const Flame& flame = flames[std::size_t(f)];
+    const ProfileDensity& density = *mDensities[std::size_t(profileIndex(flame))];
+    auto spine = std::make_unique<SpineFrame>(flame);
+    const double radius = mParams.width * flame.radius, length = spine->length();
+    const int n = particleCount(mParams.sampling, density, *spine, radius, camera);
+    glm::dvec3 meanVelocity(0.0);
+    for (const SpinePoint& p : flame.points) meanVelocity += p.v;
+    meanVelocity /= double(flame.points.size());
+    const double energy =
+        flame.intensity * flameEnergy(mParams.incandescence, glm::length(meanVelocity), flame.radius, length);
+    glm::dvec3 c, t, nn, b;
+    spine->frameAt(0.5, &c, &t, &nn, &b);
+    out.sampled[std::size_t(f)] = n;
+    out.energy[std::size_t(f)] = energy;
+    factor[std::size_t(f)] = incandescenceFactor(energy, std::size_t(n), density.meanDensity(), length,
+                                                 glm::length(c - camera.position));
+    // Canonical volume (widest radii³) to world: R² across, L / aspect along the spine.
+    mass[std::size_t(f)] =
+        flame.intensity * density.mass() * radius * radius * length / density.profile().aspect() / double(n);
+    FlameLight& light = out.lights[std::size_t(f)];
+    light.flameId = flame.id;
+    light.centre = c;
+    light.radius = length / 3.0;
+    light.energy = energy;
+    spines[std::size_t(f)] = std::move(spine);
+  });
+
+  std::vector<std::size_t> offset(nf + 1, 0);
+  std::vector<Chunk> chunks;
+  for (int f = 0; f < count; ++f) {
+    const int n = out.sampled[std::size_t(f)];
+    offset[std::size_t(f) + 1] = offset[std::size_t(f)] + std::size_t(n);
+    for (int b = 0; b < n; b += kChunk) chunks.push_back({f, b, std::min(n, b + kChunk)});
+  }
+  FlameParticles& parts = out.particles;
+  parts.resize(offset.back());
+  std::vector<std::uint8_t> inside(offset.back());
+  std::vector<glm::dvec3> chunkColor(chunks.size());
+  const glm::dvec2 blend = mKolmogorov->blend(time);
+  const ObstacleSet* obstacles = mObstacles && !mObstacles->empty() ? mObstacles.get() : nullptr;
+
+  // Per particle: sample (eq. 4), colour (§5.1), flow noise, Figure 4, Kolmogorov noise, eq. 6.
+  parallelFor(0, int(chunks.size()), [&](int c) {
+    const Chunk& chunk = chunks[std::size_t(c)];
+    const Flame& flame = flames[std::size_t(chunk.flame)];
+    const int pi = profileIndex(flame);
+    const ProfileDensity& density = *mDensities[std::size_t(pi)];
+    const ColorImage* image = mImages.empty() ? nullptr : &mImages[mImages.size() == 1 ? 0 : std::size_t(pi)];
+    const SpineFrame& spine = *spines[std::size_t(chunk.flame)];
+    const double aspect = density.profile().aspect(), radius = mParams.width * flame.radius;
+    const double zSpan = density.zMax() - density.zMin();
+    const int n = out.sampled[std::size_t(chunk.flame)];
+    glm::dvec3 colorSum(0.0);
+    for (int i = chunk.begin; i < chunk.end; ++i) {
+      const std::size_t m = offset[std::size_t(chunk.flame)] + std::size_t(i);
+      const ProfileSample s = sampleFlame(density, mParams.seed, flame.id, i, n);
+      glm::dvec3 p = s.position;
+      glm::dvec3 velocity;
+      double age;
+      spine.motionAt(std::clamp(p.z / aspect, 0.0, 1.0), &velocity, &age);
+      const glm::vec3 color = image ? image->sample(0.5 + 0.5 * p.x / density.rhoMax(), (p.z - density.zMin()) / zSpan)
+                                    : glm::vec3(1.f);
+      p += mFlow.displacement(p, time - age, flame.radius);
+      glm::dvec3 x = spine.map(p, aspect, radius);
+      x += mKolmogorov->displacement(x, time, blend);
+      parts.positions[m] = glm::vec3(x);
+      parts.velocities[m] = glm::vec3(velocity);
+      parts.colors[m] = color;
+      parts.density[m] = float(flame.intensity * s.density);
+      parts.incandescence[m] = float(factor[std::size_t(chunk.flame)] * s.density);
+      parts.mass[m] = float(mass[std::size_t(chunk.flame)]);
+      parts.flame[m] = std::uint32_t(chunk.flame);
+      // 2: dropped (its stored position inside an obstacle, §6.1; or merged below).
+      inside[m] = obstacles && obstacles->distance(glm::dvec3(parts.positions[m])) < 0.0 ? 2 : s.inside ? 1 : 0;
+      colorSum += glm::dvec3(color);
+    }
+    chunkColor[std::size_t(c)] = colorSum;
+  });
+  if (obstacles)
+    for (std::size_t m = 0; m < parts.size(); ++m) out.obstructed += inside[m] == 2 ? 1 : 0;
+  // Mean colour per flame, summed in chunk order (deterministic).
+  std::vector<glm::dvec3> colorSum(nf, glm::dvec3(0.0));
+  for (std::size_t c = 0; c < chunks.size(); ++c) colorSum[std::size_t(chunks[c].flame)] += chunkColor[c];
+  for (int f = 0; f < count; ++f)
+    if (out.sampled[std::size_t(f)] > 0)
+      out.lights[std::size_t(f)].color = glm::vec3(colorSum[std::size_t(f)] / double(out.sampled[std::size_t(f)]));
+
+  if (mParams.merging && count > 1) {
+    std::vector<MergeVolume> volumes;
+    for (int f = 0; f < count; ++f) {
+      const ProfileDensity& density = *mDensities[std::size_t(profileIndex(flames[std::size_t(f)]))];
+      const double radius = mParams.width * flames[std::size_t(f)].radius;
+      MergeVolume v = mergeVolume(*spines[std::size_t(f)], density.profile(), radius);
+      // Glow shell, the ends' extension along the tangents, and both noises.
+      const double ends = (density.zMax() - density.profile().aspect()) / density.profile().aspect() *
+                          spines[std::size_t(f)]->length();
+      v.reach = std::max(radius * (density.rhoMax() - 1.0), ends) + radius * 2.0 * mParams.flowNoise.amplitude +
+                3.0 * mParams.kolmogorov.amplitude;
+      volumes.push_back(v);
+    }
+    const auto neighbours = mergeNeighbours(volumes);
+    parallelFor(0, int(chunks.size()), [&](int c) {
+      const Chunk& chunk = chunks[std::size_t(c)];
+      const auto& near = neighbours[std::size_t(chunk.flame)];
+      if (near.empty()) return;
+      for (int i = chunk.begin; i < chunk.end; ++i) {
+        const std::size_t m = offset[std::size_t(chunk.flame)] + std::size_t(i);
+        if (inside[m] != 2 && mergedAway(volumes, near, glm::dvec3(parts.positions[m]), inside[m] != 0)) inside[m] = 2;
+      }
+    });
+  }
+  if (obstacles || (mParams.merging && count > 1)) {
+    std::size_t kept = 0;
+    for (std::size_t m = 0; m < parts.size(); ++m) {
+      if (inside[m] == 2) continue;
+      if (kept != m) {
+        parts.positions[kept] = parts.positions[m];
+        parts.velocities[kept] = parts.velocities[m];
+        parts.colors[kept] = parts.colors[m];
+        parts.density[kept] = parts.density[m];
+        parts.incandescence[kept] = parts.incandescence[m];
+        parts.mass[kept] = parts.mass[m];
+        parts.flame[kept] = parts.flame[m];
+      }
+      ++kept;
+    }
+    out.merged = parts.size() - kept - out.obstructed;
+    parts.resize(kept);
+  }
+}
+
+}  // namespace plume

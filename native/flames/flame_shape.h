@@ -1,0 +1,97 @@
+#pragma once
+/// \file flame_shape.h
+/// The shape and render stage of structural flames for one frame (structural_flames.txt
+/// §4.4–4.5, §5): for every flame, Monte-Carlo samples of eq. 4 in its profile, the buoyancy
+/// flow noise, the cylindrical mapping of Figure 4, the Kolmogorov noise, merging, base colour
+/// and incandescence (eq. 5–6), and one light per flame.
+///
+/// Deterministic: particle n of flame f draws from Rng(seed, f.id · 2³² + n), flames are laid
+/// out in input order and merging keeps that order, so the result is bit-identical at any
+/// thread count.
+
+#include "flames/flame.h"
+#include "flames/flame_sampler.h"
+#include "flames/flow_noise.h"
+#include "flames/incandescence.h"
+#include "flames/kolmogorov_noise.h"
+#include "flames/obstacle_sdf.h"
+#include "flames/profile_density.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace plume {
+
+/// Every setting of the shape stage.
+struct FlameShapeParams {
+  DensityParams density;
+  SamplingParams sampling;
+  FlowNoiseParams flowNoise;
+  KolmogorovParams kolmogorov;
+  IncandescenceParams incandescence;
+  double width = 1.0;    ///< the flame's widest radius R = width · Flame::radius
+  bool merging = true;   ///< §4.5 (the paper switched it off for the dragon)
+  std::uint64_t seed = 0;
+  int threads = 0;       ///< 0: all cores
+  /// Throws std::invalid_argument naming the setting and its accepted range.
+  void validate() const;
+};
+
+/// The particles of one frame, every array of size().
+struct FlameParticles {
+  std::vector<glm::vec3> positions;   ///< world, m
+  std::vector<glm::vec3> velocities;  ///< m/s, eq. 1 of the nearest spine points (motion blur)
+  std::vector<glm::vec3> colors;      ///< base colour (§5.1)
+  std::vector<float> density;         ///< d(x_i) = I / (1 + dist²/ℓ²), eq. 4
+  std::vector<float> incandescence;   ///< E_i, eq. 6
+  std::vector<float> mass;            ///< ∫ d dV of its flame / n (m³): rasterized density ≈ d
+  std::vector<std::uint32_t> flame;   ///< index of its flame in the input
+  std::size_t size() const { return positions.size(); }
+  void resize(std::size_t n);
+};
+
+/// One frame's output.
+struct FlameShapeFrame {
+  FlameParticles particles;
+  std::vector<FlameLight> lights;  ///< one per flame, input order
+  std::vector<int> sampled;        ///< samples drawn per flame (before merging)
+  std::vector<double> energy;      ///< eq. 5 times the intensity, per flame
+  std::size_t merged = 0;          ///< particles dropped by merging
+  std::size_t obstructed = 0;      ///< particles dropped inside obstacles (§6.1)
+};
+
+/// The shape stage, built once per bake (profile tables, noise tile), run once per frame.
+class FlameShaper {
+ public:
+  /// `profiles`: flame f uses profiles[min(f.source, size-1)]; `images`: none (white), one for
+  /// all, or one per profile. Throws std::invalid_argument on bad settings.
+  FlameShaper(const std::vector<FlameProfile>& profiles, const FlameShapeParams& params,
+              std::vector<ColorImage> images = {});
+  /// The frame at time t (s) seen from `camera`.
+  FlameShapeFrame shape(const std::vector<Flame>& flames, double time, const FlameCamera& camera) const;
+  /// The same into `out`, reusing its arrays' memory (a bake's frame loop).
+  void shape(const std::vector<Flame>& flames, double time, const FlameCamera& camera, FlameShapeFrame& out) const;
+
+  /// §6.1: particles whose final position is inside an obstacle (φ < 0) are dropped; none
+  /// (the default) keeps all. Read from several threads during shape().
+  void setObstacles(std::shared_ptr<const ObstacleSet> obstacles) { mObstacles = std::move(obstacles); }
+
+  const ProfileDensity& density(int source) const;
+  const FlameShapeParams& params() const { return mParams; }
+  const FlowNoise& flowNoise() const { return mFlow; }
+  const KolmogorovNoise& kolmogorov() const { return *mKolmogorov; }
+
+ private:
+  int profileIndex(const Flame& flame) const;
+  FlameShapeParams mParams;
+  std::vector<std::unique_ptr<ProfileDensity>> mDensities;
+  std::vector<ColorImage> mImages;
+  FlowNoise mFlow;
+  std::unique_ptr<KolmogorovNoise> mKolmogorov;
+  std::shared_ptr<const ObstacleSet> mObstacles;
+};
+
+}  // namespace plume

@@ -1,0 +1,79 @@
+"""Structural flames, shape and render side (structural_flames.txt §4.4-4.5, §5) through the
+bindings: profiles, sampling, lights, energy balance (eq. 5-6) and the flame VDB."""
+import math
+
+import numpy as np
+import pytest
+
+import _native as native
+
+
+def straight_flame(x=0.0, length=0.3, radius=0.03, ident=1, n=8, speed=1.5):
+    z = np.linspace(0.0, length, n)
+    points = np.stack([np.full(n, x), np.zeros(n), z], axis=1)
+    return dict(points=points, velocities=np.tile([0.0, 0.0, speed], (n, 1)), ages=z / speed,
+                radius=radius, id=ident)
+
+
+def test_profiles_are_normalized_and_curves_are_checked():
+    for name in ("candle", "torch", "campfire"):
+        p = native.FlameProfile.library(name)
+        assert max(p.radius(s) for s in np.linspace(0, 1, 101)) == pytest.approx(1.0)
+        assert p.aspect > 1.0
+    with pytest.raises(ValueError, match="profile must be one of"):
+        native.FlameProfile.library("volcano")
+    with pytest.raises(ValueError, match="at least 2 points"):
+        native.FlameProfile.from_curve(np.array([[1.0, 0.0]]))
+    with pytest.raises(ValueError, match="must not decrease"):
+        native.FlameProfile.from_curve(np.array([[1.0, 1.0], [0.5, 0.0]]))
+    curve = native.FlameProfile.from_curve(np.array([[0.0, 0.0], [0.2, 0.5], [0.0, 1.0]]))
+    assert curve.aspect == pytest.approx(5.0)
+    assert curve.radius(0.5) == pytest.approx(1.0)
+
+
+def test_shape_energy_lights_and_colors():
+    camera = native.FlameCamera(position=(0.0, -2.0, 0.3))
+    image = np.zeros((4, 2, 3), np.float32)
+    image[..., 0] = 1.0  # a red reference image: every base colour is red
+    shaper = native.FlameShaper([native.FlameProfile.library("torch")], images=[image], fixed_count=5000, seed=2)
+    out = shaper.shape([straight_flame()], 0.5, camera)
+    assert out["positions"].shape == (5000, 3) and out["sampled"] == [5000]
+    assert np.allclose(out["colors"], [1.0, 0.0, 0.0])
+    h = 0.3
+    l = math.dist((0.0, 0.0, 0.15), (0.0, -2.0, 0.3))
+    expected = out["energy"][0] / (4 * math.pi * (0.25 * h * h + l * l))
+    assert out["incandescence"].sum() == pytest.approx(expected, rel=0.01)  # eq. 6 sums to eq. 5
+    light = out["lights"][0]
+    assert light["radius"] == pytest.approx(h / 3, rel=1e-3)
+    assert light["energy"] == pytest.approx(out["energy"][0])
+    assert np.all((out["density"] > 0.19) & (out["density"] <= 1.0))  # d ∈ [I/(1+cutoff²), I]
+
+
+def test_camera_count_and_bad_input():
+    near = native.FlameCamera(position=(0.0, -2.0, 0.15))
+    far = native.FlameCamera(position=(0.0, -4.0, 0.15))
+    shaper = native.FlameShaper([native.FlameProfile.library("candle")], max_particles=10**7)
+    n_near = shaper.shape([straight_flame()], 0.0, near)["sampled"][0]
+    n_far = shaper.shape([straight_flame()], 0.0, far)["sampled"][0]
+    assert n_far / n_near == pytest.approx(0.25, rel=0.03)  # projected pixels ∝ 1/l²
+    with pytest.raises(ValueError, match="at least 2 spine points"):
+        shaper.shape([dict(points=np.zeros((1, 3)), radius=0.1)], 0.0, near)
+    with pytest.raises(ValueError, match="radius"):
+        shaper.shape([dict(points=np.zeros((3, 3)), radius=0.0)], 0.0, near)
+    with pytest.raises(ValueError, match="falloff"):
+        native.FlameShaper([native.FlameProfile.library("candle")], falloff=0.0)
+
+
+def test_write_flames_vdb(tmp_path):
+    camera = native.FlameCamera(position=(0.0, -2.0, 0.15))
+    shaper = native.FlameShaper([native.FlameProfile.library("candle")], fixed_count=20000, seed=1)
+    out = shaper.shape([straight_flame(), straight_flame(x=0.2, ident=2)], 0.25, camera)
+    path = tmp_path / "flames_0001.vdb"
+    voxels = native.write_flames_vdb(path, out, voxel_size=0.01, frame=1)
+    assert voxels > 0 and path.exists()
+    names = native.vdb_grid_names(str(path))
+    assert set(names) == {"density", "temperature", "flame", "color", "velocity"}
+    density = native.read_vdb_grid(str(path), "density")
+    # The splatted mass is conserved: Σ ρ Δx³ = Σ mass.
+    total = density["values"].astype(np.float64).sum() * 0.01**3
+    assert total == pytest.approx(out["mass"].astype(np.float64).sum(), rel=1e-3)
