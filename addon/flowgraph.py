@@ -124,7 +124,7 @@ class SynthesisSettings:
     preview_points: int = 20000
     #: MB of prepared pathline groups the native Synthesizer keeps between visits of the walk
     #: (least recently used out); 0 reads every visit from its file
-    group_cache_mb: int = 1024
+    group_cache_mb: int = 2048
 
 
 #: Fourier modes of the turbulence velocity (enough for an irregular, smooth field).
@@ -384,6 +384,41 @@ def load_graph(native, folder, owner):
     return graph, states
 
 
+#: The prepared-group cache of the last synthesized graph, kept for the Blender session:
+#: (key, PreparedGroupCache). Synthesizing the same graph again (another seed, other keys, a
+#: longer range) reads no group twice.
+_SESSION_CACHE = [None, None]
+
+
+def _states_key(states: List[State], budget_mb):
+    """What a cached group depends on: every state's pathline file (path, size, time) in order,
+    and the budget."""
+    key = [int(budget_mb)]
+    for st in states:
+        path = cache.pathlines_path(st.folder)
+        try:
+            info = os.stat(path)
+            key.append((os.path.abspath(path), info.st_size, info.st_mtime_ns))
+        except OSError:
+            key.append((os.path.abspath(path), -1, -1))
+    return tuple(key)
+
+
+def session_cache(native, states: List[State], budget_mb):
+    """The PreparedGroupCache of this graph's states for the session (a new one, and the old one
+    dropped, when the states, their files or the budget changed)."""
+    key = _states_key(states, budget_mb)
+    if _SESSION_CACHE[0] != key:
+        _SESSION_CACHE[1] = None  # free the old groups first
+        _SESSION_CACHE[:] = [key, native.PreparedGroupCache(int(budget_mb) * 1_000_000)]
+    return _SESSION_CACHE[1]
+
+
+def clear_session_cache():
+    """Frees the session's prepared groups (a new file is loaded, the add-on unregisters)."""
+    _SESSION_CACHE[:] = [None, None]
+
+
 @dataclass
 class SynthesisResult:
     frame_start: int
@@ -436,8 +471,9 @@ class SynthesisRunner:
 
     def run(self) -> SynthesisResult:
         s, native = self.s, self.native
-        syn = native.Synthesizer(self.states[0].file.layout,
-                                 cache_bytes=int(s.group_cache_mb) * 1_000_000)
+        groups = session_cache(native, self.states, s.group_cache_mb)
+        misses = groups.misses
+        syn = native.Synthesizer(self.states[0].file.layout, 0, groups)
         result = SynthesisResult(frame_start=s.frame_start, last_frame=s.frame_start - 1)
         fire_dir = os.path.join(self.out_folder, FIRE_FOLDER)
         os.makedirs(fire_dir, exist_ok=True)
@@ -473,5 +509,5 @@ class SynthesisRunner:
             result.last_frame = frame
             if self.progress is not None:
                 self.progress(i + 1, total)
-        result.group_reads = syn.cache_misses
+        result.group_reads = groups.misses - misses
         return result

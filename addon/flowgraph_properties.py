@@ -66,8 +66,9 @@ class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
         description="At most this many points per frame in the point preview: more live "
                     "particles are thinned evenly (every (live / this)-th); 100 to 1,000,000")
     group_cache: IntProperty(
-        name="Group Cache (MB)", default=1024, min=0, max=65536,
-        description="Memory kept for pathline groups between visits of the random walk: a "
+        name="Group Cache (MB)", default=2048, min=0, max=65536,
+        description="Memory kept for prepared pathline groups between visits of the random "
+                    "walk and, for the Blender session, between syntheses of the same graph: a "
                     "revisited node is not read from its pathlines.bin again (0: read every "
                     "visit); 0 to 65,536 MB")
     # --- Built data ---

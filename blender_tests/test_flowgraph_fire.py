@@ -224,7 +224,7 @@ class FlowGraphFireTest(unittest.TestCase):
         # The group cache only saves file reads: with none, every particle is the same.
         g.group_cache = 0
         self.assertEqual(bpy.ops.plume.fire_synthesize(), {'FINISHED'})
-        g.group_cache = 1024
+        g.group_cache = 2048
         for f in (frames[0], frames[-1]):
             np.testing.assert_array_equal(
                 flowgraph.read_points(flowgraph.points_path(folder, f))["positions"],

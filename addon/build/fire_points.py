@@ -55,12 +55,23 @@ def frame_change_pre(scene, *_args):
             update_object(ob, scene.frame_current)
 
 
+@bpy.app.handlers.persistent
+def load_post(*_args):
+    """Another .blend: the prepared pathline groups of the last synthesis are freed."""
+    flowgraph.clear_session_cache()
+
+
 def register():
     frame_handlers.add(frame_change_pre)
+    if load_post not in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.append(load_post)
 
 
 def unregister():
     frame_handlers.remove(frame_change_pre)
+    while load_post in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(load_post)
+    flowgraph.clear_session_cache()
     _files.clear()
 
 

@@ -239,6 +239,19 @@ void bindSynthesizer(py::module_& m) {
     return py::make_tuple(u.x, u.y, u.z);
   });
 
+  py::class_<PreparedGroupCache, std::shared_ptr<PreparedGroupCache>> cache(
+      m, "PreparedGroupCache",
+      "Least-recently-used cache of prepared pathline groups keyed (state, node step), shared by "
+      "the synthesizers of one graph (Synthesizer(layout, threads, cache=...)): synthesizing "
+      "again reads no group twice. Not thread-safe: one synthesizer steps at a time.");
+  cache.def(py::init<std::size_t>(), py::arg("budget_bytes"));
+  cache.def_property_readonly("hits", &PreparedGroupCache::hits);
+  cache.def_property_readonly("misses", &PreparedGroupCache::misses);
+  cache.def_property_readonly("bytes", &PreparedGroupCache::bytes);
+  cache.def_property_readonly("budget", &PreparedGroupCache::budget);
+  cache.def_property_readonly("size", &PreparedGroupCache::size);
+  cache.def("clear", &PreparedGroupCache::clear, "Drops every group (the counters stay).");
+
   py::class_<Synthesizer> s(
       m, "Synthesizer",
       "Synthesis by eq. 13 (§5.2): each step, live particles move by their own pathline's "
@@ -250,6 +263,13 @@ void bindSynthesizer(py::module_& m) {
         py::arg("layout"), py::arg("threads") = 0, py::arg("cache_bytes") = 0,
         "cache_bytes: budget of the least-recently-used cache of prepared groups step_node() keeps "
         "between visits (0: every visit reads its file). ValueError on a bad layout or threads < 0.");
+  s.def(py::init([](const PathlineLayout& layout, int threads,
+                     std::shared_ptr<PreparedGroupCache> cache) {
+          if (!cache) throw std::invalid_argument("cache must be a PreparedGroupCache, not None");
+          return std::make_unique<Synthesizer>(layout, threads, std::move(cache));
+        }),
+        py::arg("layout"), py::arg("threads"), py::arg("cache"),
+        "The same, with a cache shared with other synthesizers of the same graph.");
   s.def(
       "step",
       [](Synthesizer& syn, const PathlineGroup& g, const py::object& ext) {

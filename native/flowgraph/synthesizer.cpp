@@ -18,7 +18,12 @@ constexpr int kChunk = 512;
 }  // namespace
 
 Synthesizer::Synthesizer(const PathlineLayout& layout, int threads, std::size_t cacheBytes)
-    : mLayout(layout), mThreads(threads), mCache(cacheBytes) {
+    : Synthesizer(layout, threads, std::make_shared<PreparedGroupCache>(cacheBytes)) {}
+
+Synthesizer::Synthesizer(const PathlineLayout& layout, int threads,
+                         std::shared_ptr<PreparedGroupCache> cache)
+    : mLayout(layout), mThreads(threads), mCache(std::move(cache)) {
+  if (!mCache) throw std::invalid_argument("synthesis needs a cache of prepared groups (got none)");
   if (layout.particles < 1)
     throw std::invalid_argument("synthesis needs pathline groups of >= 1 particle (got " +
                                 std::to_string(layout.particles) + ")");
@@ -78,7 +83,7 @@ void Synthesizer::stepNode(const PathlineFile& file, int node, int state, const 
 }
 
 std::shared_ptr<const PreparedGroup> Synthesizer::findOrRead(const PathlineFile& file, int node, int state) {
-  std::shared_ptr<const PreparedGroup> cached = mCache.find(state, node);
+  std::shared_ptr<const PreparedGroup> cached = mCache->find(state, node);
   if (!cached) {
     file.readGroup(node, mRead, state);
     checkGroup(mRead);
@@ -89,7 +94,7 @@ std::shared_ptr<const PreparedGroup> Synthesizer::findOrRead(const PathlineFile&
 void Synthesizer::emitNode(std::shared_ptr<const PreparedGroup> cached) {
   if (!cached) {
     cached = prepare(mRead);
-    mCache.insert(cached);
+    mCache->insert(cached);
   }
   emit(std::move(cached));
 }

@@ -67,6 +67,10 @@ class Synthesizer {
   /// otherwise). `threads`: worker threads (0: all cores). `cacheBytes`: budget of the cache of
   /// prepared groups stepNode() keeps between visits (0: every visit reads its file).
   explicit Synthesizer(const PathlineLayout& layout, int threads = 0, std::size_t cacheBytes = 0);
+  /// The same with a cache shared with other synthesizers of the same graph (the add-on keeps one
+  /// per graph across syntheses, so synthesizing again with another seed or other keys reads no
+  /// group twice). Its keys (state, node) must mean the same files for all of them. Not null.
+  Synthesizer(const PathlineLayout& layout, int threads, std::shared_ptr<PreparedGroupCache> cache);
 
   const PathlineLayout& layout() const { return mLayout; }
 
@@ -87,7 +91,7 @@ class Synthesizer {
   void stepNode(const PathlineFile& file, int node, int state, glm::vec3 externalVelocity = glm::vec3(0.f));
   void stepNode(const PathlineFile& file, int node, int state, const ExternalVelocity& field);
   /// The cache stepNode() uses: its hits, misses (file reads) and bytes.
-  const PreparedGroupCache& cache() const { return mCache; }
+  const PreparedGroupCache& cache() const { return *mCache; }
 
   /// Steps taken. After step n (counting from 0) the particles are at synthesis time n Δt_n.
   long long steps() const { return mSteps; }
@@ -130,7 +134,7 @@ class Synthesizer {
   int mThreads;
   std::vector<Slot> mSlots;  ///< ring of L: the group emitted at step n lives in slot n mod L
   long long mSteps = 0;
-  PreparedGroupCache mCache;
+  std::shared_ptr<PreparedGroupCache> mCache;
   PathlineGroup mRead;                   ///< buffers of stepNode()'s file reads
   std::shared_ptr<PreparedGroup> mSpare;  ///< a prepared group no slot or cache references
 };

@@ -127,6 +127,27 @@ def test_step_node_cache_only_saves_reads(tmp_path):
         cached.step_node(f, f.node_count)
 
 
+def test_shared_cache_between_syntheses(tmp_path):
+    """A PreparedGroupCache shared by two synthesizers (the add-on keeps one per graph for the
+    session): the second synthesis of the same walk reads nothing and gives the same particles."""
+    path, _, _ = recorded_bake(tmp_path)
+    f = _native.PathlineFile.open(path)
+    walk = [0, 1, 2, 3, 1, 2, 3, 4]
+    shared = _native.PreparedGroupCache(1 << 30)
+    results = []
+    for _ in range(2):
+        syn = _native.Synthesizer(f.layout, 0, shared)
+        for k in walk:
+            syn.step_node(f, k, 0, (0.2, 0.0, 0.0))
+        results.append(syn.particles())
+    assert shared.misses == 5 and shared.hits == 11  # nodes 0-4 read once, all of run 2 hits
+    assert shared.size == 5 and shared.bytes <= shared.budget
+    for name in ("positions", "density", "temperature"):
+        np.testing.assert_array_equal(results[0][name], results[1][name])
+    with pytest.raises(ValueError, match="cache"):
+        _native.Synthesizer(f.layout, 0, None)
+
+
 def test_rasterized_frame_vdb(tmp_path):
     path, _, _ = recorded_bake(tmp_path)
     f = _native.PathlineFile.open(path)

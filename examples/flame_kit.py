@@ -1,0 +1,126 @@
+"""Shared pieces of the structural-flames examples (structural_flames.txt, issue 7), run inside
+Blender: a Flame Source made through the operators an artist clicks, simple solid materials,
+the bake (plume.flames_bake) with its per-frame figures, and the render of a few frames into a
+strip. Builds on scene_kit.
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import flame_kit
+"""
+
+import json
+import os
+import time
+
+import bpy
+
+import scene_kit
+
+
+def flame_source(name, add_primitive, location, profile, flames, source_radius, **primitive):
+    """A mesh primitive (e.g. bpy.ops.mesh.primitive_cylinder_add with its keywords) at
+    `location` made a Flame Source (plume.role_set) with `profile`, `flames` flames of source
+    radius r = `source_radius` (m); the mesh itself is left visible (it is the wick, torch or log)."""
+    add_primitive(location=location, **primitive)
+    ob = bpy.context.active_object
+    ob.name = name
+    bpy.ops.plume.role_set(role='FLAME_SOURCE')
+    fl = ob.plume.flame
+    fl.profile, fl.flames, fl.radius = profile, flames, source_radius
+    return ob
+
+
+def solid(ob, color, roughness=0.6, emission=None, name=None):
+    """Gives `ob` a Principled BSDF material of base `color` (an optional emission colour, e.g. a
+    glowing ember); returns the material."""
+    mat = bpy.data.materials.new(name or ob.name)
+    mat.use_nodes = True
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Roughness"].default_value = roughness
+    if emission is not None:
+        bsdf.inputs["Emission"].default_value = (*emission, 1.0)
+        bsdf.inputs["Emission Strength"].default_value = 1.0
+    ob.data.materials.clear()
+    ob.data.materials.append(mat)
+    return mat
+
+
+def floor(size, z=0.0, color=(0.05, 0.04, 0.035), name="Floor"):
+    """A square plane of `size` (m) at height `z`, a dull dark material."""
+    bpy.ops.mesh.primitive_plane_add(size=size, location=(0.0, 0.0, z))
+    ob = bpy.context.active_object
+    ob.name = name
+    solid(ob, color, roughness=0.8)
+    return ob
+
+
+def flames_settings(scene, frames, **values):
+    """scene.plume_flames for frames 1..frames, its cache next to the .blend, then `values`
+    (e.g. height_persistent=0.03, merging=False)."""
+    f = scene.plume_flames
+    f.frame_start, f.frame_end = 1, frames
+    f.cache_directory = "//plume_cache/flames/"
+    for name, value in values.items():
+        setattr(f, name, value)
+    return f
+
+
+def manifest(scene):
+    """The bake's manifest (flames_manifest.json): per-frame "flames" and "particles"."""
+    folder = scene_kit.addon_module("flame_snapshot").cache_folder(scene)
+    with open(os.path.join(folder, "flames_manifest.json"), encoding="utf-8") as fh:
+        return json.load(fh)
+
+
+def bake_flames(scene, tag):
+    """Bake Flames (plume.flames_bake); prints its time per frame and the live flames and
+    particles per frame. Returns (seconds per frame, flames per frame, particles per frame)."""
+    seconds = scene_kit.run_op(bpy.ops.plume.flames_bake, tag, "Bake Flames")
+    m = manifest(scene)
+    frames = len(m["flames"])
+    flames, particles = m["flames"], m["particles"]
+    per = seconds / max(frames, 1)
+    print(f"{tag}: Bake Flames {frames} frames in {seconds:.1f} s ({per:.3f} s/frame); "
+          f"{scene.plume_flames.summary}", flush=True)
+    print(f"{tag}: flames per frame {flames}", flush=True)
+    print(f"{tag}: particles per frame min {min(particles):,} mean "
+          f"{sum(particles) // max(frames, 1):,} max {max(particles):,}", flush=True)
+    return per, flames, particles
+
+
+def flame_look(scene, tag, out_dir, width=320, height=240, samples=48,
+               world=(0.0015, 0.0015, 0.002)):
+    """Cycles at a small size on a near-black world (the flames and their lights light the
+    scene), Filmic so bright flame cores keep their colour."""
+    scene_kit.cycles(scene, width, height, samples, os.path.join(out_dir, tag + "_"))
+    scene_kit.plain_world(scene, world)
+    scene.view_settings.view_transform = 'Filmic'
+    scene.cycles.volume_bounces = 0  # the flames emit; scattering in them is not worth its cost
+    scene.cycles.sample_clamp_indirect = 1.0  # no fireflies from the bright, small flames
+    scene.cycles.volume_step_rate = 2.0  # steps of two voxels through the soft flames
+
+
+def flame_example(tag, usage, default_frames, setup, show, **look):
+    """A flames example from the command line: OUT_DIR [FRAMES]. setup(scene, frames) builds the
+    scene (Flame Sources, settings, camera); `look`: keywords of flame_look. Then the .blend is
+    saved to OUT_DIR/TAG.blend, Bake Flames runs, the frames at fractions `show` of the shot are
+    rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are printed.
+    Returns (scene, flames per frame)."""
+    out_dir, frames = scene_kit.parse_args(usage, default_frames)
+    scene = scene_kit.new_scene()
+    flame_look(scene, tag, out_dir, **look)
+    setup(scene, frames)
+    scene.frame_start, scene.frame_end = 1, frames
+    scene_kit.save_blend(out_dir, tag)
+    bake_s, flames, particles = bake_flames(scene, tag)
+    bpy.ops.wm.save_mainfile()
+    t0 = time.perf_counter()
+    seconds, paths = scene_kit.render_frames_timed(
+        scene, scene_kit.shown_frames(show, frames), out_dir, tag)
+    lit = ", ".join(f"{scene_kit.lit_share(p) * 100:.0f}%" for p in paths)
+    print(f"{tag}: render {seconds:.1f} s/frame ({scene.render.resolution_x}x"
+          f"{scene.render.resolution_y}, {scene.cycles.samples} samples; lit pixels {lit}) -> "
+          f"{scene_kit.strip(paths, os.path.join(out_dir, tag + '_strip.png'))}", flush=True)
+    print(f"{tag}: total {time.perf_counter() - t0 + bake_s * len(flames):.0f} s "
+          f"(bake + render)", flush=True)
+    return scene, flames
