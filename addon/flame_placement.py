@@ -70,17 +70,20 @@ def interpolate(corner_values, faces, bary):
 
 def sample_map(image, uvs):
     """Greyscale (mean of R, G, B) of `image` (h, w, ≥3 floats, row 0 at the bottom: Blender's
-    pixel order) at `uvs` (k, 2), bilinear, repeating like Blender's image textures."""
+    pixel order) at `uvs` (k, 2), bilinear. UVs outside [0, 1) repeat the image, but the filter
+    holds the edge texels (no blending across the border): a map describes one surface, and
+    blending its opposite edge in would light a left-to-right ramp's edge flames half-way."""
     h, w = image.shape[:2]
     grey = np.asarray(image[..., :3], np.float64).mean(axis=2)
-    x = np.asarray(uvs)[:, 0] % 1.0 * w - 0.5
-    y = np.asarray(uvs)[:, 1] % 1.0 * h - 0.5
+    c = np.asarray(uvs, np.float64)
+    c = np.where((c >= 0.0) & (c <= 1.0), c, c % 1.0)  # a UV of exactly 1 is the right edge
+    x, y = c[:, 0] * w - 0.5, c[:, 1] * h - 0.5
     x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
     fx, fy = x - x0, y - y0
     out = np.zeros(len(x))
     for dx, dy, wgt in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)),
                         (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
-        out += wgt * grey[(y0 + dy) % h, (x0 + dx) % w]
+        out += wgt * grey[np.clip(y0 + dy, 0, h - 1), np.clip(x0 + dx, 0, w - 1)]
     return out
 
 

@@ -428,6 +428,7 @@ class FlameBakeRunner:
             has_camera = snap.cameras[i] is not None
             if shaper is None or (shape_key(s), has_camera) != key:
                 shaper = self.build.shaper(s, self.profiles, self.images, has_camera)
+                shaper.set_obstacles(self.obstacles)  # §6.1: the system's own SDFs, shared
                 key = (shape_key(s), has_camera)
             live = system.flames()
             shaped = shaper.shape(live, system.time, self._camera(i))

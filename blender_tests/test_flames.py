@@ -24,6 +24,16 @@ from helpers import (OUT_DIR, assert_reports_error, image_pixels, native,  # noq
 
 FRAMES = 12
 GRIDS = {"density", "temperature", "flame", "color", "velocity"}
+OBSTACLE_FRAMES = 8
+KEY_FRAMES = 16
+#: (lower, upper) corners of the plate over the candle (m): 2 cm thick, 1 cm above the wick.
+PLATE = ((-0.04, -0.04, 0.02), (0.04, 0.04, 0.04))
+
+
+def box_distance(points, lo, hi):
+    """Exact signed distance (m, < 0 inside) of points (N, 3) to the box [lo, hi]."""
+    q = np.abs(points - (lo + hi) / 2) - (hi - lo) / 2
+    return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
 
 
 def flame_scene(tmp, flames=1, profile='CANDLE'):
@@ -168,6 +178,109 @@ class FlamesTest(unittest.TestCase):
                                    place.interpolate(v[b], *place.place_flames(v, b, 5, 3)))
         one = place.interpolate(v[t], *place.place_flames(v, t, 1, seed=0))[0]
         self.assertGreater(one[2], 0.95)  # the top of the sphere
+
+    def test_obstacle(self):
+        """§6.1: a plate over the candle. Without obstacles the flames burn through it (the
+        control bake: density inside it); with them no spine point ends inside it and no
+        rendered density lies inside it."""
+        from plume import flames as flames_mod
+        folder = os.path.join(self.tmp, "obstacle")
+        src = flame_scene(folder)
+        scn = bpy.context.scene
+        scn.plume_flames.frame_end = OBSTACLE_FRAMES
+        lo, hi = np.array(PLATE[0]), np.array(PLATE[1])
+        bpy.ops.mesh.primitive_cube_add(size=1.0, location=tuple((lo + hi) / 2),
+                                        scale=tuple(hi - lo))
+        bpy.ops.plume.role_set(role='OBSTACLE')
+        bpy.context.active_object.hide_render = True
+        select_only(src)
+        # Cells of the flame VDB deep inside the plate: the hat kernel of the raster spreads a
+        # particle over the cells within one voxel of it, and the voxelized SDF (trilinear over
+        # OBSTACLE_VOXEL cells) is exact on the plate's flat faces and errs by at most half a
+        # cell at its edges, so particles kept (phi_grid >= 0) touch no cell deeper than
+        # voxel + OBSTACLE_VOXEL / 2 inside the plate.
+        deep = scn.plume_flames.voxel_size + 0.5 * flames_mod.OBSTACLE_VOXEL
+
+        def inside_mass():
+            total = 0.0
+            for frame in range(1, OBSTACLE_FRAMES + 1):
+                g = native().read_vdb_grid(flames_mod.volume_path(folder, frame), "density")
+                vals = np.asarray(g["values"], np.float64)
+                axes = [g["world_of_voxel_zero"][a] + (g["min"][a] + np.arange(vals.shape[a]))
+                        * g["voxel_size"] for a in range(3)]
+                inner = [(x > lo[a] + deep) & (x < hi[a] - deep) for a, x in enumerate(axes)]
+                total += float(vals[np.ix_(*inner)].sum())
+            return total
+
+        scn.plume_flames.use_obstacles = False
+        self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})
+        burnt = inside_mass()
+        self.assertGreater(burnt, 0.0)  # the plate is in the flames' way
+        scn.plume_flames.use_obstacles = True
+        self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})
+        kept = inside_mass()
+        low = np.inf
+        for frame in range(1, OBSTACLE_FRAMES + 1):
+            pts = flames_mod.read_spines(flames_mod.spines_path(folder, frame))["points"]
+            low = min(low, float(box_distance(pts, lo, hi).min()))
+        print(f"  obstacle: density inside the plate {burnt:.3g} -> {kept:.3g}; "
+              f"lowest spine point distance {low * 1000:.2f} mm")
+        self.assertEqual(kept, 0.0)
+        # Points are pushed to phi_grid >= obstacle_margin (1 mm) > the grid's error at edges.
+        self.assertGreaterEqual(low, 0.0)
+
+    def test_spines_keyframes(self):
+        """Bake Spines to Keyframes: one curve object per flame id whose point F-curves hold a
+        key on every frame the flame lives, equal to the cached points (padded with the tip
+        when it has fewer), hidden (viewport and render) on the baked frames it does not live."""
+        from plume import flames as flames_mod
+        from plume.build import flame_spine_keys as keys_mod
+        folder = os.path.join(self.tmp, "keys")
+        flame_scene(folder)
+        scn = bpy.context.scene
+        scn.plume_flames.frame_end = KEY_FRAMES
+        scn.plume_flames.lifespan_scale = 0.1  # separated flames that are born and die
+        op = bpy.ops.plume.flames_bake_spines_keyframes
+        assert_reports_error(self, op, r"no flames are baked",
+                             lambda: (len(bpy.data.objects), len(bpy.data.actions)))
+        self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})
+        self.assertEqual(op(), {'FINISHED'})
+        tracks = keys_mod.read_tracks(folder, 1, KEY_FRAMES)
+        col = bpy.data.collections[keys_mod.COLLECTION_NAME]
+        self.assertEqual(sorted(o[keys_mod.ID_KEY] for o in col.objects), sorted(tracks))
+        mortal = 0
+        for fid, by_frame in tracks.items():
+            ob = bpy.data.objects[keys_mod.object_name(fid)]
+            n = len(ob.data.splines[0].points)
+            self.assertEqual(n, max(len(p) for p in by_frame.values()))
+            fcs = {(fc.data_path, fc.array_index): fc
+                   for fc in ob.data.animation_data.action.fcurves}
+            self.assertEqual(len(fcs), 3 * n)
+            for frame, pts in by_frame.items():
+                want = keys_mod.padded(pts, n)
+                for k in range(n):
+                    for c in range(3):
+                        fc = fcs[(f"splines[0].points[{k}].co", c)]
+                        key = [p for p in fc.keyframe_points if p.co[0] == frame]
+                        self.assertEqual(len(key), 1)  # a key on the frame, the cached value
+                        self.assertEqual(key[0].co[1], want[k, c])
+            vis = {fc.data_path: fc for fc in ob.animation_data.action.fcurves}
+            for frame in range(1, KEY_FRAMES + 1):
+                for path in ("hide_viewport", "hide_render"):
+                    self.assertEqual(bool(vis[path].evaluate(frame)), frame not in by_frame)
+            mortal += len(by_frame) < KEY_FRAMES
+        # Through the scene: at the last frame every live flame's object shows its points.
+        scn.frame_set(KEY_FRAMES)
+        sp = flames_mod.read_spines(flames_mod.spines_path(folder, KEY_FRAMES))
+        start = 0
+        for fid, count in zip(sp["ids"], sp["counts"]):
+            ob = bpy.data.objects[keys_mod.object_name(int(fid))]
+            self.assertFalse(ob.hide_viewport)
+            co = np.array([p.co[:3] for p in ob.data.splines[0].points])[:count]
+            np.testing.assert_allclose(co, sp["points"][start:start + count], atol=1e-6)
+            start += count
+        print(f"  keyframes: {len(tracks)} flame ids, {mortal} not alive on every frame")
+        self.assertGreater(mortal, 0)  # the hide keys are exercised
 
     def test_bad_input(self):
         folder = os.path.join(self.tmp, "bad")

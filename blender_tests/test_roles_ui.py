@@ -39,7 +39,7 @@ PANELS = ("PHYSICS_PT_plume", "PHYSICS_PT_plume_settings", "PHYSICS_PT_plume_for
           "PHYSICS_PT_plume_obstacle", "PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames")
 FLAME_PANELS = {"PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames"}
 OPERATORS = ("PLUME_OT_role_set", "PLUME_OT_bake", "PLUME_OT_cache_free", "PLUME_OT_flames_bake",
-             "PLUME_OT_flames_free")
+             "PLUME_OT_flames_free", "PLUME_OT_flames_bake_spines_keyframes")
 
 
 class FakeLayout:

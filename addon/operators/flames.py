@@ -1,6 +1,7 @@
 """plume.flames_bake and plume.flames_free (structural_flames.txt): bake the scene's Flame
 Sources into flames_####.vdb + spines_####.npz, then the "Plume Flames" Volume, the "Plume Flame
-Spines" curve and the flame lights. execute() bakes blocking (``blender -b``, scripts); invoke()
+Spines" curve and the flame lights; plume.flames_bake_spines_keyframes turns the cached spines
+into keyed curve objects. execute() bakes blocking (``blender -b``, scripts); invoke()
 (UI) runs the bake on a worker thread with a modal timer for progress, Esc cancels (BLENDER_NOTES
 §5). Every input is checked before anything is written, so bad input changes nothing."""
 
@@ -11,7 +12,7 @@ import time
 import bpy
 
 from .. import _native, flames
-from ..build import flame_spines, flames_volume
+from ..build import flame_spine_keys, flame_spines, flames_volume
 from ..flame_snapshot import cache_folder, flames_snapshot
 from ..settings import BakeError
 
@@ -163,8 +164,38 @@ class PLUME_OT_flames_free(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class PLUME_OT_flames_bake_spines_keyframes(bpy.types.Operator):
+    """Convert the cached spines of the baked frames into one curve object per flame with its
+    points keyframed (hidden while the flame does not live): they work without Plume and can be
+    re-keyed by hand"""
+
+    bl_idname = "plume.flames_bake_spines_keyframes"
+    bl_label = "Bake Spines to Keyframes"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def execute(self, context):
+        scene = context.scene
+        f = scene.plume_flames
+        if _running:
+            self.report({'ERROR'}, "Plume: flames are baking; wait for the bake to finish")
+            return {'CANCELLED'}
+        if f.frames_baked < 1:
+            self.report({'ERROR'}, "Plume: no flames are baked (press Bake Flames first)")
+            return {'CANCELLED'}
+        first = int(f.frame_start)
+        try:
+            objects, keys = flame_spine_keys.bake(scene, cache_folder(scene), first,
+                                                  first + int(f.frames_baked) - 1)
+        except (OSError, ValueError) as e:
+            self.report({'ERROR'}, f"Plume: the flames cache cannot be read: {e}")
+            return {'CANCELLED'}
+        self.report({'INFO'}, f"Plume: {len(objects)} flame spines keyed ({keys:,} keys) in "
+                              f"collection '{flame_spine_keys.COLLECTION_NAME}'")
+        return {'FINISHED'}
+
+
 def is_baking():
     return bool(_running)
 
 
-classes = (PLUME_OT_flames_bake, PLUME_OT_flames_free)
+classes = (PLUME_OT_flames_bake, PLUME_OT_flames_free, PLUME_OT_flames_bake_spines_keyframes)

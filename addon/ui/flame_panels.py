@@ -52,6 +52,7 @@ def draw_flames(layout, scene):
     row.enabled = not is_baking()
     row.operator("plume.flames_bake", icon='PHYSICS')
     row.operator("plume.flames_free", icon='TRASH')
+    layout.operator("plume.flames_bake_spines_keyframes", icon='KEYINGSET')
     col = layout.column(align=True)
     col.prop(f, "frame_start", text="Frame Start")
     col.prop(f, "frame_end", text="End")

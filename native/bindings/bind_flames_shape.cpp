@@ -192,6 +192,16 @@ void bindFlamesShape(py::module_& m) {
       "profiles: flame f uses profiles[min(source, len-1)]; images: None, one, or one per profile, float "
       "(height, width, 3) row 0 at the bottom. ValueError on bad settings.");
   shaper.def(
+      "set_obstacles",
+      [](FlameShaper& s, const std::vector<std::shared_ptr<ObstacleSdf>>& obstacles) {
+        auto set = std::make_shared<ObstacleSet>();
+        for (const auto& o : obstacles) set->add(o);
+        s.setObstacles(obstacles.empty() ? nullptr : std::move(set));
+      },
+      py::arg("obstacles"),
+      "§6.1: particles whose final position is inside one of these obstacles (the ObstacleSdf objects "
+      "given to FlameSystem.add_obstacle, shared, not copied) are dropped; [] keeps all.");
+  shaper.def(
       "shape",
       [](const FlameShaper& s, const py::list& flames, double time, const FlameCamera& camera) {
         std::vector<Flame> list;
@@ -213,6 +223,7 @@ void bindFlamesShape(py::module_& m) {
         d["sampled"] = frame.sampled;
         d["energy"] = frame.energy;
         d["merged"] = frame.merged;
+        d["obstructed"] = frame.obstructed;
         py::list lights;
         for (const FlameLight& l : frame.lights) {
           py::dict ld;
@@ -228,7 +239,7 @@ void bindFlamesShape(py::module_& m) {
       },
       py::arg("flames"), py::arg("time"), py::arg("camera"),
       "dict: positions, velocities, colors (N, 3) float32; density (eq. 4), incandescence (eq. 6), mass (N,); "
-      "flame (N,) input index; sampled, energy (eq. 5) per flame; merged; lights [dict(flame_id, centre, "
+      "flame (N,) input index; sampled, energy (eq. 5) per flame; merged; obstructed (§6.1); lights [dict(flame_id, centre, "
       "radius h/3, energy, color)].");
 
   m.def(

@@ -150,10 +150,31 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
   parts.resize(offset.back());
   std::vector<std::uint8_t> inside(offset.back());
   std::vector<glm::dvec3> chunkColor(chunks.size());
-  const glm::dvec2 blend = mKolmogorov->blend(time);
   const ObstacleSet* obstacles = mObstacles && !mObstacles->empty() ? mObstacles.get() : nullptr;
 
-  // Per particle: sample (eq. 4), colour (§5.1), flow noise, Figure 4, Kolmogorov noise, eq. 6.
+  // §4.5 merging: every flame's volume and neighbours, tested in the particle pass below (the
+  // test reads only the spines, never the other flames' particles).
+  const bool merging = mParams.merging && count > 1;
+  std::vector<MergeVolume> volumes;
+  std::vector<std::vector<int>> neighbours(nf);
+  if (merging) {
+    for (int f = 0; f < count; ++f) {
+      const ProfileDensity& density = *mDensities[std::size_t(profileIndex(flames[std::size_t(f)]))];
+      const double radius = mParams.width * flames[std::size_t(f)].radius;
+      MergeVolume v = mergeVolume(*spines[std::size_t(f)], density.profile(), radius);
+      // Glow shell, the ends' extension along the tangents, and both noises.
+      const double ends = (density.zMax() - density.profile().aspect()) / density.profile().aspect() *
+                          spines[std::size_t(f)]->length();
+      v.reach = std::max(radius * (density.rhoMax() - 1.0), ends) + radius * 2.0 * mParams.flowNoise.amplitude +
+                3.0 * mParams.kolmogorov.amplitude;
+      volumes.push_back(v);
+    }
+    neighbours = mergeNeighbours(volumes);
+  }
+  const KolmogorovFrame kolmogorov(*mKolmogorov, time);
+
+  // Per particle: sample (eq. 4), colour (§5.1), flow noise, Figure 4, Kolmogorov noise, eq. 6,
+  // obstacles and merging.
   parallelFor(0, int(chunks.size()), [&](int c) {
     const Chunk& chunk = chunks[std::size_t(c)];
     const Flame& flame = flames[std::size_t(chunk.flame)];
@@ -164,6 +185,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const double aspect = density.profile().aspect(), radius = mParams.width * flame.radius;
     const double zSpan = density.zMax() - density.zMin();
     const int n = out.sampled[std::size_t(chunk.flame)];
+    const std::vector<int>& near = neighbours[std::size_t(chunk.flame)];
     glm::dvec3 colorSum(0.0);
     for (int i = chunk.begin; i < chunk.end; ++i) {
       const std::size_t m = offset[std::size_t(chunk.flame)] + std::size_t(i);
@@ -176,7 +198,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
                                     : glm::vec3(1.f);
       p += mFlow.displacement(p, time - age, flame.radius);
       glm::dvec3 x = spine.map(p, aspect, radius);
-      x += mKolmogorov->displacement(x, time, blend);
+      x += kolmogorov.displacement(x);
       parts.positions[m] = glm::vec3(x);
       parts.velocities[m] = glm::vec3(velocity);
       parts.colors[m] = color;
@@ -184,8 +206,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       parts.incandescence[m] = float(factor[std::size_t(chunk.flame)] * s.density);
       parts.mass[m] = float(mass[std::size_t(chunk.flame)]);
       parts.flame[m] = std::uint32_t(chunk.flame);
-      // 2: dropped (its stored position inside an obstacle, §6.1; or merged below).
+      // 2: dropped (its stored position inside an obstacle, §6.1).
       inside[m] = obstacles && obstacles->distance(glm::dvec3(parts.positions[m])) < 0.0 ? 2 : s.inside ? 1 : 0;
+      if (inside[m] == 0 && !near.empty() && mergedAway(volumes, near, glm::dvec3(parts.positions[m]), false))
+        inside[m] = 3;  // 3: merged (§4.5)
       colorSum += glm::dvec3(color);
     }
     chunkColor[std::size_t(c)] = colorSum;
@@ -199,34 +223,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     if (out.sampled[std::size_t(f)] > 0)
       out.lights[std::size_t(f)].color = glm::vec3(colorSum[std::size_t(f)] / double(out.sampled[std::size_t(f)]));
 
-  if (mParams.merging && count > 1) {
-    std::vector<MergeVolume> volumes;
-    for (int f = 0; f < count; ++f) {
-      const ProfileDensity& density = *mDensities[std::size_t(profileIndex(flames[std::size_t(f)]))];
-      const double radius = mParams.width * flames[std::size_t(f)].radius;
-      MergeVolume v = mergeVolume(*spines[std::size_t(f)], density.profile(), radius);
-      // Glow shell, the ends' extension along the tangents, and both noises.
-      const double ends = (density.zMax() - density.profile().aspect()) / density.profile().aspect() *
-                          spines[std::size_t(f)]->length();
-      v.reach = std::max(radius * (density.rhoMax() - 1.0), ends) + radius * 2.0 * mParams.flowNoise.amplitude +
-                3.0 * mParams.kolmogorov.amplitude;
-      volumes.push_back(v);
-    }
-    const auto neighbours = mergeNeighbours(volumes);
-    parallelFor(0, int(chunks.size()), [&](int c) {
-      const Chunk& chunk = chunks[std::size_t(c)];
-      const auto& near = neighbours[std::size_t(chunk.flame)];
-      if (near.empty()) return;
-      for (int i = chunk.begin; i < chunk.end; ++i) {
-        const std::size_t m = offset[std::size_t(chunk.flame)] + std::size_t(i);
-        if (inside[m] != 2 && mergedAway(volumes, near, glm::dvec3(parts.positions[m]), inside[m] != 0)) inside[m] = 2;
-      }
-    });
-  }
-  if (obstacles || (mParams.merging && count > 1)) {
+  if (obstacles || merging) {
     std::size_t kept = 0;
     for (std::size_t m = 0; m < parts.size(); ++m) {
-      if (inside[m] == 2) continue;
+      if (inside[m] >= 2) continue;
       if (kept != m) {
         parts.positions[kept] = parts.positions[m];
         parts.velocities[kept] = parts.velocities[m];

@@ -148,4 +148,35 @@ glm::dvec3 KolmogorovNoise::displacement(const glm::dvec3& x, double t, glm::dve
   return mParams.amplitude * glm::dvec3(glm::mix(x0, x1, f.z));
 }
 
+KolmogorovFrame::KolmogorovFrame(const KolmogorovNoise& noise, double t) : mNoise(noise), mTime(t) {
+  if (noise.mParams.amplitude <= 0.0) return;
+  const glm::dvec2 w = noise.blend(t);
+  const float wa = float(w.x), wb = float(w.y);
+  const int n = noise.mN, mask = n - 1, half = n / 2;
+  mBlend.resize(noise.mTile.size());
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j) {
+      const glm::vec3* p = &noise.mTile[std::size_t((k * n + j) * n)];
+      const glm::vec3* q = &noise.mTile[std::size_t((((k + half) & mask) * n + ((j + half) & mask)) * n)];
+      glm::vec3* out = &mBlend[std::size_t((k * n + j) * n)];
+      for (int i = 0; i < n; ++i) out[i] = wa * p[i] + wb * q[(i + half) & mask];
+    }
+}
+
+glm::dvec3 KolmogorovFrame::displacement(const glm::dvec3& x) const {
+  const KolmogorovParams& params = mNoise.mParams;
+  if (params.amplitude <= 0.0) return glm::dvec3(0.0);
+  const int n = mNoise.mN, mask = n - 1;
+  const glm::dvec3 u = (x - params.drift * mTime) * (double(n) / params.scale);
+  const glm::dvec3 floorU = glm::floor(u);
+  const glm::vec3 f(u - floorU);
+  const int i0 = int(static_cast<long long>(floorU.x) & mask), j0 = int(static_cast<long long>(floorU.y) & mask),
+            k0 = int(static_cast<long long>(floorU.z) & mask);
+  const int i1 = (i0 + 1) & mask, j1 = (j0 + 1) & mask, k1 = (k0 + 1) & mask;
+  auto at = [&](int i, int j, int k) { return mBlend[std::size_t((k * n + j) * n + i)]; };
+  const glm::vec3 x0 = glm::mix(glm::mix(at(i0, j0, k0), at(i1, j0, k0), f.x), glm::mix(at(i0, j1, k0), at(i1, j1, k0), f.x), f.y);
+  const glm::vec3 x1 = glm::mix(glm::mix(at(i0, j0, k1), at(i1, j0, k1), f.x), glm::mix(at(i0, j1, k1), at(i1, j1, k1), f.x), f.y);
+  return params.amplitude * glm::dvec3(glm::mix(x0, x1, f.z));
+}
+
 }  // namespace plume

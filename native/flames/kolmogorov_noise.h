@@ -47,9 +47,26 @@ class KolmogorovNoise {
   const KolmogorovParams& params() const { return mParams; }
 
  private:
+  friend class KolmogorovFrame;
   KolmogorovParams mParams;
   int mN = 0;
   std::vector<glm::vec3> mTile;  ///< x fastest
+};
+
+/// The field at one time t (§4.5, "generated on a per-frame basis"): the two parts of the tile
+/// blended once per frame, B = cos φ T(i) + sin φ T(i + N/2), so a lookup reads 8 corners
+/// instead of 16. The same single-precision products and sums as KolmogorovNoise::displacement,
+/// so the values are the same bit for bit.
+class KolmogorovFrame {
+ public:
+  KolmogorovFrame(const KolmogorovNoise& noise, double t);
+  /// KolmogorovNoise::displacement(x, t).
+  glm::dvec3 displacement(const glm::dvec3& x) const;
+
+ private:
+  const KolmogorovNoise& mNoise;
+  double mTime;
+  std::vector<glm::vec3> mBlend;  ///< x fastest, N³
 };
 
 /// In-place 3-D FFT of an N³ complex array (x fastest), N a power of two; inverse without the

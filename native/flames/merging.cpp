@@ -3,6 +3,9 @@
 
 #include "flames/merging.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace plume {
 
 MergeVolume mergeVolume(const SpineFrame& spine, const FlameProfile& profile, double radius) {
@@ -12,13 +15,32 @@ MergeVolume mergeVolume(const SpineFrame& spine, const FlameProfile& profile, do
   v.radius = radius;
   v.lower = spine.lower() - glm::dvec3(radius);
   v.upper = spine.upper() + glm::dvec3(radius);
+  const std::vector<glm::dvec3>& points = spine.points();
+  v.chordStart = points.front();
+  v.chord = points.back() - points.front();
+  v.chordLength2 = glm::dot(v.chord, v.chord);
+  // The distance to a segment is convex, so along each polyline segment it peaks at an end.
+  double deviation = 0.0;
+  for (const glm::dvec3& p : points) deviation = std::max(deviation, std::sqrt(chordDistance2(v, p)));
+  // Margin far above rounding: the capsule may only ever hold more than the spine's R-tube.
+  const double capsule = (radius + deviation) * (1.0 + 1e-6) + 1e-12;
+  v.capsule2 = capsule * capsule;
   return v;
+}
+
+double chordDistance2(const MergeVolume& g, const glm::dvec3& x) {
+  const glm::dvec3 ax = x - g.chordStart;
+  const double t = g.chordLength2 > 0.0 ? std::clamp(glm::dot(ax, g.chord) / g.chordLength2, 0.0, 1.0) : 0.0;
+  const glm::dvec3 d = ax - t * g.chord;
+  return glm::dot(d, d);
 }
 
 bool insideFlame(const MergeVolume& g, const glm::dvec3& x) {
   if (x.x < g.lower.x || x.y < g.lower.y || x.z < g.lower.z || x.x > g.upper.x || x.y > g.upper.y ||
       x.z > g.upper.z)
     return false;
+  // Outside the capsule: farther than R from every point of the spine, so outside (below).
+  if (chordDistance2(g, x) > g.capsule2) return false;
   double distance;
   // Farther than R from the spine is outside (the widest radius is 1).
   const double s = g.spine->closest(x, &distance, g.radius);

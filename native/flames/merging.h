@@ -26,10 +26,17 @@ struct MergeVolume {
   double radius = 0.0;      ///< R (m)
   glm::dvec3 lower{0.0}, upper{0.0};  ///< a box holding its profile
   double reach = 0.0;  ///< how far (m) its own particles may lie beyond that box (glow, noise)
+  /// A capsule around the chord C(0)→C(1) holding every point within R of the spine polyline
+  /// (its radius R + the polyline's largest distance from the chord): a cheap exact reject.
+  glm::dvec3 chordStart{0.0}, chord{0.0};
+  double chordLength2 = 0.0, capsule2 = 0.0;  ///< |chord|², capsule radius² (rounded up)
 };
 
 /// A MergeVolume for a spine and profile of radius R, with a box grown by R (widest radius = 1).
 MergeVolume mergeVolume(const SpineFrame& spine, const FlameProfile& profile, double radius);
+
+/// Squared distance from x to g's chord C(0)→C(1).
+double chordDistance2(const MergeVolume& g, const glm::dvec3& x);
 
 /// Whether world x is inside flame g's transformed profile.
 bool insideFlame(const MergeVolume& g, const glm::dvec3& x);

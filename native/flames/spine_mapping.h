@@ -59,6 +59,8 @@ class SpineFrame {
   /// Closest point of the spine polyline to x: returns s (fraction of L) and the distance.
   /// With `within` > 0, returns −1 as soon as x is known to be farther than `within`.
   double closest(const glm::dvec3& x, double* distance, double within = 0.0) const;
+  /// The polyline's points, base first.
+  const std::vector<glm::dvec3>& points() const { return mLine.x; }
   /// Axis-aligned bounds of the polyline.
   glm::dvec3 lower() const { return mLower; }
   glm::dvec3 upper() const { return mUpper; }

@@ -77,3 +77,21 @@ def test_write_flames_vdb(tmp_path):
     # The splatted mass is conserved: Σ ρ Δx³ = Σ mass.
     total = density["values"].astype(np.float64).sum() * 0.01**3
     assert total == pytest.approx(out["mass"].astype(np.float64).sum(), rel=1e-3)
+
+
+def test_obstacles_drop_particles():
+    """§6.1 through set_obstacles: no particle left inside the box, the dropped ones counted; the
+    same samples otherwise (the box only removes)."""
+    camera = native.FlameCamera(position=(0.0, -2.0, 0.15))
+    shaper = native.FlameShaper([native.FlameProfile.library("torch")], fixed_count=5000, seed=4)
+    free = shaper.shape([straight_flame()], 0.5, camera)
+    assert free["obstructed"] == 0
+    box = native.BoxSdf((-0.2, -0.2, 0.15), (0.2, 0.2, 0.25))
+    shaper.set_obstacles([box])
+    out = shaper.shape([straight_flame()], 0.5, camera)
+    assert np.all(box.distance(out["positions"]) >= 0.0)
+    inside = int((box.distance(free["positions"]) < 0.0).sum())
+    assert inside > 500 and out["obstructed"] == inside
+    assert len(out["positions"]) == len(free["positions"]) - inside
+    shaper.set_obstacles([])
+    assert shaper.shape([straight_flame()], 0.5, camera)["obstructed"] == 0
