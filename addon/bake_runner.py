@@ -336,7 +336,8 @@ class BakeRunner:
                 if not ok:
                     result.cancelled = True
                     break
-                self._solver.write_vdb(cache.volume_path(folder, frame))
+                self._solver.write_vdb(cache.volume_path(folder, frame),
+                                       velocity_everywhere=snap.velocity_everywhere)
                 if tracer is not None:  # atomic (tmp + rename) like the VDB
                     self._native.write_streak_file(cache.streak_path(folder, frame),
                                                    tracer.snapshot())

@@ -145,8 +145,9 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
     wind_domain: PointerProperty(
         name="Wind Domain", type=bpy.types.Object,
         poll=lambda _s, ob: getattr(ob, "plume", None) is not None and ob.plume.role == 'DOMAIN',
-        description="§6.1: a baked Plume domain whose velocity (where it holds smoke) adds to w, "
-                    "frame by frame (the paper used a 40³ solver around obstacles)")
+        description="§6.1: a baked Plume domain whose velocity adds to w, frame by frame, "
+                    "where it holds smoke, or everywhere when baked with Velocity Everywhere "
+                    "(the paper used a 40³ solver around obstacles)")
     use_obstacles: BoolProperty(
         name="Obstacles", default=True,
         description="§6.1: spine points are pushed out of the scene's Obstacle objects (closed "

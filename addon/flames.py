@@ -370,13 +370,15 @@ class FlameBakeRunner:
 
     def _domain_wind(self, frame):
         """§6.1: the baked domain's cell-centred velocity of `frame` as a GridWind (None when
-        the frame is not baked)."""
+        the frame is not baked or stores no velocity: no smoke, Velocity Everywhere off)."""
         from . import cache
         name, folder = self.snap.wind_domain
         path = cache.volume_path(folder, frame)
         if not os.path.isfile(path):
             return None
         g = self.native.read_vdb_grid(path, "velocity")
+        if np.asarray(g["values"]).size == 0:
+            return None
         origin = tuple(np.asarray(g["world_of_voxel_zero"]) - 0.5 * g["voxel_size"]
                        + np.asarray(g["min"]) * g["voxel_size"])
         return self.native.GridWind(np.asarray(g["values"], np.float32), float(g["voxel_size"]),

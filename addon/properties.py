@@ -231,6 +231,10 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                                   description="Name of the Volume object showing this domain's bake")
     frames_baked: IntProperty(name="Frames Baked", default=0, min=0,
                               description="Frames of the last bake available in the cache")
+    velocity_everywhere: BoolProperty(
+        name="Velocity Everywhere", default=False,
+        description="Store the velocity in every cell of each frame, not only where there is "
+                    "smoke: for a domain used as a flame Wind Domain (larger files)")
     # --- Toon smoke (cartoon_smoke.txt, plume.toon_build) ---
     toon: PointerProperty(type=PlumeToonSettings, name="Toon Smoke")
     # --- Flow-graph fire (graph_fire_synthesis.txt, plume.flowgraph_build / fire_synthesize) ---

@@ -215,6 +215,8 @@ class BakeSnapshot:
     pathlines: PathlineSettings = field(default_factory=PathlineSettings)
     #: flame_smoke.FlameSmokeSettings: smoke from the flames cache (structural_flames.txt §6.3)
     flame_smoke: Optional[object] = None
+    #: velocity in every cell of the frame VDBs (a flames Wind Domain, structural_flames.txt §6.1)
+    velocity_everywhere: bool = False
 
     @property
     def frame_count(self):
@@ -244,6 +246,8 @@ class BakeSnapshot:
             data["pathlines"] = dataclasses.asdict(self.pathlines)
         if self.flame_smoke is not None and self.flame_smoke.enabled:  # absent when off
             data["flame_smoke"] = self.flame_smoke.fingerprint()
+        if self.velocity_everywhere:  # absent when off, so older caches still resume
+            data["velocity_everywhere"] = True
         return data
 
     def frame_input_hash(self, frame):

@@ -244,7 +244,7 @@ def take_snapshot(context, addon_version="0.1.0"):
                                    nodes_per_frame=int(d.pathline_nodes_per_frame),
                                    lifetime=float(d.pathline_lifetime),
                                    float16=bool(d.pathline_float16)),
-        flame_smoke=smoke)
+        flame_smoke=smoke, velocity_everywhere=bool(d.velocity_everywhere))
 
 
 def flame_smoke_settings(domain, scene):

@@ -179,6 +179,7 @@ class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
         sub.active = d.motion_source == 'MANTAFLOW'  # its cache moves the smoke, no simulation
         sub.prop(d, "mantaflow_domain")
         layout.prop(d, "cache_directory", text="Directory")
+        layout.prop(d, "velocity_everywhere")
         baking = is_baking(ob)
         row = layout.row(align=True)
         row.enabled = not baking

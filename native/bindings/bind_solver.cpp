@@ -447,14 +447,15 @@ void bindSmokeSolver(py::module_& m) {
 
   c.def(
       "write_vdb",
-      [](const SmokeSolver& s, const py::object& path) {
+      [](const SmokeSolver& s, const py::object& path, bool velocityEverywhere) {
         const std::string p = pathArg(path);
         py::gil_scoped_release release;
-        writeVdbFrame(p, s);
+        writeVdbFrame(p, s, velocityEverywhere);
       },
-      py::arg("path"),
+      py::arg("path"), py::arg("velocity_everywhere") = false,
       "Writes grids density (ρ + soot), temperature, flame (combustion only) and velocity "
-      "(cell-centred) to a VDB, atomically. RuntimeError on failure.");
+      "(cell-centred; where there is smoke or flame, or in every cell with "
+      "velocity_everywhere) to a VDB, atomically. RuntimeError on failure.");
   c.def(
       "save_state",
       [](const SmokeSolver& s, const py::object& path) {

@@ -24,7 +24,7 @@ namespace {
 
 }  // namespace
 
-void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
+void writeVdbFrame(const std::string& path, const SmokeSolver& solver, bool velocityEverywhere) {
   initializeOpenVdb();
   const SmokeParams& p = solver.params();
   const glm::ivec3 n = p.resolution;
@@ -59,6 +59,7 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
     // Cell-centred velocity (the mean of each cell's two faces per axis), stored only where
     // there is smoke or flame: the projection leaves tiny velocities in the whole domain, which
     // would make every frame a dense grid (270 MB for ten frames at 128³) for motion blur only.
+    // velocityEverywhere keeps them all: the domain is then a wind field (§6.1 of the flames).
     reserveHugePages(velocity, solver.density().count());
     velocity.resize(solver.density().count());
     const MacGrid3& mac = solver.velocity();
@@ -68,7 +69,8 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver) {
       for (int j = 0; j < n.y; ++j)
         for (int i = 0; i < n.x; ++i) {
           const std::size_t m = std::size_t(i) + std::size_t(n.x) * (std::size_t(j) + std::size_t(n.y) * k);
-          const bool visible = density[m] != 0.f || (burning && flame[m] != 0.f);
+          const bool visible =
+              velocityEverywhere || density[m] != 0.f || (burning && flame[m] != 0.f);
           const glm::vec3 c = visible ? mac.cellCenter(i, j, k) : glm::vec3(0.f);
           velocity[m] = openvdb::Vec3s(c.x, c.y, c.z);
         }

@@ -120,6 +120,31 @@ TEST(VdbFrame, RoundTripValuesAndTransform) {
       }
 }
 
+TEST(VdbFrame, VelocityEverywhereKeepsClearAir) {
+  // structural_flames.txt §6.1: a domain read as a wind field needs its velocity in clear air.
+  const fs::path dir = scratchDir("velocity_everywhere");
+  SmokeSolver s(smallParams(false));
+  fillPattern(s, 2.f);
+  s.density().fill(0.f);  // no smoke anywhere: the default frame stores no velocity at all
+  s.soot().fill(0.f);
+  const std::string masked = (dir / "masked.vdb").string(), full = (dir / "full.vdb").string();
+  writeVdbFrame(masked, s);
+  writeVdbFrame(full, s, /*velocityEverywhere=*/true);
+  EXPECT_EQ(readVdbGrid(masked, "velocity").size, glm::ivec3(0));
+  const DenseGrid v = readVdbGrid(full, "velocity");
+  const glm::ivec3 n = s.params().resolution;
+  // The pattern's velocity is non-zero in the corner cells, so the stored box is the domain.
+  ASSERT_EQ(v.min, glm::ivec3(0));
+  ASSERT_EQ(v.size, n);
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        const glm::vec3 c = s.velocity().cellCenter(i, j, k);
+        const std::size_t m = 3 * (std::size_t(i) + std::size_t(n.x) * (j + std::size_t(n.y) * k));
+        for (int a = 0; a < 3; ++a) EXPECT_EQ(v.values[m + std::size_t(a)], c[a]);
+      }
+}
+
 TEST(VdbFrame, UnwritablePathThrowsAndLeavesNoTmp) {
   const fs::path dir = scratchDir("unwritable");
   SmokeSolver s(smallParams());
