@@ -6,7 +6,7 @@ flames are highly transparent, §5.3). Renders without the add-on."""
 
 import bpy
 
-from . import volume
+from . import datablocks, volume
 from .. import flames
 
 OBJECT_NAME = "Plume Flames"
@@ -26,13 +26,8 @@ def flames_material(emission):
     """The shared flames material (created once, then left to the artist; Emission updated)."""
     mat = bpy.data.materials.get(MATERIAL)
     if mat is None:
-        mat = bpy.data.materials.new(MATERIAL)
-        mat.use_nodes = True
-        nt = mat.node_tree
-        nt.nodes.clear()
+        mat, nt, out = datablocks.node_material(MATERIAL)
         N, L = nt.nodes.new, nt.links.new
-        out = N("ShaderNodeOutputMaterial")
-        out.location = (300, 0)
         pv = N("ShaderNodeVolumePrincipled")
         pv.inputs["Density"].default_value = FLAME_DENSITY
         pv.inputs["Density Attribute"].default_value = "density"
