@@ -8,7 +8,7 @@ SUDO=""
 
 PACKAGES=(blender cmake g++ pybind11-dev libopenvdb-dev libglm-dev libosd-dev libtbb-dev
           libboost-dev libboost-iostreams-dev googletest libgtest-dev libbenchmark-dev python3-pytest python3-numpy
-          xvfb xauth libgl1-mesa-dri)
+          xvfb xauth libgl1-mesa-dri python3-venv patchelf zip unzip binutils)
 
 install_packages() {
   local missing=()
@@ -28,23 +28,31 @@ build_native() {
   cmake --build "$BUILD" -j "$(nproc)"
 }
 
-# Where Blender 3.4 finds user add-ons.
-addon_dir() {
+# Where each supported Blender (3.4.1, 4.5, 5.0) finds user add-ons: one folder when
+# $BLENDER_USER_SCRIPTS is set, else each version's own under ~/.config/blender.
+addon_dirs() {
   if [ -n "${BLENDER_USER_SCRIPTS:-}" ]; then
     echo "$BLENDER_USER_SCRIPTS/addons/plume"
   else
-    echo "$HOME/.config/blender/3.4/scripts/addons/plume"
+    local v
+    for v in 3.4 4.5 5.0; do echo "$HOME/.config/blender/$v/scripts/addons/plume"; done
   fi
 }
 
 install_addon() {
   local dest
-  dest="$(addon_dir)"
-  echo "== installing the add-on into $dest"
-  rm -rf "$dest"
-  mkdir -p "$dest"
-  (cd "$ROOT/addon" && tar --exclude='__pycache__' -cf - .) | (cd "$dest" && tar -xf -)
-  cp "$BUILD"/native/_native*.so "$dest/"
+  for dest in $(addon_dirs); do
+    echo "== installing the add-on into $dest"
+    rm -rf "$dest"
+    mkdir -p "$dest"
+    (cd "$ROOT/addon" && tar --exclude='__pycache__' -cf - .) | (cd "$dest" && tar -xf -)
+    cp "$BUILD"/native/_native*.so "$dest/"
+  done
+}
+
+# The bpy 4.5 LTS and 5.x venvs (pinned in blender_tests/run.py), created once and reused.
+setup_bpy() {
+  /usr/bin/python3 "$ROOT/blender_tests/run.py" --setup all
 }
 
 setup_all() {

@@ -7,6 +7,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+from . import blender_compat as compat
 from . import cache
 from .mantaflow_cache import BORDER_SETTINGS, MantaflowSource
 from .settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, EmitterSnapshot,
@@ -86,7 +87,8 @@ def _source_is_keyed(obj):
     if ad is None:
         return False
     actions = [ad.action] + [strip.action for track in ad.nla_tracks for strip in track.strips]
-    paths = [fc.data_path for a in actions if a is not None for fc in a.fcurves]
+    paths = [fc.data_path for a in actions if a is not None
+             for fc in compat.action_fcurves(a)]
     paths += [d.data_path for d in ad.drivers]
     return any(p.startswith("plume.source") for p in paths)
 

@@ -36,6 +36,16 @@ def _raise(exc):
     raise exc
 
 
+def _compat():
+    """The add-on's module of Blender version differences (tests use it as the builders do)."""
+    enable_addon()
+    import importlib
+    return importlib.import_module(ADDON + ".blender_compat")
+
+
+compat = _compat()
+
+
 def native():
     """The installed add-on's native module (plume._native)."""
     from plume import _native

@@ -19,7 +19,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (OUT_DIR, assert_reports_error, image_pixels, native,  # noqa: E402
+from helpers import (OUT_DIR, compat, assert_reports_error, image_pixels, native,  # noqa: E402
                      reset_scene, rmtree, run, select_only, temp_dir, tree_listing)
 
 FRAMES = 12
@@ -254,7 +254,7 @@ class FlamesTest(unittest.TestCase):
             n = len(ob.data.splines[0].points)
             self.assertEqual(n, max(len(p) for p in by_frame.values()))
             fcs = {(fc.data_path, fc.array_index): fc
-                   for fc in ob.data.animation_data.action.fcurves}
+                   for fc in compat.fcurves(ob.data)}
             self.assertEqual(len(fcs), 3 * n)
             for frame, pts in by_frame.items():
                 want = keys_mod.padded(pts, n)
@@ -264,7 +264,7 @@ class FlamesTest(unittest.TestCase):
                         key = [p for p in fc.keyframe_points if p.co[0] == frame]
                         self.assertEqual(len(key), 1)  # a key on the frame, the cached value
                         self.assertEqual(key[0].co[1], want[k, c])
-            vis = {fc.data_path: fc for fc in ob.animation_data.action.fcurves}
+            vis = {fc.data_path: fc for fc in compat.fcurves(ob)}
             for frame in range(1, KEY_FRAMES + 1):
                 for path in ("hide_viewport", "hide_render"):
                     self.assertEqual(bool(vis[path].evaluate(frame)), frame not in by_frame)

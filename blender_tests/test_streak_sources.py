@@ -18,7 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (add_domain, add_sphere_source, assert_reports_error, native,  # noqa: E402
+from helpers import (add_domain, compat, add_sphere_source, assert_reports_error, native,  # noqa: E402
                      reset_scene, rmtree, run, select_only, temp_dir)
 
 #: 16 cells along 2 units: a bake of a few frames takes well under a second.
@@ -72,7 +72,7 @@ def key_source(src, keys):
     action = bpy.data.actions.new("SourceKeys")
     src.animation_data_create().action = action
     for path in ("plume.source.density", "plume.source.emit_particles"):
-        fcurve = action.fcurves.new(path)
+        fcurve = compat.fcurve_new(src, path)
         for frame, on in keys:
             fcurve.keyframe_points.insert(frame, float(on)).interpolation = 'CONSTANT'
 
@@ -315,7 +315,7 @@ class StreakSourcesTest(unittest.TestCase):
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
         self.assertEqual(manifest(self.folder)["last_run"]["computed_frames"], [9])
         # A changed key makes the stored frames stale: the bake starts over.
-        fcurve = src.animation_data.action.fcurves.find("plume.source.density")
+        fcurve = compat.fcurves(src).find("plume.source.density")
         next(k for k in fcurve.keyframe_points if k.co.x == 7).co.y = 0.5
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
         m = manifest(self.folder)
@@ -324,7 +324,7 @@ class StreakSourcesTest(unittest.TestCase):
         # The new key's density, 0.5, give or take the few % the global mass correction adds.
         self.assertAlmostEqual(max(vdb_at(self.folder, 7, cells)), 0.5, delta=0.05)
         # So does a changed emission key alone (it changes only the particles).
-        fcurve = src.animation_data.action.fcurves.find("plume.source.emit_particles")
+        fcurve = compat.fcurves(src).find("plume.source.emit_particles")
         next(k for k in fcurve.keyframe_points if k.co.x == 7).co.y = 0.0
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
         self.assertEqual(manifest(self.folder)["last_run"]["computed_frames"], list(range(1, 10)))
@@ -333,7 +333,7 @@ class StreakSourcesTest(unittest.TestCase):
     def test_bad_keyed_value_names_its_frame_and_changes_nothing(self):
         dom, src = build_scene(self.cache, frame_end=4)
         key_source(src, ((1, True), (3, False)))
-        fcurve = src.animation_data.action.fcurves.find("plume.source.density")
+        fcurve = compat.fcurves(src).find("plume.source.density")
         fcurve.keyframe_points[1].co.y = -1.0
         select_only(dom)
         self.assert_bake_error(r"source 'Source': density must be >= 0 \(got -1\.0 at frame 3\)")

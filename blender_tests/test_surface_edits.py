@@ -17,7 +17,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import add_domain, reset_scene, rmtree, run, select_only, temp_dir  # noqa: E402
+from helpers import add_domain, compat, reset_scene, rmtree, run, select_only, temp_dir  # noqa: E402
 from test_streak_surfaces import FRAMES, build_scene, counts, surface_objects  # noqa: E402
 
 EDIT_FRAME = 10
@@ -196,7 +196,7 @@ class SurfaceEditsTest(unittest.TestCase):
         start, cps = cache_points(ob)
         for o in self.obs:
             self.assertTrue(o.get("plume_surface_baked"))
-            fcs = o.data.animation_data.action.fcurves
+            fcs = compat.fcurves(o.data)
             self.assertEqual(len(fcs), len(o.data.splines[0].points) * 3)
             self.assertEqual({len(fc.keyframe_points) for fc in fcs}, {len(cps)})
         # Without the handler, the F-curves alone give cache + offsets.

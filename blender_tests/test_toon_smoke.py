@@ -20,7 +20,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (OUT_DIR, add_domain, add_sphere_source, assert_reports_error,  # noqa: E402
+from helpers import (OUT_DIR, add_domain, compat, add_sphere_source, assert_reports_error,  # noqa: E402
                      image_pixels, native, reset_scene, rmtree, run, select_only, temp_dir,
                      tree_listing)
 
@@ -60,20 +60,9 @@ def state(folder):
     """Everything plume.toon_build may change: datablocks, scene settings, cache files."""
     scn = bpy.context.scene
     return (len(bpy.data.objects), len(bpy.data.meshes), len(bpy.data.materials),
-            len(bpy.data.images), len(bpy.data.node_groups), scn.use_nodes,
+            len(bpy.data.images), len(bpy.data.node_groups), compat.compositor_tree(scn) is not None,
             bpy.context.view_layer.use_pass_z, scn.render.use_lock_interface,
             tuple(tree_listing(folder)))
-
-
-def file_output(nt, out_dir, name, socket):
-    """A 32-bit float EXR File Output of `socket` (frame number appended to `name`)."""
-    fo = nt.nodes.new('CompositorNodeOutputFile')
-    fo.base_path = out_dir
-    fo.format.file_format = 'OPEN_EXR'
-    fo.format.color_depth = '32'
-    fo.format.exr_codec = 'ZIP'
-    fo.file_slots[0].path = name
-    nt.links.new(socket, fo.inputs[0])
 
 
 def assert_billboards_follow_camera(test, ob, snap, stretch_factor):
@@ -190,7 +179,7 @@ class ToonSmokeTest(unittest.TestCase):
         t.depth_threshold = 0.25
         t.ramp_color_high = (0.2, 0.9, 0.3, 1.0)
         assert_billboards_follow_camera(self, ob, snap, 1.5)
-        group = scn.node_tree.nodes["Plume Depth Differences"]
+        group = compat.compositor_tree(scn).nodes["Plume Depth Differences"]
         self.assertAlmostEqual(group.inputs["Gamma"].default_value, 0.25, places=6)
         ramp = next(n for n in bpy.data.materials["Plume Toon Domain"].node_tree.nodes
                     if n.type == 'VALTORGB')
@@ -232,15 +221,15 @@ class ToonSmokeTest(unittest.TestCase):
         bpy.data.objects["Domain"].hide_render = True
         bpy.data.objects.get("Domain_smoke") and setattr(
             bpy.data.objects["Domain_smoke"], "hide_render", True)
-        nt = scn.node_tree
+        nt = compat.compositor_tree(scn)
         group = nt.nodes["Plume Depth Differences"]
         self.assertEqual(group.node_tree.name, "Plume Depth Differences")
         rl = next(n for n in nt.nodes if n.type == 'R_LAYERS')
         out = os.path.join(OUT_DIR, "toon")
         os.makedirs(out, exist_ok=True)
-        file_output(nt, out, "depth", rl.outputs["Depth"])
-        file_output(nt, out, "outline", group.outputs["Outline"])
-        file_output(nt, out, "image", group.outputs["Image"])
+        compat.compositor_file_output(nt, out, "depth", rl.outputs["Depth"])
+        compat.compositor_file_output(nt, out, "outline", group.outputs["Outline"])
+        compat.compositor_file_output(nt, out, "image", group.outputs["Image"])
         scn.frame_set(RENDER_FRAME)
         scn.render.filepath = os.path.join(out, "toon.png")
         t0 = time.perf_counter()

@@ -3,6 +3,8 @@ an object of a given type reused by name (one of another type is replaced)."""
 
 import bpy
 
+from .. import blender_compat as compat
+
 
 def empty_node_group(name, tree_type):
     """Node group `name` of `tree_type` ('GeometryNodeTree', 'CompositorNodeTree', ...) with no
@@ -11,8 +13,7 @@ def empty_node_group(name, tree_type):
     if ng is None or ng.bl_idname != tree_type:
         ng = bpy.data.node_groups.new(name, tree_type)
     ng.nodes.clear()
-    for sockets in (ng.inputs, ng.outputs):
-        sockets.clear()
+    compat.group_sockets_clear(ng)
     return ng
 
 

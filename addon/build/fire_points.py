@@ -10,6 +10,7 @@ import numpy as np
 
 from . import datablocks, frame_handlers, point_frames
 from .volume import FIRE_EMISSION, FIRE_KELVIN, _scaled_attribute
+from .. import blender_compat as compat
 from .. import flowgraph
 
 #: Custom properties of a fire points object: its cache folder and synthesized frame range.
@@ -79,11 +80,12 @@ def points_group():
     """The "Plume Fire Points" geometry-nodes group (rebuilt in place): Mesh to Points with
     the Radius input, then Set Material."""
     ng = datablocks.empty_node_group(GROUP, 'GeometryNodeTree')
-    ng.inputs.new('NodeSocketGeometry', "Geometry")
-    radius = ng.inputs.new('NodeSocketFloatDistance', "Radius")
+    new = compat.group_socket_new
+    new(ng, 'INPUT', 'NodeSocketGeometry', "Geometry")
+    radius = new(ng, 'INPUT', 'NodeSocketFloatDistance', "Radius")
     radius.min_value, radius.default_value = 0.0, 0.01
-    ng.inputs.new('NodeSocketMaterial', "Material")
-    ng.outputs.new('NodeSocketGeometry', "Geometry")
+    new(ng, 'INPUT', 'NodeSocketMaterial', "Material")
+    new(ng, 'OUTPUT', 'NodeSocketGeometry', "Geometry")
     N, L = ng.nodes.new, ng.links.new
     gin, gout = N('NodeGroupInput'), N('NodeGroupOutput')
     gin.location, gout.location = (-400, 0), (400, 0)
@@ -132,7 +134,7 @@ def build_object(scene, domain, folder, frame_start, last_frame, cell_size, max_
     if mod is None or mod.type != 'NODES':
         mod = ob.modifiers.new(GROUP, 'NODES')
     mod.node_group = ng
-    ids = {s.name: s.identifier for s in ng.inputs}
+    ids = compat.group_input_ids(ng)
     mod[ids["Radius"]] = 0.5 * float(cell_size)
     mod[ids["Material"]] = points_material(max_temperature)
     # The handler rewrites the points while rendering frames: lock the interface.

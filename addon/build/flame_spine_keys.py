@@ -12,6 +12,7 @@ hide_viewport and hide_render keyed on every baked frame (boolean keys hold, no 
 import bpy
 import numpy as np
 
+from .. import blender_compat as compat
 from .. import flames
 from .surface_edits import point_paths
 
@@ -62,8 +63,8 @@ def _collection(scene):
     return col
 
 
-def _key(action, path, index, frames, values, group):
-    fc = action.fcurves.new(path, index=index, action_group=group)
+def _key(id_data, path, index, frames, values, group):
+    fc = compat.fcurve_new(id_data, path, index=index, group=group)
     fc.keyframe_points.add(len(frames))
     fc.keyframe_points.foreach_set(
         "co", np.column_stack([frames, values]).astype(np.float32).ravel())
@@ -100,12 +101,12 @@ def bake(scene, folder, first, last):
         ob.data.animation_data_create().action = cu_action
         for k, path in enumerate(point_paths(n)):
             for c in range(3):
-                _key(cu_action, path, c, frames, xyz[:, k, c], "Plume Spine")
+                _key(ob.data, path, c, frames, xyz[:, k, c], "Plume Spine")
         hidden = ~np.isin(baked, frames)
         ob_action = bpy.data.actions.new(f"{ob.name} Visibility")
         ob.animation_data_create().action = ob_action
         for path in ("hide_viewport", "hide_render"):
-            _key(ob_action, path, 0, baked, hidden.astype(np.float32), "Plume Spine")
+            _key(ob, path, 0, baked, hidden.astype(np.float32), "Plume Spine")
         objects.append(ob)
         keys += len(frames) * n * 3 + 2 * len(baked)
     return objects, keys

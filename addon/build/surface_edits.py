@@ -14,6 +14,8 @@ plume.surface_edits_store operator (which also loads edit-mode data first).
 import bpy
 import numpy as np
 
+from .. import blender_compat as compat
+
 #: Offsets (float64, nu * nv * 3) of the hand edits.
 EDITS_KEY = "plume_surface_edits"
 #: Index into the control-point cache of the frame whose points were last written.
@@ -108,13 +110,14 @@ def bake_keyframes(ob, cps, frame_start):
         action = bpy.data.actions.new(f"{ob.name}_plume_keys")
         ad.action = action
     paths = set(point_paths(n))
-    for fc in [fc for fc in action.fcurves if fc.data_path in paths]:
-        action.fcurves.remove(fc)
+    curves = compat.fcurves(cu)
+    for fc in [fc for fc in curves if fc.data_path in paths]:
+        curves.remove(fc)
     keys = np.empty((frames, 2), dtype=np.float32)
     keys[:, 0] = np.arange(frame_start, frame_start + frames, dtype=np.float32)
     for k, path in enumerate(point_paths(n)):
         for c in range(3):
-            fc = action.fcurves.new(path, index=c, action_group="Plume Surface")
+            fc = compat.fcurve_new(cu, path, index=c, group="Plume Surface")
             fc.keyframe_points.add(frames)
             keys[:, 1] = xyz[:, k, c]
             fc.keyframe_points.foreach_set("co", keys.ravel())

@@ -11,6 +11,7 @@ import bpy
 import numpy as np
 
 from . import frame_handlers, surface_edits
+from .. import blender_compat as compat
 
 #: Custom properties of a surface object: its control-point cache and the domain it came from.
 CACHE_KEY = "plume_surface_cache"
@@ -225,8 +226,7 @@ def sheet_material(name, image_path, width, height, frame_start, frames, setting
     """p = d × e^(−|n·v|) (or 1 − |n·v|), Transparent mixed with Emission by p (§3.4)."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
-    mat.blend_method = 'BLEND'
-    mat.shadow_method = 'HASHED'
+    compat.set_transparency(mat, 'BLEND')
     mat.use_backface_culling = False
     nt = mat.node_tree
     nt.nodes.clear()

@@ -15,6 +15,7 @@ Also: scene wiring with the Z pass, and the optional Freestyle style."""
 import bpy
 
 from . import datablocks
+from .. import blender_compat as compat
 from .toon_nodes import link_math
 
 GROUP = "Plume Depth Differences"
@@ -39,32 +40,33 @@ def depth_group():
     """The compositor node group (rebuilt in place when it exists). Outputs: Image (outline
     pixels in Outline Color, others from Image) and Outline (1 on outline pixels, else 0)."""
     ng = datablocks.empty_node_group(GROUP, 'CompositorNodeTree')
-    for name, kind, default in INPUTS:
-        ng.inputs.new(kind, name).default_value = default
-    ng.inputs["Gamma"].min_value = 0.0
-    ng.inputs["Ignore Background"].min_value, ng.inputs["Ignore Background"].max_value = 0.0, 1.0
-    ng.outputs.new('NodeSocketColor', "Image")
-    ng.outputs.new('NodeSocketFloat', "Outline")
+    new = compat.group_socket_new
+    sockets = {name: new(ng, 'INPUT', kind, name) for name, kind, _ in INPUTS}
+    for name, _, default in INPUTS:
+        sockets[name].default_value = default
+    sockets["Gamma"].min_value = 0.0
+    sockets["Ignore Background"].min_value, sockets["Ignore Background"].max_value = 0.0, 1.0
+    new(ng, 'OUTPUT', 'NodeSocketColor', "Image")
+    new(ng, 'OUTPUT', 'NodeSocketFloat', "Outline")
     N, L = ng.nodes.new, ng.links.new
     gin, gout = N('NodeGroupInput'), N('NodeGroupOutput')
     gin.location, gout.location = (-1200, 0), (1100, 0)
     z = gin.outputs["Depth"]
 
     def math(op, a, b, x, y):
-        return link_math(ng, op, a, b, (x, y), kind='CompositorNodeMath')
+        return link_math(ng, op, a, b, (x, y), kind=compat.COMPOSITOR_MATH)
 
     conditions = []
     for n, (dx, dy, size) in enumerate(((1, 0, "Pixel Width"), (-1, 0, "Pixel Width"),
                                         (0, 1, "Pixel Height"), (0, -1, "Pixel Height"))):
         y = 600 - n * 300
-        t = N('CompositorNodeTranslate')
-        t.location, t.wrap_axis, t.use_relative = (-1000, y), 'NONE', False
-        t.inputs["X"].default_value, t.inputs["Y"].default_value = float(dx), float(dy)
+        t = compat.compositor_translate(ng, dx, dy)
+        t.location = (-1000, y)
         L(z, t.inputs["Image"])
-        sep = N('CompositorNodeSepRGBA')  # the neighbour's depth exactly (no colour->BW mix)
+        sep = N('CompositorNodeSeparateColor')  # the neighbour's depth exactly (no colour->BW)
         sep.location = (-850, y)
         L(t.outputs["Image"], sep.inputs["Image"])
-        neighbour = sep.outputs["R"]
+        neighbour = sep.outputs["Red"]
         diff = math('ABSOLUTE', math('SUBTRACT', neighbour, z, -700, y), None, -550, y)
         over = math('GREATER_THAN', math('DIVIDE', diff, gin.outputs[size], -400, y),
                     gin.outputs["Gamma"], -250, y)
@@ -79,12 +81,12 @@ def depth_group():
     keep = math('SUBTRACT', 1.0, math('MULTIPLY', gin.outputs["Ignore Background"], background,
                                       350, -300), 500, -300)
     outline = math('MULTIPLY', any_, keep, 650, 100)
-    mix = N('CompositorNodeMixRGB')
+    mix, fac, a, b, mixed = compat.compositor_mix(ng)
     mix.location = (850, 100)
-    L(outline, mix.inputs["Fac"])
-    L(gin.outputs["Image"], mix.inputs[1])
-    L(gin.outputs["Outline Color"], mix.inputs[2])
-    L(mix.outputs["Image"], gout.inputs["Image"])
+    L(outline, fac)
+    L(gin.outputs["Image"], a)
+    L(gin.outputs["Outline Color"], b)
+    L(mixed, gout.inputs["Image"])
     L(outline, gout.inputs["Outline"])
     return ng
 
@@ -98,7 +100,7 @@ def set_outline(node, settings):
 
 def scene_node(scene):
     """The scene's "Plume Depth Differences" node, or None."""
-    nt = scene.node_tree if scene.use_nodes else None
+    nt = compat.compositor_tree(scene)
     return nt.nodes.get(NODE) if nt is not None else None
 
 
@@ -106,13 +108,12 @@ def wire_scene(scene, view_layer, settings, far):
     """Render Layers (Z pass on) -> "Plume Depth Differences" -> Composite in the scene's
     compositor, the group node's inputs set from the toon settings. Returns the group node."""
     view_layer.use_pass_z = True
-    scene.use_nodes = True
-    nt = scene.node_tree
+    nt = compat.compositor_tree(scene, create=True)
     group = depth_group()
     rl = next((n for n in nt.nodes if n.type == 'R_LAYERS'), None) or nt.nodes.new(
         'CompositorNodeRLayers')
-    comp = next((n for n in nt.nodes if n.type == 'COMPOSITE'), None) or nt.nodes.new(
-        'CompositorNodeComposite')
+    result = compat.compositor_output(nt)
+    comp = result.node
     # A new group node each time: the group's sockets were just rebuilt, and a node kept from an
     # earlier build would hold (and link to) its stale sockets - the second build lost the outline.
     old = nt.nodes.get(NODE)
@@ -127,7 +128,7 @@ def wire_scene(scene, view_layer, settings, far):
     node.inputs["Far"].default_value = float(far)
     nt.links.new(rl.outputs["Image"], node.inputs["Image"])
     nt.links.new(rl.outputs["Depth"], node.inputs["Depth"])
-    nt.links.new(node.outputs["Image"], comp.inputs["Image"])
+    nt.links.new(node.outputs["Image"], result)
     return node
 
 

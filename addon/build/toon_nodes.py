@@ -7,6 +7,7 @@ only where the stencil is opaque (with the view layer's pass_alpha_threshold).""
 import bpy
 
 from . import datablocks
+from .. import blender_compat as compat
 
 GROUP = "Plume Toon Billboards"
 #: Alpha above which a stencil pixel is opaque (material cut-out and Cycles pass threshold).
@@ -40,15 +41,16 @@ def billboard_group():
     Stretch Factor (k), Perspective. The orientation is computed here, from the camera as the
     depsgraph evaluates it for the frame drawn, so an animated camera never lags a frame."""
     ng = datablocks.empty_node_group(GROUP, 'GeometryNodeTree')
-    ng.inputs.new('NodeSocketGeometry', "Geometry")
-    ng.inputs.new('NodeSocketObject', "Camera")
-    ng.inputs.new('NodeSocketMaterial', "Material")
-    k = ng.inputs.new('NodeSocketFloat', "Stretch Factor")
+    new = compat.group_socket_new
+    new(ng, 'INPUT', 'NodeSocketGeometry', "Geometry")
+    new(ng, 'INPUT', 'NodeSocketObject', "Camera")
+    new(ng, 'INPUT', 'NodeSocketMaterial', "Material")
+    k = new(ng, 'INPUT', 'NodeSocketFloat', "Stretch Factor")
     k.min_value, k.default_value = 0.0, 0.5
     k.description = "k: the stencil stretches to 1 + k |v_screen| along the motion (Figure 4)"
-    persp = ng.inputs.new('NodeSocketBool', "Perspective")
+    persp = new(ng, 'INPUT', 'NodeSocketBool', "Perspective")
     persp.default_value = True
-    ng.outputs.new('NodeSocketGeometry', "Geometry")
+    new(ng, 'OUTPUT', 'NodeSocketGeometry', "Geometry")
     N, L = ng.nodes.new, ng.links.new
     gin, gout = N('NodeGroupInput'), N('NodeGroupOutput')
     gin.location, gout.location = (-1800, 0), (900, 0)
@@ -177,7 +179,7 @@ def is_perspective(camera):
 
 def set_camera(mod, camera):
     """Points the billboards at `camera` (perspective or not). False when nothing changed."""
-    ids = {s.name: s.identifier for s in mod.node_group.inputs}
+    ids = compat.group_input_ids(mod.node_group)
     persp = is_perspective(camera)
     if mod[ids["Camera"]] == camera and bool(mod[ids["Perspective"]]) == persp:
         return False
@@ -199,7 +201,7 @@ def apply_billboards(ob, camera, material, stretch_factor):
     if mod is None or mod.type != 'NODES':
         mod = ob.modifiers.new(GROUP, 'NODES')
     mod.node_group = ng
-    ids = {s.name: s.identifier for s in ng.inputs}
+    ids = compat.group_input_ids(ng)
     set_camera(mod, camera)
     mod[ids["Material"]] = material
     set_stretch(mod, stretch_factor)
@@ -223,7 +225,7 @@ def set_ramp(mat, settings):
 
 
 def set_stretch(mod, stretch_factor):
-    ids = {s.name: s.identifier for s in mod.node_group.inputs}
+    ids = compat.group_input_ids(mod.node_group)
     mod[ids["Stretch Factor"]] = float(stretch_factor)
 
 
@@ -232,9 +234,7 @@ def toon_material(name, stencil_path, settings):
     out by the stencil's alpha > ALPHA_THRESHOLD (mixed with Transparent, so 0 or 1, never blended)."""
     mat = bpy.data.materials.get(name) or bpy.data.materials.new(name)
     mat.use_nodes = True
-    mat.blend_method = 'CLIP'
-    mat.alpha_threshold = ALPHA_THRESHOLD
-    mat.shadow_method = 'CLIP'
+    compat.set_transparency(mat, 'CLIP', ALPHA_THRESHOLD)
     mat.use_backface_culling = False
     nt = mat.node_tree
     nt.nodes.clear()
