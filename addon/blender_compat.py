@@ -28,10 +28,22 @@ def _legacy_sockets(ng):
 
 def group_socket_new(ng, in_out, socket_type, name):
     """A new input ('INPUT') or output ('OUTPUT') socket of node group `ng`; the returned socket
-    takes default_value, min_value, max_value and description in every version."""
+    takes default_value, min_value, max_value and description in every version. Subtyped types
+    ('NodeSocketFloatDistance', ...) become the base type with that subtype from 4.0."""
     if _legacy_sockets(ng):
         return (ng.inputs if in_out == 'INPUT' else ng.outputs).new(socket_type, name)
-    return ng.interface.new_socket(name, in_out=in_out, socket_type=socket_type)
+    subtype = next((s for s in _SUBTYPES if socket_type.endswith(s.title().replace("_", ""))
+                    and socket_type != "NodeSocket" + s.title()), None)
+    base = socket_type[:-len(subtype.title().replace("_", ""))] if subtype else socket_type
+    socket = ng.interface.new_socket(name, in_out=in_out, socket_type=base)
+    if subtype:
+        socket.subtype = subtype
+    return socket
+
+
+#: Socket subtypes that 3.x spells as their own socket types (NodeSocketFloatDistance, ...).
+_SUBTYPES = ("DISTANCE", "FACTOR", "ANGLE", "PERCENTAGE", "TIME", "UNSIGNED", "TRANSLATION",
+             "DIRECTION", "VELOCITY", "ACCELERATION", "EULER", "XYZ")
 
 
 def group_sockets(ng, in_out):
@@ -147,33 +159,50 @@ def _slot(id_data, action, create):
     return slot
 
 
+def _channelbag(id_data, action, create):
+    """The channel bag of `id_data`'s slot in `action` (layered actions, 4.4+), or None."""
+    slot = _slot(id_data, action, create)
+    if slot is None:
+        return None
+    if not create:
+        from bpy_extras import anim_utils
+        return anim_utils.action_get_channelbag_for_slot(action, slot)
+    layer = action.layers[0] if len(action.layers) else action.layers.new("Layer")
+    strip = layer.strips[0] if len(layer.strips) else layer.strips.new(type='KEYFRAME')
+    return strip.channelbag(slot, ensure=True)
+
+
 def fcurve_new(id_data, path, index=0, group=""):
-    """A new F-curve on the action assigned to `id_data` (which must have one)."""
+    """A new F-curve on the action assigned to `id_data` (which must have one), in the group
+    `group` when given. From 4.4 it goes in the channel bag of the ID's slot (created and
+    assigned when missing: the legacy Action.fcurves of 4.4-4.5 leave a new action's slot
+    unassigned, so nothing would play)."""
     action = id_data.animation_data.action
-    if hasattr(action, "fcurves"):
+    if not hasattr(action, "slots"):  # 3.4
         return action.fcurves.new(path, index=index, action_group=group)
-    from bpy_extras import anim_utils
-    bag = anim_utils.action_ensure_channelbag_for_slot(action, _slot(id_data, action, True))
-    return bag.fcurves.new(path, index=index, group_name=group)
+    bag = _channelbag(id_data, action, True)
+    fc = bag.fcurves.new(path, index=index)
+    if group:
+        fc.group = bag.groups.get(group) or bag.groups.new(group)
+    return fc
 
 
 def fcurves(id_data):
-    """The F-curves animating `id_data` through its assigned action ([] without one); from 5.0
+    """The F-curves animating `id_data` through its assigned action ([] without one); from 4.4
     the channel bag of its slot. The result supports iteration, find(path, index) and remove()."""
     ad = id_data.animation_data
     action = ad.action if ad is not None else None
     if action is None:
         return []
-    if hasattr(action, "fcurves"):
+    if not hasattr(action, "slots"):
         return action.fcurves
-    from bpy_extras import anim_utils
-    bag = anim_utils.action_get_channelbag_for_slot(action, ad.action_slot)
+    bag = _channelbag(id_data, action, False)
     return bag.fcurves if bag is not None else []
 
 
 def action_fcurves(action):
     """Every F-curve of `action`, whatever slot it animates."""
-    if hasattr(action, "fcurves"):
+    if not hasattr(action, "layers"):
         return list(action.fcurves)
     return [fc for layer in action.layers for strip in layer.strips
             for bag in strip.channelbags for fc in bag.fcurves]
@@ -222,3 +251,75 @@ def compositor_file_output(nt, directory, name, socket):
         fo.file_slots[0].path = name
         nt.links.new(socket, fo.inputs[0])
     return fo
+
+
+# --- Blender's Mantaflow in the bpy wheels ----------------------------------------------------
+
+#: Mantaflow's Python class hierarchy (its `PYTHON() class X : public Y` declarations), by the
+#: names the `manta` module gives its classes.
+_MANTA_BASES = {
+    "FluidSolver": "PbClass", "GridBase": "PbClass", "Grid4dBase": "PbClass", "Mesh": "PbClass",
+    "MeshDataBase": "PbClass", "Shape": "PbClass", "ParticleBase": "PbClass",
+    "ParticleDataBase": "PbClass", "MovingObstacle": "PbClass", "WaveletNoiseField": "PbClass",
+    "Timings": "PbClass",
+    "Grid_Real": "GridBase", "Grid_Vec3": "GridBase", "Grid_int": "GridBase",
+    "LevelsetGrid": "Grid_Real", "MACGrid": "Grid_Vec3", "FlagGrid": "Grid_int",
+    "Grid4d_Real": "Grid4dBase", "Grid4d_Vec3": "Grid4dBase", "Grid4d_Vec4": "Grid4dBase",
+    "Grid4d_int": "Grid4dBase",
+    "VortexSheetMesh": "Mesh",
+    "MeshDataImpl_Real": "MeshDataBase", "MeshDataImpl_Vec3": "MeshDataBase",
+    "MeshDataImpl_int": "MeshDataBase",
+    "NullShape": "Shape", "Box": "Shape", "Sphere": "Shape", "Cylinder": "Shape", "Slope": "Shape",
+    "ParticleSystem_BasicParticleData": "ParticleBase",
+    "ParticleSystem_ParticleIndexData": "ParticleBase",
+    "ParticleSystem_TurbulenceParticleData": "ParticleBase",
+    "ParticleSystem_VortexParticleData": "ParticleBase",
+    "BasicParticleSystem": "ParticleSystem_BasicParticleData",
+    "ParticleIndexSystem": "ParticleSystem_ParticleIndexData",
+    "TurbulenceParticleSystem": "ParticleSystem_TurbulenceParticleData",
+    "VortexParticleSystem": "ParticleSystem_VortexParticleData",
+    "ParticleDataImpl_Real": "ParticleDataBase", "ParticleDataImpl_Vec3": "ParticleDataBase",
+    "ParticleDataImpl_int": "ParticleDataBase",
+}
+#: Index of PyTypeObject.tp_mro among its pointer-sized fields (CPython 3.11, 64-bit).
+_TP_MRO_FIELD = 43
+
+
+def repair_mantaflow_bindings():
+    """Makes Blender's own Mantaflow bake in the `bpy` wheels (4.2+ on Linux), whose `manta`
+    classes come unlinked from their bases (every class's MRO is (class, object)): Blender's
+    4.x smoke scripts then stop at `phiObs.setConst(9999)` ("'LevelsetGrid' object has no
+    attribute 'setConst'") and the bake aborts the process. This sets each class's MRO to the
+    declared hierarchy, so base methods resolve and type checks pass. A no-op where the
+    hierarchy is linked (Blender's own executables) or when `manta` is missing; returns the
+    number of classes relinked. Only Mantaflow's bakes need it; Plume's own bakes do not."""
+    try:
+        import manta
+    except ImportError:
+        return 0
+    if issubclass(manta.LevelsetGrid, manta.Grid_Real):
+        return 0
+    import ctypes
+
+    def chain(name):
+        out = [getattr(manta, name)]
+        while name in _MANTA_BASES:
+            name = _MANTA_BASES[name]
+            out.append(getattr(manta, name))
+        return tuple(out) + (object,)
+
+    relinked = 0
+    for name in _MANTA_BASES:
+        cls = getattr(manta, name, None)
+        if cls is None or len(cls.__mro__) > 2:
+            continue
+        slot = ctypes.c_void_p.from_address(id(cls) + ctypes.sizeof(ctypes.c_void_p)
+                                            * _TP_MRO_FIELD)
+        if slot.value != id(cls.__mro__):
+            return relinked  # another type layout: leave the classes alone
+        mro = chain(name)
+        ctypes.pythonapi.Py_IncRef(ctypes.py_object(mro))  # owned by the type from now on
+        slot.value = id(mro)
+        ctypes.pythonapi.PyType_Modified(ctypes.py_object(cls))
+        relinked += 1
+    return relinked

@@ -35,13 +35,13 @@ def flames_material(emission):
         blackbody = N("ShaderNodeBlackbody")
         blackbody.location = (-450, -150)
         L(_attribute(nt, "temperature", -150).outputs["Fac"], blackbody.inputs["Temperature"])
-        tint = N("ShaderNodeMixRGB")
-        tint.location = (-250, -150)
-        tint.blend_type = 'MULTIPLY'
-        tint.inputs["Fac"].default_value = 1.0
-        L(blackbody.outputs["Color"], tint.inputs[1])
-        L(_attribute(nt, "color", -350).outputs["Vector"], tint.inputs[2])
-        L(tint.outputs["Color"], pv.inputs["Emission Color"])
+        # blackbody x colour, component-wise (a Vector Math node: Cycles 5.0 crashes optimizing
+        # a volume shader holding the legacy MixRGB node)
+        tint = N("ShaderNodeVectorMath")
+        tint.location, tint.operation = (-250, -150), 'MULTIPLY'
+        L(blackbody.outputs["Color"], tint.inputs[0])
+        L(_attribute(nt, "color", -350).outputs["Vector"], tint.inputs[1])
+        L(tint.outputs["Vector"], pv.inputs["Emission Color"])
         L(_attribute(nt, "color", 150).outputs["Vector"], pv.inputs["Color"])
         strength = volume._scaled_attribute(nt, "flame", emission, -500)
         strength.name = "Plume Emission"
