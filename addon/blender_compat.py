@@ -103,6 +103,12 @@ def compositor_tree(scene, create=False):
     return scene.node_tree
 
 
+def compositor_full_precision(scene):
+    """32-bit floats through the compositor (4.2+ may otherwise pick half floats)."""
+    if hasattr(scene.render, "compositor_precision"):
+        scene.render.compositor_precision = 'FULL'
+
+
 def compositor_output(nt):
     """The input socket whose image is the compositor's result (Composite's Image before 5.0, the
     Group Output's first socket from 5.0), its node created when missing."""
@@ -213,14 +219,20 @@ def action_fcurves(action):
 def set_transparency(mat, mode, alpha_threshold=0.5):
     """EEVEE transparency: 'CLIP' (cut out at alpha_threshold, shadows too), 'BLEND' (blended,
     hashed shadows). Cycles ignores these; they keep EEVEE previews right."""
-    if hasattr(mat, "surface_render_method"):  # EEVEE Next (4.2+)
+    if hasattr(mat, "surface_render_method"):  # EEVEE Next (4.2+): the shader cuts at alpha
         mat.surface_render_method = 'DITHERED' if mode == 'CLIP' else 'BLENDED'
         mat.use_transparent_shadow = True
-    if hasattr(mat, "shadow_method"):  # 3.4
-        mat.shadow_method = 'CLIP' if mode == 'CLIP' else 'HASHED'
-    if hasattr(mat, "blend_method"):
+    else:  # 3.4
         mat.blend_method = mode
+        mat.shadow_method = 'CLIP' if mode == 'CLIP' else 'HASHED'
     mat.alpha_threshold = alpha_threshold
+
+
+def transparency(mat):
+    """The mode set_transparency gave `mat` ('CLIP', 'BLEND' or 'OPAQUE')."""
+    if hasattr(mat, "surface_render_method"):
+        return {'DITHERED': 'CLIP', 'BLENDED': 'BLEND'}.get(mat.surface_render_method, 'OPAQUE')
+    return mat.blend_method if mat.blend_method in ('CLIP', 'BLEND') else 'OPAQUE'
 
 
 def eevee_engine():
@@ -239,13 +251,15 @@ def compositor_file_output(nt, directory, name, socket):
     """A File Output node writing `socket` as a 32-bit float EXR to
     <directory>/<name><frame:04d>.exr on every render."""
     fo = nt.nodes.new('CompositorNodeOutputFile')
+    if hasattr(fo.format, "media_type"):  # 5.0+: a multilayer EXR unless told otherwise
+        fo.format.media_type = 'IMAGE'
     fo.format.file_format = 'OPEN_EXR'
     fo.format.color_depth = '32'
     fo.format.exr_codec = 'ZIP'
-    if hasattr(fo, "file_output_items"):  # 5.0+: one item per input, named in the file name
+    if hasattr(fo, "file_output_items"):  # 5.0+: file name + item name, '#' -> frame number
         fo.directory, fo.file_name = directory, ""
-        fo.file_output_items.new('RGBA', name)
-        nt.links.new(socket, fo.inputs[name])
+        fo.file_output_items.new('RGBA', name + "####")
+        nt.links.new(socket, fo.inputs[name + "####"])
     else:
         fo.base_path = directory
         fo.file_slots[0].path = name

@@ -79,6 +79,20 @@ def command(label, path, names):
     return [py, "-c", boot, path, *tail]
 
 
+def clean_env():
+    """The environment for a test process, without a pyenv's PATH entries: Debian's Blender looks
+    for its Python home along PATH and, finding pyenv's 3.11, loses /usr/lib/python3/dist-packages
+    (numpy, the add-on's only dependency)."""
+    env = dict(os.environ)
+    root = env.get("PYENV_ROOT")
+    if root:
+        env["PATH"] = os.pathsep.join(p for p in env.get("PATH", "").split(os.pathsep)
+                                      if not p.startswith(root))
+        for k in [k for k in env if k.startswith("PYENV")]:
+            del env[k]
+    return env
+
+
 def run_file(label, path, names):
     """(passed, failed) test counts of one file; a file that crashes or prints no summary counts
     as one failure."""
@@ -86,7 +100,8 @@ def run_file(label, path, names):
     print(f"-- [{label}] {os.path.basename(path)}", flush=True)
     try:
         proc = subprocess.run(command(label, path, names), stdout=subprocess.PIPE,
-                              stderr=subprocess.STDOUT, text=True, timeout=TIMEOUT_S)
+                              stderr=subprocess.STDOUT, text=True, timeout=TIMEOUT_S,
+                              env=clean_env())
         out, rc = proc.stdout, proc.returncode
     except subprocess.TimeoutExpired as e:
         out, rc = (e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) \

@@ -188,7 +188,7 @@ class ToonSmokeTest(unittest.TestCase):
         t.stretch_factor, t.depth_threshold = 0.5, GAMMA
         self.assertEqual(ob.modifiers[0].node_group.name, "Plume Toon Billboards")
         mat = bpy.data.materials["Plume Toon Domain"]
-        self.assertEqual(mat.blend_method, 'CLIP')
+        self.assertEqual(compat.transparency(mat), 'CLIP')
         self.assertEqual(bpy.context.view_layer.pass_alpha_threshold, 0.5)
         # The generated stencil is deterministic: a second build writes the same bytes.
         path = os.path.join(self.folder, "stencil_puffy.png")

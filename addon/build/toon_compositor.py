@@ -66,8 +66,13 @@ def depth_group():
         sep = N('CompositorNodeSeparateColor')  # the neighbour's depth exactly (no colour->BW)
         sep.location = (-850, y)
         L(t.outputs["Image"], sep.inputs["Image"])
-        neighbour = sep.outputs["Red"]
-        diff = math('ABSOLUTE', math('SUBTRACT', neighbour, z, -700, y), None, -550, y)
+        # 0 * z + neighbour: the neighbour on z's pixel grid. 4.2-4.5's compositor translates by
+        # moving an image's domain and computes a math node on its first input's domain, so z
+        # must come first for the shifted depth to be resampled onto z's pixels (uncovered ones
+        # read 0); 3.4 and 5.0 shift the pixels themselves, and there this is the identity.
+        neighbour = math('ADD', math('MULTIPLY', z, 0.0, -850, y - 120), sep.outputs["Red"],
+                         -700, y - 120)
+        diff = math('ABSOLUTE', math('SUBTRACT', z, neighbour, -700, y), None, -550, y)
         over = math('GREATER_THAN', math('DIVIDE', diff, gin.outputs[size], -400, y),
                     gin.outputs["Gamma"], -250, y)
         inside = math('MULTIPLY', math('GREATER_THAN', neighbour, 0.0, -550, y - 120),
@@ -109,6 +114,7 @@ def wire_scene(scene, view_layer, settings, far):
     compositor, the group node's inputs set from the toon settings. Returns the group node."""
     view_layer.use_pass_z = True
     nt = compat.compositor_tree(scene, create=True)
+    compat.compositor_full_precision(scene)  # depths differ by less than half floats resolve
     group = depth_group()
     rl = next((n for n in nt.nodes if n.type == 'R_LAYERS'), None) or nt.nodes.new(
         'CompositorNodeRLayers')
