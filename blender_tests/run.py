@@ -5,6 +5,7 @@
     blender_tests/run.py --blender 5.0 test_bake.py -- BakeTest.test_cache_free
     blender_tests/run.py --blender all                          # every file in every Blender
     blender_tests/run.py --setup all                            # create the bpy venvs only
+    blender_tests/run.py --blender 4.5 --script examples/compare_mantaflow.py -- 64 48
 
 Blenders: "3.4" is Debian 12's packaged 3.4.1 (``blender -b --factory-startup``); "4.5" and "5.0"
 are the ``bpy`` wheels from the Python package index, pinned below, each in its own CPython 3.11
@@ -124,6 +125,8 @@ def main(argv):
     ap.add_argument("--blender", default="3.4", choices=[*BPY_PINS, "all"])
     ap.add_argument("--setup", choices=[*BPY_PINS, "all"],
                     help="create the venv(s) of the bpy Blender(s) and stop")
+    ap.add_argument("--script", help="run this script (an example, a benchmark) in the Blender "
+                    "given by --blender, passing the arguments after --, and exit with its code")
     ap.add_argument("files", nargs="*", help="test files (default: every blender_tests/test_*.py)")
     a = ap.parse_args(args_)
     if a.setup:
@@ -131,6 +134,9 @@ def main(argv):
             setup(label)
         return 0
     labels = list(BPY_PINS) if a.blender == "all" else [a.blender]
+    if a.script:
+        return max(subprocess.run(command(label, os.path.abspath(a.script), names),
+                                  env=clean_env()).returncode for label in labels)
     files = [f if os.path.exists(f) else os.path.join(HERE, f) for f in a.files] or \
         sorted(glob.glob(os.path.join(HERE, "test_*.py")))
     totals = {}

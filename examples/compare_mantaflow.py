@@ -1,6 +1,7 @@
 """Bake time of Mantaflow vs Plume on the same smoke scene, in one Blender process.
 
     blender -b --factory-startup --python examples/compare_mantaflow.py -- RES FRAMES
+    blender_tests/run.py --blender 4.5 --script examples/compare_mantaflow.py -- RES FRAMES
 
 Scene (built twice): a 2 m cube domain standing on the floor (z 0..2), a UV sphere of radius
 0.16 m at (0, 0, 0.3) emitting smoke (density 1, temperature 1), RES cells along every axis,
@@ -183,6 +184,8 @@ def build_mantaflow(res, frames, cache_dir):
     sphere = bpy.context.active_object
     sphere.name = "SmokeSource"
     select_only(sphere)
+    from plume import blender_compat
+    blender_compat.repair_mantaflow_bindings()  # the bpy wheels' Mantaflow cannot bake without
     if bpy.ops.object.quick_smoke(style='SMOKE') != {'FINISHED'}:
         raise CompareError("bpy.ops.object.quick_smoke() failed")
     dom = bpy.context.active_object
@@ -376,7 +379,7 @@ def run(res, frames, work):
     plume_dir = os.path.join(work, "plume")
     os.makedirs(manta_dir)
     os.makedirs(plume_dir)
-    print(f"compare_mantaflow: {res}^3 cells, {frames} frames at {scene.render.fps} fps, "
+    print(f"compare_mantaflow: Blender {bpy.app.version_string}, {res}^3 cells, {frames} frames at {scene.render.fps} fps, "
           f"caches in {work}", flush=True)
 
     # 1. Mantaflow
@@ -435,6 +438,8 @@ def main():
         print(f"compare_mantaflow: FAILED: {e}", file=sys.stderr, flush=True)
         sys.exit(1)
     finally:
+        # Free the Mantaflow domain while Python runs (the bpy module aborts freeing it at exit).
+        bpy.ops.wm.read_homefile(use_factory_startup=True)
         if keep:
             print(f"compare_mantaflow: caches kept in {work}", flush=True)
         else:

@@ -65,8 +65,9 @@ def particles_object(dom, frame):
     ob = bpy.data.objects.new(mesh.name, mesh)
     bpy.context.scene.collection.objects.link(ob)
     ng = bpy.data.node_groups.new("ParticlePoints", 'GeometryNodeTree')
-    ng.inputs.new('NodeSocketGeometry', "Geometry")
-    ng.outputs.new('NodeSocketGeometry', "Geometry")
+    new_socket = scene_kit.compat().group_socket_new
+    new_socket(ng, 'INPUT', 'NodeSocketGeometry', "Geometry")
+    new_socket(ng, 'OUTPUT', 'NodeSocketGeometry', "Geometry")
     n_in, n_out = ng.nodes.new("NodeGroupInput"), ng.nodes.new("NodeGroupOutput")
     to_points = ng.nodes.new("GeometryNodeMeshToPoints")
     to_points.inputs["Radius"].default_value = PARTICLE_RADIUS

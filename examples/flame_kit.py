@@ -38,7 +38,7 @@ def solid(ob, color, roughness=0.6, emission=None, name=None):
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
     bsdf.inputs["Roughness"].default_value = roughness
     if emission is not None:
-        bsdf.inputs["Emission"].default_value = (*emission, 1.0)
+        scene_kit.compat().principled_emission_color(bsdf).default_value = (*emission, 1.0)
         bsdf.inputs["Emission Strength"].default_value = 1.0
     ob.data.materials.clear()
     ob.data.materials.append(mat)

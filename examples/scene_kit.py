@@ -234,17 +234,18 @@ def bake_toon(dom, tag):
 
 def build_toon(dom, tag):
     """Build Toon Smoke on `dom` again (e.g. after changing its toon settings), checks that the
-    Composite output is the "Plume Depth Differences" group's image (so the rendered and saved
+    compositor's result is the "Plume Depth Differences" group's image (so the rendered and saved
     frames carry the outlines); returns the seconds."""
     bpy.context.view_layer.objects.active = dom
     seconds = run_op(bpy.ops.plume.toon_build, tag, "Build Toon Smoke")
     scene = bpy.context.scene
-    comp = next((n for n in scene.node_tree.nodes if n.type == 'COMPOSITE'), None)
-    link = comp.inputs["Image"].links[0] if comp and comp.inputs["Image"].is_linked else None
-    if not (scene.use_nodes and scene.render.use_compositing and link is not None
+    tree = compat().compositor_tree(scene)
+    result = compat().compositor_output(tree) if tree is not None else None
+    link = result.links[0] if result is not None and result.is_linked else None
+    if not (scene.render.use_compositing and link is not None
             and link.from_node.type == 'GROUP'
             and link.from_node.node_tree.name == "Plume Depth Differences"):
-        sys.exit(f"{tag}: the Composite output is not the outline group's image")
+        sys.exit(f"{tag}: the compositor's result is not the outline group's image")
     return seconds
 
 
@@ -288,7 +289,7 @@ def burst(src, frames_on):
         for name in ("density", "temperature", "velocity"):
             src.keyframe_insert("plume.source." + name, frame=frame)
     s.density, s.temperature, s.velocity = on
-    for fc in src.animation_data.action.fcurves:
+    for fc in compat().fcurves(src):
         for k in fc.keyframe_points:
             k.interpolation = 'CONSTANT'
     return src
@@ -362,6 +363,11 @@ def addon_module(name):
     return importlib.import_module("plume." + name)
 
 
+def compat():
+    """The add-on's module of Blender version differences (plume.blender_compat)."""
+    return addon_module("blender_compat")
+
+
 def select(objects, active):
     """Selects exactly `objects` and makes `active` the active object."""
     bpy.ops.object.select_all(action='DESELECT')
@@ -427,7 +433,7 @@ def flicker(src, speed, fuel_share, period, seed=0):
         for name in ("velocity", "fuel"):
             src.keyframe_insert("plume.source." + name, frame=min(frame, period + 1))
     s.fuel, s.velocity = fuel, (0.0, 0.0, 0.0)
-    for fc in src.animation_data.action.fcurves:
+    for fc in compat().fcurves(src):
         fc.modifiers.new('CYCLES')
     return src
 
@@ -489,7 +495,7 @@ def key_target_states(dom, keys):
     for frame, state in keys:
         g.target_state = state
         g.keyframe_insert("target_state", frame=frame)
-    for fc in dom.animation_data.action.fcurves:
+    for fc in compat().fcurves(dom):
         if fc.data_path.endswith("target_state"):
             for k in fc.keyframe_points:
                 k.interpolation = 'CONSTANT'

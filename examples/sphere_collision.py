@@ -74,7 +74,7 @@ def make_source():
         s.emit_particles = on
         src.keyframe_insert('plume.source.density', frame=frame)
         src.keyframe_insert('plume.source.emit_particles', frame=frame)
-    for fc in src.animation_data.action.fcurves:
+    for fc in scene_kit.compat().fcurves(src):
         for k in fc.keyframe_points:
             k.interpolation = 'CONSTANT'
     return src

@@ -29,7 +29,7 @@ def best_render_seconds(scene, view_layer, repeats):
     best = {True: float("inf"), False: float("inf")}
     for _ in range(repeats):
         for outlines in (True, False):
-            scene.use_nodes = view_layer.use_pass_z = outlines
+            scene.render.use_compositing = view_layer.use_pass_z = outlines
             t0 = time.perf_counter()
             bpy.ops.render.render()
             best[outlines] = min(best[outlines], time.perf_counter() - t0)
@@ -50,7 +50,8 @@ def main():
     bpy.ops.wm.open_mainfile(filepath=os.path.abspath(argv[0]))
     scene, view_layer = bpy.context.scene, bpy.context.view_layer
     toon = [o for o in scene.objects if "plume_toon_cache" in o]
-    tree = scene.node_tree
+    from plume import blender_compat
+    tree = blender_compat.compositor_tree(scene)
     if not toon or tree is None or "Plume Depth Differences" not in tree.nodes:
         sys.exit(f"{argv[0]}: no toon smoke built (run the example first)")
     scene.frame_set(frame if frame is not None else scene.frame_end)
