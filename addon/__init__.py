@@ -19,8 +19,14 @@ bl_info = {
 if sys.version_info[:2] != (3, 11):
     raise ImportError(
         "Plume: the native module is built for Python 3.11, but this Blender runs Python "
-        f"{sys.version_info[0]}.{sys.version_info[1]}; use Blender 3.4-4.x with Python 3.11 "
+        f"{sys.version_info[0]}.{sys.version_info[1]}; use Blender 3.4 to 5.0 (Python 3.11) "
         "or rebuild the module against this Python")
+
+import bpy  # noqa: E402
+
+if tuple(bpy.app.version) < (3, 4, 0):
+    raise ImportError(f"Plume needs Blender 3.4 or newer (this is {bpy.app.version_string}); "
+                      "tested in 3.4.1, 4.5 LTS and 5.0")
 
 try:
     from . import _native  # noqa: F401  (fail here, with a clear message)
@@ -35,8 +41,6 @@ except ImportError as e:
         "-DPython_EXECUTABLE=/usr/bin/python3 && cmake --build build -j2 --target _native, then "
         "copy build/native/_native*.so next to the add-on's __init__.py (the README's install "
         "command does both)") from e
-
-import bpy  # noqa: E402  (after the checks above)
 
 from . import operators, properties, ui  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402

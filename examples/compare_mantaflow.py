@@ -379,8 +379,8 @@ def run(res, frames, work):
     plume_dir = os.path.join(work, "plume")
     os.makedirs(manta_dir)
     os.makedirs(plume_dir)
-    print(f"compare_mantaflow: Blender {bpy.app.version_string}, {res}^3 cells, {frames} frames at {scene.render.fps} fps, "
-          f"caches in {work}", flush=True)
+    print(f"compare_mantaflow: Blender {bpy.app.version_string}, {res}^3 cells, {frames} frames "
+          f"at {scene.render.fps} fps, caches in {work}", flush=True)
 
     # 1. Mantaflow
     manta_dom, sphere = build_mantaflow(res, frames, manta_dir)
