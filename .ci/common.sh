@@ -66,27 +66,31 @@ setup_all() {
 # blender_tests/install_zip/plume_zip.py, RUNPATH $ORIGIN). A Blender 3.4 add-on zip and a
 # Blender 4.2+ extension at once. Needs build_native first; prints the zip's path and size.
 package_zip() {
-  local helper="$ROOT/blender_tests/install_zip/plume_zip.py" version stage zip
+  local helper="$ROOT/blender_tests/install_zip/plume_zip.py" version stage zip ext
   version="$(/usr/bin/python3 "$helper" version "$ROOT/addon")"
   zip="$ROOT/dist/plume-$version-linux-x64.zip"
   stage="$(mktemp -d)"
   echo "== packaging plume $version"
-  /usr/bin/python3 "$helper" stage "$ROOT/addon" "$(ls "$BUILD"/native/_native*.so)" "$stage/plume" \
-    || { rm -rf "$stage"; return 1; }
-  /usr/bin/python3 "$helper" check "$stage/plume" || { rm -rf "$stage"; return 1; }
-  mkdir -p "$ROOT/dist"
-  rm -f "$zip"
-  (cd "$stage" && zip -q -r -X -9 "$zip" plume) || { rm -rf "$stage"; return 1; }
-  rm -rf "$stage"
-  # Blender's own extension validator (strict: what `blender --command extension validate` and
-  # the extensions platform check), when a bpy venv holds a copy of it. Install-from-Disk is
-  # lenient, so findings are warnings here.
-  local ext
-  ext="$(ls "${PLUME_VENV_ROOT:-$HOME/.cache/plume/venvs}"/bpy-*/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py 2>/dev/null | tail -n 1 || true)"
-  if [ -n "$ext" ]; then
-    /usr/bin/python3 "$ext" validate "$zip" >/dev/null 2>&1 \
-      || { echo "== warning: Blender's strict extension validation reports:"; \
-           /usr/bin/python3 "$ext" validate "$zip" 2>&1 | sed 's/^/   /' || true; }
+  if ! { /usr/bin/python3 "$helper" stage "$ROOT/addon" "$BUILD"/native/_native*.so \
+           "$stage/plume" &&
+         /usr/bin/python3 "$helper" check "$stage/plume" &&
+         mkdir -p "$ROOT/dist" && rm -f "$zip" &&
+         (cd "$stage" && zip -q -r -X -9 "$zip" plume); }; then
+    rm -rf "$stage"
+    echo "== packaging failed" >&2
+    return 1
   fi
-  echo "== $(du -h "$zip" | cut -f1)  $zip ($(stat -c %s "$zip") bytes, $(unzip -Z1 "$zip" | wc -l) entries)"
+  rm -rf "$stage"
+  # Blender's own strict extension validator (`blender --command extension validate`, the
+  # extensions platform's check), from a bpy venv when there is one: the manifest must pass it.
+  ext="$(ls "${PLUME_VENV_ROOT:-$HOME/.cache/plume/venvs}"/bpy-*/lib/python3.11/site-packages/\
+bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py 2>/dev/null | tail -n 1 || true)"
+  if [ -n "$ext" ] && ! /usr/bin/python3 "$ext" validate "$zip" >/dev/null 2>&1; then
+    echo "== $zip fails Blender's extension validation:" >&2
+    /usr/bin/python3 "$ext" validate "$zip" 2>&1 | sed 's/^/   /' >&2 || true
+    rm -f "$zip"
+    return 1
+  fi
+  echo "== $zip: $(du -h "$zip" | cut -f1) ($(stat -c %s "$zip") bytes," \
+       "$(unzip -Z1 "$zip" | wc -l) entries)"
 }

@@ -36,14 +36,17 @@ def _raise(exc):
     raise exc
 
 
-def _compat():
-    """The add-on's module of Blender version differences (tests use it as the builders do)."""
-    enable_addon()
-    import importlib
-    return importlib.import_module(ADDON + ".blender_compat")
+class _Compat:
+    """The add-on's module of Blender version differences (plume.blender_compat), which tests
+    use as the builders do; loaded on first use, enabling the add-on then."""
+
+    def __getattr__(self, name):
+        enable_addon()
+        import importlib
+        return getattr(importlib.import_module(ADDON + ".blender_compat"), name)
 
 
-compat = _compat()
+compat = _Compat()
 
 
 def native():

@@ -20,8 +20,8 @@ _running = {}
 
 
 def _addon_version():
-    from .. import bl_info
-    return ".".join(str(v) for v in bl_info["version"])
+    from .. import VERSION
+    return VERSION
 
 
 def _prepare(context):
