@@ -11,9 +11,10 @@ Blenders: "3.4" is Debian 12's packaged 3.4.1 (``blender -b --factory-startup``)
 are the ``bpy`` wheels from the Python package index, pinned below, each in its own CPython 3.11
 venv under $PLUME_VENV_ROOT (default ~/.cache/plume/venvs), created once by --setup and reused.
 A test file under a ``bpy`` module runs in ``<venv>/bin/python`` after ``import bpy``: the same
-script, the same operators, no window. The add-on must be installed where each Blender finds user add-ons
-($BLENDER_USER_SCRIPTS/addons/plume, else ~/.config/blender/<x.y>/scripts/addons/plume);
-.ci/common.sh does that.
+script, the same operators, no window. Each Blender's renders go to $PLUME_TEST_OUT/<x.y>/
+(default /tmp/plume_test_out/<x.y>/), to compare them. The add-on must be installed where each
+Blender finds user add-ons ($BLENDER_USER_SCRIPTS/addons/plume, else
+~/.config/blender/<x.y>/scripts/addons/plume); .ci/common.sh does that.
 
 Each file prints "N passed, N failed" on its last line (helpers.run); this runner adds them up and
 prints them per Blender and in total, and exits 1 when anything failed."""
@@ -100,9 +101,11 @@ def run_file(label, path, names):
     start = time.monotonic()
     print(f"-- [{label}] {os.path.basename(path)}", flush=True)
     try:
+        env = clean_env()  # each Blender's renders in a folder of its own, to compare them
+        env["PLUME_TEST_OUT"] = os.path.join(
+            os.environ.get("PLUME_TEST_OUT", "/tmp/plume_test_out"), label)
         proc = subprocess.run(command(label, path, names), stdout=subprocess.PIPE,
-                              stderr=subprocess.STDOUT, text=True, timeout=TIMEOUT_S,
-                              env=clean_env())
+                              stderr=subprocess.STDOUT, text=True, timeout=TIMEOUT_S, env=env)
         out, rc = proc.stdout, proc.returncode
     except subprocess.TimeoutExpired as e:
         out, rc = (e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) \

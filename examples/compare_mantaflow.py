@@ -217,7 +217,9 @@ def build_mantaflow(res, frames, cache_dir):
     ds.cache_type = 'MODULAR'
     ds.cache_data_format = 'OPENVDB'
     ds.openvdb_data_depth = '32'            # full floats, like Plume's float32 grids
-    ds.openvdb_cache_compress_type = 'BLOSC'  # Plume writes Blosc too
+    # Plume writes Blosc too; Blender 5.0 offers only Zip or none, and none is the faster
+    compress = ds.bl_rna.properties["openvdb_cache_compress_type"].enum_items.keys()
+    ds.openvdb_cache_compress_type = 'BLOSC' if 'BLOSC' in compress else 'NONE'
     ds.cache_resumable = False
     ds.cache_directory = cache_dir
     ds.cache_frame_start = 1

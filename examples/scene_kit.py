@@ -547,6 +547,9 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     domains = setup(scene)
     cycles(scene, 400, 220, 64, os.path.join(out_dir, tag + "_"))
     plain_world(scene, (0.002, 0.002, 0.003))
+    # Filmic in every Blender (3.4's default; 4.x/5.x default to AgX, which renders the blackbody
+    # fire salmon-pink instead of orange-yellow): the README's strips are reproducible in each.
+    scene.view_settings.view_transform = 'Filmic'
     keys = [(max(1, round(f * frames)), state) for f, state in targets]
     scene.frame_start, scene.frame_end = 1, frames
     save_blend(out_dir, tag)
