@@ -3,7 +3,6 @@ zip into empty user folders, enable it, check where the add-on, _native and each
 were loaded from, bake and render (InstalledAddonTest); or install a zip lacking a library and
 check the error names it (BrokenInstallTest). Run by IsolatedRun, never directly."""
 
-import math
 import os
 import sys
 import time
@@ -17,7 +16,7 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.dirname(HERE))
 
 import plume_zip  # noqa: E402
-from helpers import image_pixels, select_only  # noqa: E402
+from helpers import assert_smoke_renders, select_only, smoke_studio  # noqa: E402
 from isolated import (ISOLATED_ENV, KEY_LIBS, MISSING_LIB, OUT_DIR,  # noqa: E402
                       VERSION, debian_blender, mapped_by_soname, mapped_files, run_isolated)
 
@@ -25,10 +24,6 @@ from isolated import (ISOLATED_ENV, KEY_LIBS, MISSING_LIB, OUT_DIR,  # noqa: E40
 RESOLUTION = 32
 FRAMES = 8
 SAMPLES = 8
-#: As test_bake.py: mean |render - render without the smoke| over pixels and RGB must exceed half
-#: an 8-bit level, and 1 % of the pixels must change by more than 4/255, or the smoke is missing.
-MIN_MEAN_ABS_DIFF = 0.002
-MIN_CHANGED_SHARE = 0.01
 
 
 class InstalledAddonTest(unittest.TestCase):
@@ -137,7 +132,6 @@ class InstalledAddonTest(unittest.TestCase):
 
     def test_4_bake_and_render_from_installed_addon(self):
         self.require_installed()
-        import numpy as np
         for ob in list(bpy.data.objects):
             bpy.data.objects.remove(ob, do_unlink=True)
         cache = os.path.join(self.root, "cache")
@@ -163,44 +157,11 @@ class InstalledAddonTest(unittest.TestCase):
         self.assertEqual(smoke.type, 'VOLUME')
 
         scene = bpy.context.scene
-        cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-        scene.collection.objects.link(cam)
-        cam.location = (0.0, -3.6, 0.9)
-        cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)
-        scene.camera = cam
-        sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", 'SUN'))
-        sun.data.energy = 4.0
-        sun.rotation_euler = (math.radians(40.0), math.radians(20.0), math.radians(-30.0))
-        scene.collection.objects.link(sun)
-        scene.render.engine = 'CYCLES'
-        scene.cycles.device = 'CPU'
-        scene.cycles.samples = SAMPLES
-        scene.cycles.use_denoising = False
-        scene.render.resolution_x, scene.render.resolution_y = 160, 120
-        scene.render.resolution_percentage = 100
-        scene.render.image_settings.file_format = 'PNG'
+        smoke_studio(scene, samples=SAMPLES)
         scene.frame_set(FRAMES)
         self.assertTrue(smoke.data.grids.load(), smoke.data.grids.error_message)
-        os.makedirs(OUT_DIR, exist_ok=True)
-        paths = {}
-        for visible in (True, False):
-            smoke.hide_render = not visible
-            path = os.path.join(OUT_DIR, f"install_zip_{VERSION}{'' if visible else '_empty'}.png")
-            scene.render.filepath = path
-            t0 = time.perf_counter()
-            bpy.ops.render.render(write_still=True)
-            print(f"  render ({'with' if visible else 'without'} smoke) took "
-                  f"{time.perf_counter() - t0:.2f} s -> {path}")
-            paths[visible] = path
-        a = image_pixels(paths[True])[..., :3]
-        b = image_pixels(paths[False])[..., :3]
-        diff = np.abs(a - b)
-        mean = float(diff.mean())
-        changed = float((diff.max(axis=2) > 4.0 / 255.0).mean())
-        print(f"  mean |smoke - empty| = {mean:.4f}, changed pixels = {changed:.1%}")
-        self.assertGreater(mean, MIN_MEAN_ABS_DIFF)
-        self.assertGreater(changed, MIN_CHANGED_SHARE)
-        self.assertLess(float(a.mean()), 0.95, "render is white")
+        out = os.path.join(OUT_DIR, f"install_zip_{VERSION}")
+        assert_smoke_renders(self, scene, smoke, out + ".png", out + "_empty.png")
 
 
 class BrokenInstallTest(unittest.TestCase):
