@@ -5,8 +5,10 @@ Source's point sources are and which candidate group each belongs to.
     groups = split_groups(points, first_group, emitter.candidate_split, emitter.name)
 
 A source's point sources are `point_sources` random points in each of its cells (§3.2: "10-20
-point sources are placed randomly in a source cell"), or the vertices of the mesh the artist
-picked (point_source_mesh), one streakline per vertex. A source split in k candidate groups
+point sources are placed randomly in a source cell"), thinned at random to the domain's
+max_streaklines over all Sources (a 0.25 m sphere at 40³ has ~500 cells, 8,000 streaklines at 16
+per cell, where the paper's sheets use 11-20), or the vertices of the mesh the artist picked
+(point_source_mesh), one streakline per vertex. A source split in k candidate groups
 (candidate_split) is cut into k groups of equal count along the axis of largest extent, so the
 streaklines of different parts are never clustered into one surface (§3.3). Emission pauses on
 the frames where none of the Sources with point sources has emit_particles on (Figure 10's gap).
@@ -100,19 +102,53 @@ def split_groups(points, first_group, split, source_name=""):
     return groups
 
 
+def thinning_quotas(counts, cap):
+    """How many of each Source's random point sources to keep so that about `cap` remain in all
+    (`counts`: random point sources per Source): all when cap is 0 or not exceeded, else shares
+    in proportion to the counts (largest remainders), each at least the 2 a surface needs (or
+    all, when a Source has fewer); so at most max(cap, 2 per Source)."""
+    counts = np.asarray(counts, dtype=np.int64)
+    total = int(counts.sum())
+    if cap <= 0 or total <= cap:
+        return counts.copy()
+    exact = counts * (cap / total)
+    quotas = np.floor(exact).astype(np.int64)
+    for i in np.argsort(-(exact - quotas), kind="stable")[:cap - int(quotas.sum())]:
+        quotas[i] += 1
+    return np.minimum(counts, np.maximum(quotas, np.minimum(counts, 2)))
+
+
+def thin(points, velocities, keep, seed, index):
+    """`keep` of the rows of points/velocities, chosen at random (seeded by the domain seed and
+    the Source's index), in their original order."""
+    if keep >= len(points):
+        return points, velocities
+    rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, 0x7e57, int(index)])
+    rows = np.sort(rng.choice(len(points), size=int(keep), replace=False))
+    return points[rows], velocities[rows]
+
+
 def domain_point_sources(native, params, snapshot):
     """The point sources of every Source of a traced bake on the grid of SmokeParams `params`
     (§3.2-3.3), Sources in order: world positions float32 (N, 3), candidate groups int64 (N,),
     velocities float32 (N, 3) and the Sources that have point sources (emitter snapshots, for
-    emits_during). BakeError when no Source has a point source in the domain."""
+    emits_during). The random point sources (per source cell) are thinned to the domain's
+    max_streaklines (thinning_quotas); a Point Source Mesh's vertices are kept as picked.
+    BakeError when no Source has a point source in the domain."""
     snap = snapshot
     sources = [e for e in snap.emitters if e.role == "SOURCE"]
-    emitting, all_points, all_groups, all_vel = [], [], [], []
+    placed = []
     for index, (e, group) in enumerate(zip(sources, candidate_groups(snap.emitters))):
-        placed = source_point_sources(native, params, snap.domain_name, snap.solver.seed, e, index)
-        if placed is None:
-            continue
-        points, vel = placed
+        p = source_point_sources(native, params, snap.domain_name, snap.solver.seed, e, index)
+        if p is not None:
+            placed.append((index, e, group, *p))
+    random = [k for k, (_i, e, *_rest) in enumerate(placed) if e.point_source_vertices is None]
+    quotas = thinning_quotas([len(placed[k][3]) for k in random], snap.streaks.max_streaklines)
+    for k, keep in zip(random, quotas):
+        index, e, group, points, vel = placed[k]
+        placed[k] = (index, e, group, *thin(points, vel, keep, snap.solver.seed, index))
+    emitting, all_points, all_groups, all_vel = [], [], [], []
+    for _index, e, group, points, vel in placed:
         emitting.append(e)
         all_points.append(points)
         all_vel.append(vel)
@@ -120,8 +156,47 @@ def domain_point_sources(native, params, snapshot):
     if not all_points:
         raise BakeError(f"Plume: domain '{snap.domain_name}': streak surfaces need point "
                         "sources, but no Source object has a cell inside the domain")
+    check_memory(snap.domain_name, sum(len(p) for p in all_points), snap.frame_count,
+                 max(1, snap.solver.substeps) / max(1, snap.streaks.emission_period))
     return (np.concatenate(all_points), np.concatenate(all_groups), np.concatenate(all_vel),
             emitting)
+
+
+#: Bytes per stored particle (position float32 x 3 + density float32) in the streak files, each
+#: of which Build Surfaces holds in memory.
+PARTICLE_BYTES = 16
+
+
+def streak_bytes(streaklines, frames, particles_per_frame):
+    """Bytes of every frame's streak file held together (Build Surfaces reads them all): each
+    streakline gains `particles_per_frame` particles a frame and keeps them."""
+    total_particles = particles_per_frame * frames * (frames + 1) / 2.0
+    return streaklines * total_particles * PARTICLE_BYTES
+
+
+def available_bytes():
+    """MemAvailable of /proc/meminfo (Linux), or None where it cannot be read."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def check_memory(domain_name, streaklines, frames, particles_per_frame):
+    """BakeError, before anything is written, when the streaklines of the whole shot would not
+    fit in the memory this machine has free; names the count and the memory it needs."""
+    need = streak_bytes(streaklines, frames, particles_per_frame)
+    have = available_bytes()
+    if have is not None and need > have:
+        raise BakeError(
+            f"Plume: domain '{domain_name}': {streaklines:,} streaklines over {frames} frames "
+            f"hold {need / 2**30:.1f} GB of particles, more than the {have / 2**30:.1f} GB of "
+            "memory free: lower max_streaklines (or the Sources' point_sources), or bake fewer "
+            "frames")
 
 
 def emits_during(sources, index):

@@ -181,6 +181,12 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     emission_period: IntProperty(
         name="Emission Period", default=1, soft_min=1, soft_max=20,
         description="Steps between two particles of a point source (§3.2: one every step)")
+    max_streaklines: IntProperty(
+        name="Max Streaklines", default=256, soft_min=0, soft_max=4096,
+        description="At most this many streaklines over all Sources: Point Sources per source "
+                    "cell are thinned at random (seeded, in proportion to each Source) down to "
+                    "it. The paper's sheets use 11-20 streaklines; a large source at 16 per cell "
+                    "gives thousands, which cluster into one ragged sheet. 0 keeps them all")
     motion_source: EnumProperty(
         name="Motion", default='PLUME',
         items=(('PLUME', "Plume Simulation", "Simulate the smoke with Plume and trace its velocity"),

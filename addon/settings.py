@@ -167,6 +167,8 @@ class EmitterSnapshot:
 
 #: Accepted range of the streak settings (the native StreakParams / random_points_in_cells bounds).
 EMISSION_PERIOD_RANGE = (1, 100000)
+#: Accepted max_streaklines: 0 (keep every point source) or at least the 2 a surface needs.
+MAX_STREAKLINES_RANGE = (0, 1000000)
 POINT_SOURCES_RANGE = (1, 10000)
 #: Accepted range of a source's candidate_split (§3.3).
 CANDIDATE_SPLIT_RANGE = (1, 64)
@@ -178,6 +180,8 @@ class StreakSettings:
 
     enabled: bool = False
     emission_period: int = 1  # steps between two emissions
+    #: at most this many streaklines over all Sources (point sources thinned at random), 0: all
+    max_streaklines: int = 256
 
 
 #: Accepted range of the pathline settings (the native PathlineParams bounds).
@@ -241,6 +245,7 @@ class BakeSnapshot:
         if self.streaks.enabled:  # absent when off, so older caches still resume
             data["streaks"] = {
                 "emission_period": self.streaks.emission_period,
+                "max_streaklines": self.streaks.max_streaklines,
                 "sources": [e.streak_fingerprint() for e in self.emitters if e.role == "SOURCE"]}
         if self.pathlines.enabled:  # absent when off, so older caches still resume
             data["pathlines"] = dataclasses.asdict(self.pathlines)
@@ -363,6 +368,10 @@ def validate_streaks(domain_name, streaks, emitters):
     if not (lo <= streaks.emission_period <= hi):
         raise BakeError(f"Plume: domain '{domain_name}': emission_period must be in [{lo}, {hi}] "
                         f"steps (got {streaks.emission_period})")
+    lo, hi = MAX_STREAKLINES_RANGE
+    if not (lo <= streaks.max_streaklines <= hi) or streaks.max_streaklines == 1:
+        raise BakeError(f"Plume: domain '{domain_name}': max_streaklines must be 0 (no limit) or "
+                        f"in [2, {hi}] (got {streaks.max_streaklines})")
     sources = [e for e in emitters if e.role == "SOURCE"]
     if not sources:
         raise BakeError(f"Plume: domain '{domain_name}': streak surfaces need at least one Source "

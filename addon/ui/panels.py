@@ -3,6 +3,7 @@ Mantaflow's): role buttons, then the settings of the object's role."""
 
 import bpy
 
+from .. import _native, streak_count
 from ..operators.bake import cache_status, is_baking
 from ..operators.surfaces import live_summary
 from ..properties import ROLE_ITEMS
@@ -207,6 +208,9 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         col = layout.column()
         col.active = d.streaks
         col.prop(d, "emission_period")
+        col.prop(d, "max_streaklines")
+        if d.streaks:  # what the next bake traces (§3.2), before baking
+            col.label(text=streak_count.label(_native, context.scene, ob), icon='CURVE_PATH')
         row = col.row(align=True)
         row.prop(d, "streak_threshold")
         row.operator("plume.surfaces_pick_threshold", text="", icon='SORTSIZE')

@@ -1,0 +1,114 @@
+"""Streak surfaces at an artist's scale (smoke_surfaces.txt §3.2): the scene a new user makes - a
+2 m domain at 40³, a UV sphere of radius 0.25 m as the Source, Streak Surfaces on, every other
+setting at its default - traces a bounded number of streaklines (Max Streaklines thins the 16
+point sources per source cell); the Streak Surfaces panel shows that number before baking, and it
+is what the bake traces; thinning is seeded; a count whose particles would not fit in memory is
+refused before anything is written.
+
+Run: blender_tests/run.py --blender {3.4,4.5,5.0} test_streak_defaults.py
+"""
+
+import os
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (add_domain, add_sphere_source, assert_reports_error, native,  # noqa: E402
+                     reset_scene, rmtree, run, select_only, temp_dir, tree_listing)
+
+FRAMES = 3
+
+
+def artist_scene(cache_dir, frame_end=FRAMES):
+    """The issue's scene: defaults everywhere but Streak Surfaces on."""
+    add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35))
+    dom = add_domain(resolution=40, frame_end=frame_end, cache_directory=cache_dir + "/")
+    dom.plume.domain.streaks = True
+    select_only(dom)
+    return dom
+
+
+def traced(cache_dir, frame=1, domain="Domain"):
+    return native().read_streak_file(os.path.join(cache_dir, domain, f"streaks_{frame:04d}.bin"))
+
+
+class StreakDefaultsTest(unittest.TestCase):
+    def setUp(self):
+        reset_scene()
+        self.tmp = temp_dir("plume_streak_defaults_")
+        from plume import streak_count
+        self.count = lambda dom: streak_count.count(native(), bpy.context.scene, dom)
+
+    def tearDown(self):
+        rmtree(self.tmp)
+
+    def test_default_scene_traces_what_the_panel_says(self):
+        dom = artist_scene(self.tmp)
+        d = dom.plume.domain
+        self.assertEqual(d.max_streaklines, 256)
+        self.assertEqual(bpy.data.objects["Source"].plume.source.point_sources, 16)
+        kept, placed = self.count(dom)
+        print(f"  panel: {kept} streaklines of {placed} point sources")
+        # 16 per cell of a 0.25 m sphere at 20 cells/m: hundreds of cells, thousands of points.
+        self.assertGreater(placed, 2000)
+        self.assertEqual(kept, 256)
+        from plume.ui.panels import PHYSICS_PT_plume_streaks  # noqa: F401  (the panel's line)
+        from plume import streak_count
+        self.assertIn("256 streaklines (of", streak_count.label(native(), bpy.context.scene, dom))
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        first = traced(self.tmp)
+        self.assertEqual(len(first["counts"]), kept)
+        # Seeded: a second bake from scratch places the same point sources.
+        bpy.ops.plume.cache_free()
+        select_only(dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        np.testing.assert_array_equal(traced(self.tmp)["positions"], first["positions"])
+        # 0 keeps every point source; the panel follows the setting at once.
+        d.max_streaklines = 0
+        self.assertEqual(self.count(dom), (placed, placed))
+
+    def test_thinning_keeps_each_source_in_proportion(self):
+        dom = artist_scene(self.tmp)
+        small = add_sphere_source(radius=0.12, location=(0.5, 0.0, 0.35), name="Small")
+        small.plume.source.point_sources = 4
+        select_only(dom)
+        dom.plume.domain.max_streaklines = 100
+        kept, placed = self.count(dom)
+        self.assertLessEqual(kept, 100 + 2)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        snap = traced(self.tmp)
+        groups = np.asarray(snap["groups"])
+        self.assertEqual(len(groups), kept)
+        per_group = np.bincount(groups - groups.min())
+        print(f"  streaklines per source: {per_group.tolist()} of {kept} ({placed} placed)")
+        self.assertEqual(len(per_group), 2)  # both Sources keep streaklines
+        self.assertTrue(all(n >= 2 for n in per_group))
+
+    def test_too_many_streaklines_for_memory_refused(self):
+        dom = artist_scene(self.tmp, frame_end=5000)
+        d = dom.plume.domain
+        d.max_streaklines = 0
+        bpy.data.objects["Source"].plume.source.point_sources = 10000
+        select_only(dom)
+        folder = os.path.join(self.tmp, "Domain")
+        assert_reports_error(
+            self, bpy.ops.plume.bake, r"streaklines over 5000 frames hold [0-9.]+ GB of "
+            r"particles, more than the [0-9.]+ GB of memory free: lower max_streaklines",
+            lambda: (tree_listing(folder), len(bpy.data.objects), len(bpy.data.volumes)))
+        self.assertFalse(os.path.exists(folder))
+
+    def test_bad_max_streaklines_refused(self):
+        dom = artist_scene(self.tmp)
+        dom.plume.domain.max_streaklines = 1
+        folder = os.path.join(self.tmp, "Domain")
+        assert_reports_error(self, bpy.ops.plume.bake,
+                             r"max_streaklines must be 0 \(no limit\) or in \[2, ",
+                             lambda: tree_listing(folder))
+
+
+if __name__ == "__main__":
+    run(StreakDefaultsTest)
