@@ -209,6 +209,9 @@ def write_sheet_images(folder, index, frame_start, images):
     from .. import cache
     h, w = images[0].shape
     img = bpy.data.images.new(f"plume_sheet_tmp_{index}", w, h, alpha=False, float_buffer=True)
+    # Densities, not colours: a new float image is sRGB, and saving it would write the densities
+    # sRGB-encoded (0.26 -> 0.55), which the material (reading Non-Color) took as they are.
+    img.colorspace_settings.name = 'Non-Color'
     try:
         img.file_format = 'OPEN_EXR'
         rgba = np.ones((h, w, 4), dtype=np.float32)
