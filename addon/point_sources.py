@@ -102,6 +102,28 @@ def split_groups(points, first_group, split, source_name=""):
     return groups
 
 
+def hand_groups(emitter, first_group):
+    """Candidate group of each vertex of a Source's point source mesh from its vertex groups
+    (§3.3: "close points can be assigned to different groups if desired by the user"): the
+    groups used, in vertex-group order (vertices in none last), numbered from first_group.
+    BakeError naming the group when one holds fewer than the 2 streaklines a surface needs."""
+    e = emitter
+    values, index, sizes = np.unique(np.asarray(e.point_source_groups, dtype=np.int64),
+                                     return_inverse=True, return_counts=True)
+    order = np.argsort(np.where(values < 0, np.iinfo(np.int64).max, values), kind="stable")
+    rank = np.empty(len(values), dtype=np.int64)
+    rank[order] = np.arange(len(values))
+    for value, size in zip(values, sizes):
+        if size < 2:
+            names = e.point_source_group_names
+            which = ("the vertices in no vertex group" if value < 0 else
+                     f"vertex group '{names[value] if value < len(names) else value}'")
+            raise BakeError(f"Plume: source '{e.name}': point_source_mesh '{e.point_source_mesh}':"
+                            f" {which} holds {size} vertex; a hand-made candidate group needs at "
+                            "least 2 (§3.3: a surface needs 2 streaklines)")
+    return first_group + rank[index]
+
+
 def thinning_quotas(counts, cap):
     """How many of each Source's random point sources to keep so that about `cap` remain in all
     (`counts`: random point sources per Source): all when cap is 0 or not exceeded, else shares
@@ -152,7 +174,8 @@ def domain_point_sources(native, params, snapshot):
         emitting.append(e)
         all_points.append(points)
         all_vel.append(vel)
-        all_groups.append(split_groups(points, group, e.candidate_split, e.name))
+        all_groups.append(hand_groups(e, group) if e.hand_groups else
+                          split_groups(points, group, e.candidate_split, e.name))
     if not all_points:
         raise BakeError(f"Plume: domain '{snap.domain_name}': streak surfaces need point "
                         "sources, but no Source object has a cell inside the domain")

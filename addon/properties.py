@@ -269,7 +269,9 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
         name="Point Source Mesh", type=bpy.types.Object, poll=lambda _self, ob: ob.type == 'MESH',
         description="Mesh whose vertices (world space, evaluated at the domain's first frame) are "
                     "this source's point sources, one streakline each, instead of Point Sources "
-                    "random points per cell (smoke_surfaces.txt §3.2); they must lie in the domain")
+                    "random points per cell (smoke_surfaces.txt §3.2); they must lie in the "
+                    "domain. Its vertex groups, if any, are hand-made candidate groups (§3.3): "
+                    "streaklines of different groups never share a surface")
     emit_particles: BoolProperty(
         name="Emit Particles", default=True,
         description="Emit streakline particles from this source's point sources (smoke_surfaces.txt "

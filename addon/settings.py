@@ -103,6 +103,18 @@ class EmitterSnapshot:
     #: space at frame_start, float32 (N, 3); None: `point_sources` random points per cell.
     point_source_mesh: str = ""
     point_source_vertices: Optional[np.ndarray] = None
+    #: §3.3 hand-made candidate groups: per point-source-mesh vertex, the index of the vertex group
+    #: it belongs to most (-1: none), int64 (N,); None when the mesh has no vertex groups.
+    point_source_groups: Optional[np.ndarray] = None
+    point_source_group_names: List[str] = field(default_factory=list)  # by vertex group index
+
+    @property
+    def hand_groups(self):
+        """Number of hand-made candidate groups (vertex groups used, plus one for the vertices in
+        none), 0 without vertex groups."""
+        if self.point_source_groups is None or self.point_source_vertices is None:
+            return 0
+        return len(np.unique(self.point_source_groups))
 
     @property
     def animated(self):
@@ -151,6 +163,9 @@ class EmitterSnapshot:
             v = np.ascontiguousarray(self.point_source_vertices, dtype=np.float32)
             extra["point_source_mesh"] = [self.point_source_mesh,
                                           hashlib.sha1(v.tobytes()).hexdigest()]
+        if self.hand_groups:
+            g = np.ascontiguousarray(self.point_source_groups, dtype=np.int64)
+            extra["hand_groups"] = hashlib.sha1(g.tobytes()).hexdigest()
         return data + [extra] if extra else data
 
     def fingerprint(self):
@@ -394,14 +409,15 @@ def validate_streaks(domain_name, streaks, emitters):
 def candidate_groups(emitters):
     """Candidate group of each Source (§3.3), in source order: the explicit group, or for -1 a
     number of its own that no explicit group uses. A source split in k > 1 groups
-    (candidate_split) gets the first of k consecutive numbers, all after every other source's
-    group (its candidate_group is then unused)."""
+    (candidate_split, or k hand-made groups: the vertex groups of its point source mesh) gets the
+    first of k consecutive numbers, all after every other source's group (its candidate_group is
+    then unused)."""
     sources = [e for e in emitters if e.role == "SOURCE"]
-    whole = [e for e in sources if e.candidate_split <= 1]
+    whole = [e for e in sources if _group_count(e) <= 1]
     used = {e.candidate_group for e in whole if e.candidate_group >= 0}
     groups, next_free = [], 0
     for e in sources:
-        if e.candidate_split > 1:
+        if _group_count(e) > 1:
             groups.append(None)  # numbered below, once every other group is known
         elif e.candidate_group >= 0:
             groups.append(e.candidate_group)
@@ -414,8 +430,14 @@ def candidate_groups(emitters):
     for n, e in enumerate(sources):
         if groups[n] is None:
             groups[n] = next_split
-            next_split += e.candidate_split
+            next_split += _group_count(e)
     return groups
+
+
+def _group_count(emitter):
+    """Candidate groups a Source's point sources fall in: its hand-made groups (vertex groups of
+    its point source mesh), else candidate_split."""
+    return emitter.hand_groups or emitter.candidate_split
 
 
 def to_native_params(solver, native):

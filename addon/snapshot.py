@@ -116,6 +116,22 @@ def mesh_arrays(obj, depsgraph):
     return verts.reshape(-1, 3), tris.reshape(-1, 3)
 
 
+def vertex_group_of_vertices(obj, depsgraph):
+    """The vertex group each vertex of the evaluated mesh belongs to most (its index, -1 for
+    none), int64 (N,), or None when the object has no vertex groups: hand-made candidate
+    groups of point sources (smoke_surfaces.txt §3.3)."""
+    if not obj.vertex_groups:
+        return None
+    ob = obj.evaluated_get(depsgraph)
+    mesh = ob.to_mesh()
+    try:
+        return np.array([max(v.groups, key=lambda g: g.weight).group
+                         if any(g.weight > 0.0 for g in v.groups) else -1
+                         for v in mesh.vertices], dtype=np.int64)
+    finally:
+        ob.to_mesh_clear()
+
+
 def scene_emitters(scene, domain):
     return [o for o in scene.objects
             if o is not domain and o.type == 'MESH' and o.plume.role in EMITTER_ROLES]
@@ -191,6 +207,8 @@ def point_source_vertices(context, objs, snaps, frame_start):
             world = local.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
             snap.point_source_mesh = mesh_obj.name
             snap.point_source_vertices = world.astype(np.float32)
+            snap.point_source_groups = vertex_group_of_vertices(mesh_obj, depsgraph)
+            snap.point_source_group_names = [g.name for g in mesh_obj.vertex_groups]
     finally:
         if moved:
             scene.frame_set(current, subframe=subframe)

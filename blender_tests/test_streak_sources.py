@@ -248,6 +248,30 @@ class StreakSourcesTest(unittest.TestCase):
         src.plume.source.point_sources = 1
         self.assert_bake_error(r"candidate_split 64 needs at least 128 point sources")
 
+    def test_hand_groups_from_vertex_groups(self):
+        """§3.3 manual grouping (Figure 3(b)): the vertex groups of a point source mesh are
+        candidate groups; with h0 joining everything each one is exactly one surface."""
+        dom, src = build_scene(self.cache, frame_end=4)
+        ring = [(0.15 * np.cos(a), 0.15 * np.sin(a), 0.5)
+                for a in np.linspace(0.0, 2 * np.pi, 12, endpoint=False)]
+        dots = add_point_mesh(ring, "Ring")
+        for name, members in (("Left", range(0, 5)), ("Right", range(5, 6))):
+            dots.vertex_groups.new(name=name).add(list(members), 1.0, 'REPLACE')
+        src.plume.source.point_source_mesh = dots
+        select_only(dom)
+        # A hand group of one vertex cannot make a surface: refused, named, nothing written.
+        self.assert_bake_error(r"point_source_mesh 'Ring': vertex group 'Right' holds 1 vertex; a "
+                               r"hand-made candidate group needs at least 2")
+        dots.vertex_groups["Right"].add([6, 7, 8], 1.0, 'REPLACE')
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        groups = np.asarray(streaks(self.folder, 4)["groups"])
+        # Vertex-group order, the vertices in none last.
+        self.assertEqual(groups.tolist(), [0] * 5 + [1] * 4 + [2] * 3)
+        dom.plume.domain.streak_threshold = 1e6  # no clustering inside a group
+        self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})
+        surfaces = [o for o in bpy.data.objects if o.type == 'SURFACE']
+        self.assertEqual(sorted(o.data.splines[0].point_count_v for o in surfaces), [3, 4, 5])
+
     # ------------------------------------------------------------------ resume
     def test_resumed_traced_bake_matches_straight_bake(self):
         resumed, straight = os.path.join(self.tmp, "resumed"), os.path.join(self.tmp, "straight")
