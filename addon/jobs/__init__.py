@@ -15,9 +15,10 @@ from . import handlers, registry
 from .operator import JobOperator
 from .runner import JobCancelled, JobProgress, JobRunner
 from .staging import Staging
+from .worker import Worker
 
-__all__ = ("JobOperator", "JobRunner", "JobProgress", "JobCancelled", "Staging", "registry",
-           "register", "unregister")
+__all__ = ("JobOperator", "JobRunner", "JobProgress", "JobCancelled", "Staging", "Worker",
+           "registry", "register", "unregister")
 
 
 def register():

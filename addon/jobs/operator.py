@@ -23,8 +23,10 @@ from .worker import Worker
 
 #: Seconds between two polls of the modal timer (progress, cancel, deleted objects).
 POLL_S = 0.1
-#: Seconds of main-thread steps per poll, so the interface stays responsive.
+#: Seconds of main-thread steps per poll, and between two such polls: the interface stays
+#: responsive while main_steps() take most of the time.
 STEP_BUDGET_S = 0.05
+STEP_POLL_S = 0.01
 
 
 def status_text(title, p, seconds_left):
@@ -51,7 +53,8 @@ class JobOperator:
         if error is None and not runner.cancelled:
             try:
                 for _ in runner.main_steps(context):
-                    pass
+                    if runner.cancelled:
+                        break
             except Exception as e:
                 error = e
         return self._conclude(context, runner, error, None)
@@ -141,6 +144,9 @@ class JobOperator:
             return True
         if self._steps is None:
             self._steps = runner.main_steps(context)
+            wm = context.window_manager  # poll faster: the steps are short and many
+            wm.event_timer_remove(self._timer)
+            self._timer = wm.event_timer_add(STEP_POLL_S, window=context.window)
         end = time.perf_counter() + STEP_BUDGET_S
         try:
             while time.perf_counter() < end:

@@ -22,6 +22,7 @@ any time; native objects that run long register with watch() and are cancelled w
 """
 
 import threading
+import time
 from dataclasses import dataclass
 from typing import Optional
 
@@ -75,6 +76,8 @@ class JobRunner:
         self.worker = None
         #: The status bar's last line (operator.py), for scripts and tests.
         self.status_text = ""
+        #: time.perf_counter() of the first cancel() (None while not cancelled).
+        self.cancelled_at = None
 
     # ------------------------------------------------------------------ the four parts
     def prepare(self, context):
@@ -127,6 +130,8 @@ class JobRunner:
 
     def cancel(self):
         """Thread-safe: run() stops within one unit of work; watched native objects too."""
+        if self.cancelled_at is None:
+            self.cancelled_at = time.perf_counter()
         self._cancel.set()
         with self._lock:
             watched = list(self._watched)

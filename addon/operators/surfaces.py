@@ -150,13 +150,17 @@ class SurfacesJob(JobRunner):
         return maps
 
     def main_steps(self, context):
-        """Saves each surface's density maps as EXR files into the staging folder (Blender's
-        image writer, so on the main thread), one surface per step."""
+        """Saves the density maps as EXR files into the staging folder with Blender's image
+        writer (so on the main thread), one image per step."""
         self.sheets = []
+        total = sum(len(images) for images in self.maps)
+        done = 0
         for i, images in enumerate(self.maps):
-            self.set_progress(i, len(self.maps), "saving the density maps of surface")
-            yield
-            build.write_sheet_images(self.staging.path, i, self.frame_start, images)
+            for n, image in enumerate(images):
+                self.set_progress(done, total, "density map image")
+                yield
+                build.write_sheet_images(self.staging.path, i, self.frame_start + n, [image])
+                done += 1
             self.sheets.append((cache.sheet_path(self.folder, i, self.frame_start),
                                 images[0].shape[1], images[0].shape[0], len(images)))
 
