@@ -40,7 +40,8 @@ class UiJobsTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         if shutil.which("xvfb-run") is None:
-            raise RuntimeError("xvfb-run is missing: install the 'xvfb' package (.ci/common.sh does)")
+            raise RuntimeError("xvfb-run is missing: install the 'xvfb' package "
+                               "(.ci/common.sh does)")
         fd, path = tempfile.mkstemp(suffix=".json", prefix="plume_ui_")
         os.close(fd)
         cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", bpy.app.binary_path,
@@ -63,6 +64,10 @@ class UiJobsTest(unittest.TestCase):
                   f"{c.get('seconds_worker_ran_on') or float('nan'):.2f} s, job ended "
                   f"{c.get('seconds_to_stop', float('nan')):.2f} s after it; "
                   f"last status: {next((s[4] for s in reversed(c['seen']) if s[4]), '')!r}")
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.result.get("tmp", ""), ignore_errors=True)
 
     def case(self, operator, action):
         self.assertNotIn("error", self.result, self.result.get("error"))

@@ -67,7 +67,6 @@ class JobOperator:
         if runner is None:
             return {'CANCELLED'}
         self._runner, self._steps, self._error, self._gone = runner, None, None, None
-        self._stage = None
         wm = context.window_manager
         self._timer = wm.event_timer_add(POLL_S, window=context.window)
         wm.progress_begin(0, 100)
@@ -163,14 +162,7 @@ class JobOperator:
     def _show(self, context, runner):
         """Status bar and progress cursor from the runner's latest progress."""
         p = runner.progress()
-        now = time.perf_counter()
-        if self._stage is None or self._stage[0] != (p.label, p.total):
-            self._stage = ((p.label, p.total), now, p.done)
-        _key, t_stage, done0 = self._stage
-        left = p.seconds_left
-        if left is None and p.total > 0 and p.done > done0:
-            left = (now - t_stage) / (p.done - done0) * (p.total - p.done)
-        runner.status_text = status_text(runner.title, p, left)
+        runner.status_text = status_text(runner.title, p, p.estimate_left(time.perf_counter()))
         if p.total > 0:
             context.window_manager.progress_update(int(100 * p.done / p.total))
         if context.workspace is not None:

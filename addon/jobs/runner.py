@@ -38,12 +38,23 @@ class JobCancelled(Exception):
 @dataclass(frozen=True)
 class JobProgress:
     """What the status bar shows: `done` of `total` units named by `label` ("frame",
-    "surface"); total 0 while unknown. seconds_left None: estimated from the rate so far."""
+    "surface"); total 0 while unknown. seconds_left None: estimated from the rate since
+    `stage_started` (time.perf_counter() when this label and total were first reported)."""
 
     done: int = 0
     total: int = 0
     label: str = ""
     seconds_left: Optional[float] = None
+    stage_started: float = 0.0
+
+    def estimate_left(self, now):
+        """Seconds left: the runner's own figure, else the stage's rate so far; None when
+        nothing is known yet."""
+        if self.seconds_left is not None:
+            return self.seconds_left
+        if self.total <= 0 or self.done <= 0:
+            return None
+        return (now - self.stage_started) / self.done * (self.total - self.done)
 
 
 class JobRunner:
@@ -163,8 +174,11 @@ class JobRunner:
     # ------------------------------------------------------------------ progress
     def set_progress(self, done, total, label=None, seconds_left=None):
         """Called by run() (any thread): `done` of `total` units."""
-        p = JobProgress(int(done), int(total), self._progress.label if label is None else label,
-                        seconds_left)
+        last = self._progress
+        label = last.label if label is None else label
+        same = (label, int(total)) == (last.label, last.total) and last.stage_started
+        p = JobProgress(int(done), int(total), label, seconds_left,
+                        last.stage_started if same else time.perf_counter())
         self._progress = p  # one reference swap: readers see the old or the new value
         if self.on_progress is not None:
             self.on_progress(p)

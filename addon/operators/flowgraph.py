@@ -73,9 +73,10 @@ class FlowGraphJob(JobRunner):
         error = cache.check_writable(self.folder)
         if error is not None:
             raise BakeError(f"Plume: cache folder {self.folder} is not writable ({error})")
-        self._job = None
+        self._job = self._job_started = None
 
     def _attach(self, job):
+        self._job_started = time.perf_counter()
         self._job = self.watch(job)
 
     def progress(self):
@@ -83,7 +84,8 @@ class FlowGraphJob(JobRunner):
         job = self._job
         if job is None:
             return super().progress()
-        return JobProgress(int(100 * job.progress), 100, "cost matrix (%)")
+        return JobProgress(int(100 * job.progress), 100, "cost matrix (%)",
+                           stage_started=self._job_started)
 
     def run(self):
         self.built = flowgraph.build_graph(_native, self.states, self.settings,

@@ -14,10 +14,11 @@ Each CASE is <operator>:<action>, run in order:
 
 A case sets its scene up, invokes the operator from the Properties editor's context
 ('INVOKE_DEFAULT': worker thread + modal timer), polls the job (its progress and status-bar line)
-until it has done a few units, acts, waits for the job to end, and records what it saw: the job's
-progress over time, the thread it ran on, the seconds from the action to its end, and the scene's
-objects and the cache folder's files before and after. RESULT (JSON) is rewritten after every case
-(and before quitting), so a crash still leaves the cases before it."""
+until it has done a few units and the status bar shows them with the time left, acts, waits for the
+job to end, and records what it saw: the job's progress over time, the thread it ran on, the
+seconds from the action to its end, and the scene's objects and the cache folder's files before and
+after. RESULT (JSON) is rewritten after every case (and before quitting), so a crash still leaves
+the cases before it."""
 
 import json
 import os
@@ -47,7 +48,7 @@ state = {"case": -1, "phase": "next", "results": [], "t0": time.perf_counter(),
 
 def save(**extra):
     with open(RESULT, "w") as f:
-        json.dump({"cases": state["results"], **extra}, f)
+        json.dump({"cases": state["results"], "tmp": state["tmp"], **extra}, f)
 
 
 def window_and_area():
@@ -196,7 +197,9 @@ def step():
         p = j.progress()
         rec["seen"].append([round(time.perf_counter() - state["case_t0"], 3), p.done, p.total,
                             p.label, j.status_text])
-        if state["acted_at"] is None and p.total > 0 and p.done >= TRIGGER[rec["operator"]]:
+        # Act once the job has done a few units and the status bar has shown them.
+        if (state["acted_at"] is None and p.total > 0 and p.done >= TRIGGER[rec["operator"]]
+                and " s left" in j.status_text):
             act(rec, j)
         return POLL_S
     if state["acted_at"] is None:
