@@ -48,7 +48,7 @@ except ImportError as e:
     # name=: Blender 4.2+ reports an ImportError by its module name (without one it fails itself)
     raise ImportError(f"Plume: the native module _native {_why}. {_fix}", name=__name__) from e
 
-from . import operators, properties, ui  # noqa: E402
+from . import jobs, operators, properties, ui  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
 from .build import toon_points as _toon_points  # noqa: E402
 from .build import fire_points as _fire_points  # noqa: E402
@@ -65,9 +65,11 @@ def register():
     _toon_points.register()  # persistent frame_change_pre handler of the toon points
     _fire_points.register()  # persistent frame_change_pre handler of the fire point preview
     _flame_spines.register()  # persistent frame_change_pre handler of flame spines and lights
+    jobs.register()  # persistent load_pre + atexit: loading a file or quitting cancels the jobs
 
 
 def unregister():
+    jobs.unregister()  # running jobs are cancelled first, their temporaries removed
     _flame_spines.unregister()
     _fire_points.unregister()
     _toon_points.unregister()

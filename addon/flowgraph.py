@@ -261,9 +261,11 @@ def _params(native, s: FlowGraphSettings, alpha, beta):
     return p
 
 
-def cost_matrix(native, states: List[State], s: FlowGraphSettings):
+def cost_matrix(native, states: List[State], s: FlowGraphSettings,
+                on_job: Optional[Callable[[object], None]] = None):
     """C of eq. 9-10 over every group of every state, state by state: (cost, node counts per
-    state, FlowGraphParams with the weights α, β). BakeError on bad settings."""
+    state, FlowGraphParams with the weights α, β). BakeError on bad settings. on_job receives the
+    native CostMatrixJob before it runs (another thread may read its progress or cancel it)."""
     groups = []
     for index, st in enumerate(states):
         groups.extend(st.file.read_group(k, index) for k in range(st.file.node_count))
@@ -277,19 +279,22 @@ def cost_matrix(native, states: List[State], s: FlowGraphSettings):
     except ValueError as e:
         raise BakeError(f"Plume: flow graph: {e}") from None
     del groups  # the job holds them
+    if on_job is not None:
+        on_job(job)
     if not job.run():
         raise BakeError("Plume: flow graph: cancelled")
     return job.cost, counts, params
 
 
 def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
-                progress: Optional[Callable[[float], None]] = None):
+                progress: Optional[Callable[[float], None]] = None,
+                on_job: Optional[Callable[[object], None]] = None):
     """Cost matrix (eq. 9-10) of every group of every state, the graph (§4.3), then
     <out_folder>/flowgraph.npz and flowgraph_cost.png (Figure 4), atomically. Returns a dict
     with the graph, its cost matrix and a summary. BakeError on bad settings (nothing written;
     when too few transitions join the states, the message gives the candidates' range [a, b]
-    to choose ε from)."""
-    cost, counts, params = cost_matrix(native, states, s)
+    to choose ε from). on_job: see cost_matrix."""
+    cost, counts, params = cost_matrix(native, states, s, on_job)
     alpha, beta = params.alpha, params.beta
     try:
         graph = native.FlowGraph.build(cost, counts, params)

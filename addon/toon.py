@@ -234,14 +234,17 @@ class ToonResult:
 class ToonRunner:
     """Walks the bake frame by frame: frame_start advances from its own fields (birth only),
     each next frame from the previous volume to its own (§2.1 advection, §2.3 evolution), and
-    writes toon_<frame>.bin after each. progress(frames_done, frames_total) and cancel() are
-    optional callables; a cancelled run keeps the frames written so far."""
+    writes toon_<frame>.bin after each, into out_folder (default: the bake's folder; the toon job
+    gives its staging folder). progress(frames_done, frames_total) and cancel() are optional
+    callables; a cancelled run keeps the frames written so far."""
 
     def __init__(self, native, folder, manifest, settings: ToonSettings, domain_name="",
                  progress: Optional[Callable[[int, int], None]] = None,
-                 cancel: Optional[Callable[[], bool]] = None, source_cells=None):
+                 cancel: Optional[Callable[[], bool]] = None, source_cells=None,
+                 out_folder=None):
         self.native = native
         self.folder = folder
+        self.out_folder = folder if out_folder is None else out_folder
         self.manifest = manifest
         self.params = to_params(native, settings, domain_name)
         self.progress = progress
@@ -254,7 +257,7 @@ class ToonRunner:
         self.grid = toon_grid(manifest)
 
     def run(self) -> ToonResult:
-        native, folder = self.native, self.folder
+        native, folder, out = self.native, self.folder, self.out_folder
         try:
             particles = native.ToonParticles(self.params, *self.grid.args())
         except ValueError as e:
@@ -262,8 +265,8 @@ class ToonRunner:
         result = ToonResult(frame_start=self.frame_start, last_frame=self.frame_start - 1)
         total = self.last_frame - self.frame_start + 1
         # Frames of an older build would mix with this one (a cancel keeps a prefix): remove them.
-        for f in toon_frames(folder):
-            os.remove(toon_path(folder, f))
+        for f in toon_frames(out):
+            os.remove(toon_path(out, f))
         for frame in range(self.frame_start, self.last_frame + 1):
             if self.cancel is not None and self.cancel():
                 result.cancelled = True
@@ -273,7 +276,7 @@ class ToonRunner:
             try:
                 particles.advance_frame_from_vdb(before, after, self.dt,
                                                  source_cells=self.source_cells)
-                particles.write(toon_path(folder, frame))
+                particles.write(toon_path(out, frame))
             except (RuntimeError, ValueError) as e:
                 raise BakeError(f"Plume: toon frame {frame}: {e} (bake the domain again)") from None
             result.last_frame = frame

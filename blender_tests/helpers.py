@@ -222,3 +222,20 @@ def run(*cases):
     bpy.ops.wm.read_homefile(use_factory_startup=True)
     print(f"{passed} passed, {failed} failed", flush=True)
     sys.exit(0 if failed == 0 and result.testsRun > 0 else 1)
+
+
+def run_cancelled(op_class, job, after=1):
+    """Calls the job operator `op_class` blocking, as a script does, with `job` (a fresh
+    plume.jobs.JobRunner) as its runner, cancelled from its own progress report once `after`
+    units are done (0: at its first report; or a predicate of the JobProgress); returns the
+    operator's result."""
+    def cancel_at(p):
+        if after(p) if callable(after) else (p.total > 0 and p.done >= after or after == 0):
+            job.cancel()
+    job.on_progress = cancel_at
+    saved = op_class.make_runner
+    op_class.make_runner = lambda self, context: job
+    try:
+        return getattr(bpy.ops.plume, op_class.bl_idname.split(".")[1])()
+    finally:
+        op_class.make_runner = saved

@@ -32,7 +32,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 #: Blender label -> exact bpy wheel version (None: the system's `blender` executable).
 BPY_PINS = {"3.4": None, "4.5": "4.5.15", "5.0": "5.0.1"}
 #: Files that need a window (Xvfb + the real executable): only the packaged Blender has one.
-WINDOWED = {"test_ui_bake.py"}
+WINDOWED = {"test_ui_jobs.py"}
 #: The interpreter the venvs are made from: Debian's CPython 3.11, the _native module's ABI.
 VENV_PYTHON = "/usr/bin/python3"
 TIMEOUT_S = 1800

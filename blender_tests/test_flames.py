@@ -20,7 +20,8 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 from helpers import (OUT_DIR, compat, assert_reports_error, image_pixels, native,  # noqa: E402
-                     reset_scene, rmtree, run, select_only, temp_dir, tree_listing)
+                     reset_scene, rmtree, run, run_cancelled, select_only, temp_dir,
+                     tree_listing)
 
 FRAMES = 12
 GRIDS = {"density", "temperature", "flame", "color", "velocity"}
@@ -155,6 +156,24 @@ class FlamesTest(unittest.TestCase):
         self.assertEqual(tree_listing(folder), [])
         self.assertIsNone(bpy.data.objects.get("Plume Flames"))
         self.assertIsNone(bpy.data.objects.get("Plume Flame Spines"))
+
+    def test_cancelled_keeps_finished_frames(self):
+        """Bake Flames cancelled after two frames (from its progress report, as Esc does in the
+        UI): like a smoke bake it keeps and builds the frames it finished, and no partial file."""
+        from plume.operators.flames import FlamesJob, PLUME_OT_flames_bake
+        folder = os.path.join(self.tmp, "cancelled")
+        flame_scene(folder)
+        job = FlamesJob()
+        self.assertEqual(run_cancelled(PLUME_OT_flames_bake, job, after=2), {'FINISHED'})
+        self.assertTrue(job.result.cancelled)
+        f = bpy.context.scene.plume_flames
+        self.assertEqual(f.frames_baked, 2)
+        self.assertEqual([n for n in tree_listing(folder) if not n.endswith(".json")],
+                         ["flames_0001.vdb", "flames_0002.vdb", "spines_0001.npz",
+                          "spines_0002.npz"])
+        self.assertIsNotNone(bpy.data.objects.get(f.volume_object))
+        from plume.operators.flames import is_baking
+        self.assertFalse(is_baking())
 
     def test_placement(self):
         """Flames are placed on the mesh's up-facing faces, apart, the same for a seed."""

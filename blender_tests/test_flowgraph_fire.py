@@ -23,8 +23,8 @@ import numpy as np  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
 from helpers import (OUT_DIR, add_domain, add_sphere_source, assert_reports_error,  # noqa: E402
-                     image_pixels, native, reset_scene, rmtree, run, select_only, temp_dir,
-                     tree_listing)
+                     image_pixels, native, reset_scene, rmtree, run, run_cancelled,
+                     select_only, temp_dir, tree_listing)
 
 FRAMES = 40
 SYNTH_FRAMES = 200
@@ -296,6 +296,34 @@ class FlowGraphFireTest(unittest.TestCase):
         self.assertEqual(len([n for n in names if n.startswith("fire_")]), len(frames))
         self.assertIsNone(bpy.data.objects.get("Windy_fire_points"))
         self.assertEqual(g.points_object, "")
+
+    def test_4_cancelled_jobs_leave_nothing(self):
+        """Build Flow Graph cancelled while its native cost-matrix job runs, Synthesize Fire
+        after two frames: CANCELLED, and the scene, the panel's summary and every cache file
+        are as before (the staged graph and frames are removed)."""
+        from plume.operators.flowgraph import (FlowGraphJob, PLUME_OT_fire_synthesize,
+                                               PLUME_OT_flowgraph_build, SynthesisJob)
+
+        class CancelledInCostMatrix(FlowGraphJob):
+            def _attach(self, job):
+                super()._attach(job)
+                self.cancel()  # watch(): the native job is cancelled with the runner
+        g = self.windy.plume.domain.flowgraph
+        if not g.summary:
+            self.skipTest("needs the graph of test_1")
+        select([self.calm, self.windy], self.windy)
+        before = self.state()
+        job = CancelledInCostMatrix()
+        self.assertEqual(run_cancelled(PLUME_OT_flowgraph_build, job, after=10 ** 9),
+                         {'CANCELLED'})
+        self.assertTrue(job.cancelled)
+        self.assertEqual(self.state(), before)
+        select_only(self.windy)
+        g.frame_start, g.frame_end, g.point_preview = 1, 20, True
+        job = SynthesisJob()
+        self.assertEqual(run_cancelled(PLUME_OT_fire_synthesize, job, after=2), {'CANCELLED'})
+        self.assertEqual(job.progress().done, 2)
+        self.assertEqual(self.state(), before)
 
 
 if __name__ == "__main__":

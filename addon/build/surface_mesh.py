@@ -57,19 +57,33 @@ def read_density(path):
 
 def export_mesh(ob, frame, level):
     """Creates or replaces the MESH object f"{ob.name}_mesh"; returns it. BakeError on bad input
-    (the scene is unchanged then)."""
+    (the scene is unchanged then). Blocking: inputs(), refine() and mesh_object() in a row."""
+    return mesh_object(ob, *refine(*inputs(ob, frame), level))
+
+
+def inputs(ob, frame):
+    """(surface name, control points, nu, nv, density map) of the surface at `frame`: what
+    refine() needs, read on the main thread. BakeError when the cache is missing."""
     sp = ob.data.splines[0]
-    nu, nv = sp.point_count_u, sp.point_count_v
     density = read_density(sheet_file(ob, frame))
+    return ob.name, surface_edits.current_points(ob), sp.point_count_u, sp.point_count_v, density
+
+
+def refine(name, points, nu, nv, density, level):
+    """(vertices, quads, density per vertex in [0, 1]) of the control net refined `level` times
+    (OpenSubdiv), no bpy; BakeError naming the surface on bad input."""
     try:
-        verts, quads, dens = _native.subdivide_mesh(surface_edits.current_points(ob), nu, nv,
-                                                    level, density, True)
+        verts, quads, dens = _native.subdivide_mesh(points, nu, nv, level, density, True)
     except ValueError as e:
-        raise BakeError(f"Plume: mesh export of '{ob.name}': {e}") from None
+        raise BakeError(f"Plume: mesh export of '{name}': {e}") from None
     verts = np.asarray(verts, dtype=np.float32)
     quads = np.asarray(quads, dtype=np.int32)
     dens = np.clip(np.asarray(dens, dtype=np.float32), 0.0, 1.0)
+    return verts, quads, dens
 
+
+def mesh_object(ob, verts, quads, dens):
+    """Creates or replaces the MESH object f"{ob.name}_mesh" of refine()'s arrays; returns it."""
     name = mesh_name(ob)
     me = bpy.data.meshes.new(name)
     me.vertices.add(len(verts))

@@ -1,8 +1,11 @@
 """plume.flowgraph_build and plume.fire_synthesize (graph_fire_synthesis.txt §4.3-5): the
 selected baked fire domains (Record Pathlines on) become the states of a flow graph stored with
-the active domain; Synthesize walks it for any number of frames into a fire Volume. Every input
-is checked before anything is written, so bad input changes nothing."""
+the active domain; Synthesize walks it for any number of frames into a fire Volume. Both are jobs
+(jobs/): every input is checked on the main thread before anything is written, the work runs on
+the worker thread into a staging folder, and the files move into place and the Blender data is
+built only when it succeeded, so bad input or a cancel changes nothing."""
 
+import os
 import time
 
 import bpy
@@ -10,8 +13,10 @@ import numpy as np
 
 from .. import _native, cache, flowgraph
 from ..build import fire_points, fire_volume
+from ..jobs import JobOperator, JobProgress, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
+from .bake import domain_key
 
 #: Image datablock showing the cost matrix (Figure 4) in the panel.
 IMAGE_PREFIX = "Plume Flow Graph "
@@ -45,7 +50,66 @@ def show_cost_image(domain, folder):
     return img
 
 
-class PLUME_OT_flowgraph_build(bpy.types.Operator):
+class FlowGraphJob(JobRunner):
+    """Build Flow Graph as a job: the native cost-matrix job on the worker thread (progress and
+    cancel from it), flowgraph.npz and the cost image staged; finish() commits them and fills
+    the panel's summary."""
+
+    title = "Build Flow Graph"
+
+    def prepare(self, context):
+        self.t0 = time.perf_counter()
+        domain = active_domain(context)
+        self.domain_name = domain.name
+        g = domain.plume.domain.flowgraph
+        self.settings = graph_settings(g)
+        flowgraph.validate_graph_settings(self.settings, f"domain '{domain.name}'")
+        domains = state_domains(context, domain)
+        self.objects = tuple(d.name for d in domains)
+        self.claim(*(domain_key(d.name) for d in domains))
+        self.states = flowgraph.open_states(
+            _native, [(d.name, cache_folder_of(d)) for d in domains])
+        self.folder = cache_folder_of(domain)
+        error = cache.check_writable(self.folder)
+        if error is not None:
+            raise BakeError(f"Plume: cache folder {self.folder} is not writable ({error})")
+        self._job = self._job_started = None
+
+    def _attach(self, job):
+        self._job_started = time.perf_counter()
+        self._job = self.watch(job)
+
+    def progress(self):
+        """The native cost-matrix job's own progress while it runs."""
+        job = self._job
+        if job is None:
+            return super().progress()
+        return JobProgress(int(100 * job.progress), 100, "cost matrix (%)",
+                           stage_started=self._job_started)
+
+    def run(self):
+        self.built = flowgraph.build_graph(_native, self.states, self.settings,
+                                           self.stage(self.folder), on_job=self._attach)
+
+    def finish(self, context):
+        domain = bpy.data.objects[self.domain_name]
+        g = domain.plume.domain.flowgraph
+        self.staging.commit()
+        s, states = self.built["summary"], self.states
+        g.state_names = ", ".join(f"{i}: {st.name}" for i, st in enumerate(states))
+        g.summary = (f"{sum(s['nodes'])} nodes, {s['kept']} of {s['candidates']} transitions "
+                     f"(ε = {s['epsilon']:.3g} in [{s['a']:.3g}, {s['b']:.3g}]), pruned "
+                     f"{sum(s['pruned'])}")
+        show_cost_image(domain, self.folder)
+        return 'INFO', (f"Plume: flow graph of {len(states)} states: {g.summary} "
+                        f"({time.perf_counter() - self.t0:.1f} s)")
+
+    def busy_text(self):
+        return (f"Plume: domain '{self.domain_name}' is building a flow graph (Esc cancels): "
+                "wait for it")
+
+
+class PLUME_OT_flowgraph_build(JobOperator, bpy.types.Operator):
     """Build the flow graph of the selected fire domains (each baked with Record Pathlines is one
     state): transition costs over the pathlines' whole lifetime, transitions, dead ends pruned"""
 
@@ -53,33 +117,8 @@ class PLUME_OT_flowgraph_build(bpy.types.Operator):
     bl_label = "Build Flow Graph"
     bl_options = {'REGISTER'}  # writes cache files, which undo would not restore
 
-    def execute(self, context):
-        t0 = time.perf_counter()
-        try:
-            domain = active_domain(context)
-            g = domain.plume.domain.flowgraph
-            settings = graph_settings(g)
-            flowgraph.validate_graph_settings(settings, f"domain '{domain.name}'")
-            domains = state_domains(context, domain)
-            states = flowgraph.open_states(
-                _native, [(d.name, cache_folder_of(d)) for d in domains])
-            folder = cache_folder_of(domain)
-            error = cache.check_writable(folder)
-            if error is not None:
-                raise BakeError(f"Plume: cache folder {folder} is not writable ({error})")
-            built = flowgraph.build_graph(_native, states, settings, folder)
-        except BakeError as e:
-            self.report({'ERROR'}, str(e))
-            return {'CANCELLED'}
-        s = built["summary"]
-        g.state_names = ", ".join(f"{i}: {st.name}" for i, st in enumerate(states))
-        g.summary = (f"{sum(s['nodes'])} nodes, {s['kept']} of {s['candidates']} transitions "
-                     f"(ε = {s['epsilon']:.3g} in [{s['a']:.3g}, {s['b']:.3g}]), pruned "
-                     f"{sum(s['pruned'])}")
-        show_cost_image(domain, folder)
-        self.report({'INFO'}, f"Plume: flow graph of {len(states)} states: {g.summary} "
-                              f"({time.perf_counter() - t0:.1f} s)")
-        return {'FINISHED'}
+    def make_runner(self, context):
+        return FlowGraphJob()
 
 
 def frame_inputs(context, domain, frame_start, frame_end):
@@ -113,7 +152,83 @@ def frame_inputs(context, domain, frame_start, frame_end):
     return targets, winds, turbulence
 
 
-class PLUME_OT_fire_synthesize(bpy.types.Operator):
+#: The registry key of fire synthesis: one at a time (the session's prepared-group cache).
+SYNTHESIS_KEY = ("fire synthesis",)
+
+
+class SynthesisJob(JobRunner):
+    """Synthesize Fire as a job: the random walk and the rasterized frames on the worker thread
+    into the staging folder's fire/; finish() commits them and builds the fire Volume (and the
+    point preview)."""
+
+    title = "Synthesize Fire"
+    prepare_errors = (BakeError, ValueError)
+
+    def prepare(self, context):
+        self.t0 = time.perf_counter()
+        domain = active_domain(context)
+        self.domain_name = domain.name
+        g = domain.plume.domain.flowgraph
+        owner = f"domain '{domain.name}'"
+        self.folder = folder = cache_folder_of(domain)
+        self.objects = (domain.name,)
+        self.claim(domain_key(domain.name), SYNTHESIS_KEY)
+        graph, states = flowgraph.load_graph(_native, folder, owner)
+        d = domain.plume.domain
+        settings = flowgraph.SynthesisSettings(
+            frame_start=int(g.frame_start), frame_end=int(g.frame_end), seed=int(g.seed),
+            traversal=g.traversal, gamma=float(g.gamma), start_state=int(g.start_state),
+            max_temperature=float(d.max_temperature),
+            point_preview=bool(g.point_preview), preview_points=int(g.preview_points),
+            group_cache_mb=int(g.group_cache))
+        flowgraph.validate_synthesis(settings, graph.state_count, owner)
+        settings.targets, settings.winds, settings.turbulence = frame_inputs(
+            context, domain, settings.frame_start, settings.frame_end)
+        flowgraph.validate_synthesis(settings, graph.state_count, owner)
+        self.synthesis = flowgraph.SynthesisRunner(_native, graph, states, settings, folder,
+                                                   progress=self._frame_done,
+                                                   cancel=lambda: self.cancelled)
+        self.settings, self.states = settings, states
+        self.set_progress(0, settings.frame_end - settings.frame_start + 1, "frame")
+
+    def _frame_done(self, done, total):
+        self.set_progress(done, total, "frame")
+
+    def run(self):
+        self.synthesis.out_folder = self.stage(self.folder)
+        self.result = self.synthesis.run()
+
+    def finish(self, context):
+        domain = bpy.data.objects[self.domain_name]
+        folder, result, settings = self.folder, self.result, self.settings
+        fire = os.path.join(folder, flowgraph.FIRE_FOLDER)
+        old = [os.path.join(fire, n) for n in (os.listdir(fire) if os.path.isdir(fire) else ())
+               if (n.startswith("fire_") and n.endswith(".vdb"))
+               or (n.startswith("points_") and n.endswith(".npz"))]
+        self.staging.commit(replaced=old)
+        frames = result.last_frame - result.frame_start + 1
+        ob = fire_volume.build_fire_volume(domain, folder, result.frame_start, frames,
+                                           settings.max_temperature)
+        if settings.point_preview:
+            fire_points.build_object(context.scene, domain, folder, result.frame_start,
+                                     result.last_frame, self.states[0].file.cell_size,
+                                     settings.max_temperature)
+        else:
+            fire_points.remove_object(domain)
+        return 'INFO', (f"Plume: synthesized {frames} frames of fire into '{ob.name}' "
+                        f"({len(result.nodes_visited)} nodes, {result.transitions_taken} "
+                        f"transitions, {time.perf_counter() - self.t0:.1f} s)")
+
+    def error_text(self, exc):
+        if isinstance(exc, BakeError):
+            return str(exc)
+        return f"Plume: fire synthesis: {exc}"
+
+    def busy_text(self):
+        return f"Plume: fire synthesis of domain '{self.domain_name}' is running (Esc cancels it)"
+
+
+class PLUME_OT_fire_synthesize(JobOperator, bpy.types.Operator):
     """Synthesize fire of any length from the active domain's flow graph by a random walk
     (temporal bias γ, keyed target states, wind) into a fire Volume"""
 
@@ -121,51 +236,8 @@ class PLUME_OT_fire_synthesize(bpy.types.Operator):
     bl_label = "Synthesize Fire"
     bl_options = {'REGISTER'}
 
-    def execute(self, context):
-        t0 = time.perf_counter()
-        try:
-            domain = active_domain(context)
-            g = domain.plume.domain.flowgraph
-            owner = f"domain '{domain.name}'"
-            folder = cache_folder_of(domain)
-            graph, states = flowgraph.load_graph(_native, folder, owner)
-            d = domain.plume.domain
-            settings = flowgraph.SynthesisSettings(
-                frame_start=int(g.frame_start), frame_end=int(g.frame_end), seed=int(g.seed),
-                traversal=g.traversal, gamma=float(g.gamma), start_state=int(g.start_state),
-                max_temperature=float(d.max_temperature),
-                point_preview=bool(g.point_preview), preview_points=int(g.preview_points),
-                group_cache_mb=int(g.group_cache))
-            flowgraph.validate_synthesis(settings, graph.state_count, owner)
-            settings.targets, settings.winds, settings.turbulence = frame_inputs(
-                context, domain, settings.frame_start, settings.frame_end)
-            flowgraph.validate_synthesis(settings, graph.state_count, owner)
-            runner = flowgraph.SynthesisRunner(_native, graph, states, settings, folder)
-        except (BakeError, ValueError) as e:
-            self.report({'ERROR'}, str(e))
-            return {'CANCELLED'}
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        try:
-            result = runner.run()
-        except (RuntimeError, OSError) as e:
-            self.report({'ERROR'}, f"Plume: fire synthesis: {e}")
-            return {'CANCELLED'}
-        finally:
-            wm.progress_end()
-        frames = result.last_frame - result.frame_start + 1
-        ob = fire_volume.build_fire_volume(domain, folder, result.frame_start, frames,
-                                           settings.max_temperature)
-        if settings.point_preview:
-            fire_points.build_object(context.scene, domain, folder, result.frame_start,
-                                     result.last_frame, states[0].file.cell_size,
-                                     settings.max_temperature)
-        else:
-            fire_points.remove_object(domain)
-        self.report({'INFO'}, f"Plume: synthesized {frames} frames of fire into '{ob.name}' "
-                              f"({len(result.nodes_visited)} nodes, {result.transitions_taken} "
-                              f"transitions, {time.perf_counter() - t0:.1f} s)")
-        return {'FINISHED'}
+    def make_runner(self, context):
+        return SynthesisJob()
 
 
 classes = (PLUME_OT_flowgraph_build, PLUME_OT_fire_synthesize)

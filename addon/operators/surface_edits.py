@@ -1,12 +1,15 @@
 """Operators on built streak surfaces: store / clear hand edits (smoke_surfaces.txt §5, Figure 13),
 bake to keyframes, export as an OpenSubdiv mesh. They act on the active Plume surface (plus the
-selected ones), or, with the domain active (the panel's buttons), on all of its surfaces."""
+selected ones), or, with the domain active (the panel's buttons), on all of its surfaces. Export
+Mesh is a job (jobs/): the surfaces are read on the main thread, refined on the worker thread,
+and the meshes are built only when every surface succeeded."""
 
 import bpy
 
 from ..build import surface_edits as edits
 from ..build import surface_mesh
 from ..build.surfaces import CACHE_KEY, DOMAIN_KEY, cache_of
+from ..jobs import JobOperator, JobRunner
 from ..settings import BakeError
 
 
@@ -118,26 +121,58 @@ class PLUME_OT_surfaces_bake_keyframes(PlumeSurfaceOperator, bpy.types.Operator)
         return f"Plume: baked {len(targets)} surfaces to {keys} keyframes"
 
 
-class PLUME_OT_surfaces_export_mesh(PlumeSurfaceOperator, bpy.types.Operator):
+class ExportMeshJob(JobRunner):
+    """Export Mesh as a job: every target surface's control net and density map read by
+    prepare(), refined (OpenSubdiv) one surface after the other by run(), the MESH objects made
+    by finish()."""
+
+    title = "Export Mesh"
+
+    def __init__(self, level):
+        super().__init__()
+        self.level = level
+
+    def prepare(self, context):
+        targets = surface_targets(context, allow_baked=True)
+        frame = context.scene.frame_current
+        for ob, _frame_start, _cps in targets:
+            load_edit_mode(ob)
+            surface_mesh.sheet_file(ob, frame)  # every input checked before anything is made
+        self.objects = tuple(ob.name for ob, _s, _c in targets)
+        self.claim(*(("surface", name) for name in self.objects))
+        self.inputs = [surface_mesh.inputs(ob, frame) for ob, _s, _c in targets]
+        self.set_progress(0, len(self.inputs), "surface")
+
+    def run(self):
+        self.meshes = []
+        for i, args in enumerate(self.inputs):
+            self.check_cancel()
+            self.meshes.append(surface_mesh.refine(*args, self.level))
+            self.set_progress(i + 1, len(self.inputs), "surface")
+
+    def finish(self, context):
+        names = [surface_mesh.mesh_object(bpy.data.objects[name], *mesh).name
+                 for name, mesh in zip(self.objects, self.meshes)]
+        return 'INFO', f"Plume: exported {', '.join(names)}"
+
+    def busy_text(self):
+        return "Plume: these surfaces are being exported (Esc cancels): wait for it"
+
+
+class PLUME_OT_surfaces_export_mesh(JobOperator, bpy.types.Operator):
     """Export the current frame's surfaces as smooth meshes (OpenSubdiv) with a "density"
     point attribute"""
 
     bl_idname = "plume.surfaces_export_mesh"
     bl_label = "Export Mesh"
     bl_options = {'REGISTER', 'UNDO'}
-    allow_baked = True
 
     level: bpy.props.IntProperty(
         name="Level", default=2, min=0, max=6,
         description="Catmull-Clark refinement levels of the control net (OpenSubdiv)")
 
-    def run(self, context, targets):
-        frame = context.scene.frame_current
-        for ob, _frame_start, _cps in targets:
-            load_edit_mode(ob)
-            surface_mesh.sheet_file(ob, frame)  # every input checked before anything is made
-        names = [surface_mesh.export_mesh(ob, frame, self.level).name for ob, _s, _c in targets]
-        return f"Plume: exported {', '.join(names)}"
+    def make_runner(self, context):
+        return ExportMeshJob(self.level)
 
 
 classes = (PLUME_OT_surface_edits_store, PLUME_OT_surface_edits_clear,

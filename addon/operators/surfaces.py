@@ -1,7 +1,9 @@
 """plume.surfaces_build on the active baked domain (smoke_surfaces.txt §3.3-3.4): streak files ->
 h per candidate group -> clusters (h0) -> greedy order -> one SURFACE object per cluster with
-per-frame control points and a density-map material. Everything is computed and checked before
-the scene is touched, so bad input changes nothing."""
+per-frame control points and a density-map material. A job (jobs/): the settings are checked on
+the main thread, everything is computed on the worker thread (no bpy) into a staging folder,
+the density-map images are saved in short main-thread steps, and only then are the files moved
+into place and the objects built, so bad input or a cancel changes nothing."""
 
 import os
 import time
@@ -12,8 +14,10 @@ import numpy as np
 from .. import _native, cache
 from .. import streak_surfaces as ss
 from ..build import surfaces as build
+from ..jobs import JobOperator, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
+from .bake import domain_key
 
 #: h per candidate group, cached in memory for the panel's live count (never computed in draw):
 #: domain name -> (key of the cache state, {group: GroupDistances})
@@ -72,60 +76,69 @@ def _settings_of(d):
             "opacity": float(d.sheet_opacity)}
 
 
-class PLUME_OT_surfaces_build(bpy.types.Operator):
-    """Build streak surfaces (NURBS smoke sheets) from the active domain's streak bake"""
+class SurfacesJob(JobRunner):
+    """Build Surfaces as a job: prepare() checks the settings and the bake's manifest, run()
+    computes h, the clusters, the NURBS animations and the density maps and stages the
+    control-point files, main_steps() saves the density maps (bpy images) into the staging
+    folder, finish() commits and builds the objects."""
 
-    bl_idname = "plume.surfaces_build"
-    bl_label = "Build Surfaces"
-    bl_options = {'REGISTER'}  # writes cache files, which undo would not restore
+    title = "Build Surfaces"
+    prepare_errors = (BakeError, ValueError, RuntimeError)
 
-    def execute(self, context):
-        t0 = time.perf_counter()
-        try:
-            domain = active_domain(context)
-            d = domain.plume.domain
-            settings = _settings_of(d)
-            ss.check_threshold(d.streak_threshold, domain.name)
-            folder, m, frames, groups = compute_distances(domain)
-            plans = ss.plan_surfaces(_native, groups, d.streak_threshold)
-            if not plans:
-                raise BakeError(f"Plume: threshold h0 = {d.streak_threshold} joins no two "
-                                "streaklines: raise streak_threshold (0 = the default mean of h)")
-            anims = [ss.surface_animation(_native, frames, p) for p in plans]
-            frame_start = int(m["frame_start"])
-            maps = self._density_maps(folder, m, anims, settings)
-        except BakeError as e:
-            self.report({'ERROR'}, str(e))
-            return {'CANCELLED'}
-        except (ValueError, RuntimeError) as e:
-            self.report({'ERROR'}, f"Plume: surfaces of '{context.active_object.name}': {e}")
-            return {'CANCELLED'}
-        # Nothing above touched the scene; now the files, then the objects.
-        for path in cache.surface_files(folder):
-            os.remove(path)
-        sheets = []
-        for i, (anim, images) in enumerate(zip(anims, maps)):
-            tmp = cache.surface_path(folder, i) + ".tmp.npz"
-            np.savez(tmp, control_points=anim.control_points, frame_start=frame_start,
-                     nu=anim.nu, nv=anim.nv, order_u=anim.order_u, order_v=anim.order_v)
-            os.replace(tmp, cache.surface_path(folder, i))
-            first = build.write_sheet_images(folder, i, frame_start, images)
-            sheets.append((first, images[0].shape[1], images[0].shape[0], len(images)))
-        objs = build.build_surfaces(context, domain, folder, frame_start, anims, sheets, settings)
-        lines = sum(len(p.sources) for p in plans)
-        self.report({'INFO'}, f"Plume: {len(objs)} surfaces from {lines} streaklines "
-                              f"({time.perf_counter() - t0:.1f} s)")
-        return {'FINISHED'}
+    def prepare(self, context):
+        self.t0 = time.perf_counter()
+        domain = active_domain(context)
+        d = domain.plume.domain
+        self.domain_name = domain.name
+        self.settings = _settings_of(d)
+        ss.check_threshold(d.streak_threshold, domain.name)
+        self.h0 = d.streak_threshold
+        self.folder = cache_folder_of(domain)
+        self.objects = (domain.name,)
+        self.claim(domain_key(domain.name))
+        self.manifest = ss.streak_manifest(self.folder, domain.name)
 
-    @staticmethod
-    def _density_maps(folder, m, anims, settings):
+    def run(self):
+        folder, m = self.folder, self.manifest
+        frame_start, last = int(m["frame_start"]), int(m["last_complete_frame"])
+        self.frame_start = frame_start
+        self.set_progress(0, 0, "reading the streak files")
+        frames = ss.load_frames(_native, folder, frame_start, last)
+        self.check_cancel()
+        self.set_progress(0, 0, "distances h between streaklines")
+        groups = ss.group_distances(_native, frames)
+        _distances[self.domain_name] = (_cache_key(folder, m), groups)
+        self.check_cancel()
+        plans = ss.plan_surfaces(_native, groups, self.h0)
+        if not plans:
+            raise BakeError(f"Plume: threshold h0 = {self.h0} joins no two streaklines: raise "
+                            "streak_threshold (0 = the default mean of h)")
+        self.lines = sum(len(p.sources) for p in plans)
+        anims = []
+        for i, plan in enumerate(plans):
+            self.set_progress(i, len(plans), "surface")
+            self.check_cancel()
+            anims.append(ss.surface_animation(_native, frames, plan))
+        self.anims = anims
+        self.maps = self._density_maps(folder, m, anims, self.settings)
+        staged = self.stage(folder)
+        for i, anim in enumerate(anims):
+            self.check_cancel()
+            np.savez(cache.surface_path(staged, i), control_points=anim.control_points,
+                     frame_start=frame_start, nu=anim.nu, nv=anim.nv, order_u=anim.order_u,
+                     order_v=anim.order_v)
+
+    def _density_maps(self, folder, m, anims, settings):
         """§3.4 density map of every surface at every frame (from the VDB density grids)."""
         res = tuple(m["resolution"])
         origin, cell = tuple(m["origin"]), float(m["cell_size"])
         interp = getattr(_native.Interpolation, m["settings"]["solver"]["interpolation"])
         frame_start = int(m["frame_start"])
         maps = [[] for _ in anims]
-        for n in range(len(anims[0].surfaces)):
+        count = len(anims[0].surfaces)
+        for n in range(count):
+            self.set_progress(n, count, "density map of frame")
+            self.check_cancel()
             path = cache.volume_path(folder, frame_start + n)
             if not os.path.isfile(path):
                 raise BakeError(f"Plume: volume file {path} is missing: bake the domain again")
@@ -135,6 +148,52 @@ class PLUME_OT_surfaces_build(bpy.types.Operator):
                     _native, anim.surfaces[n], density, origin, cell, settings["k_u"],
                     settings["k_v"], interp, anim.particles, anim.nv))
         return maps
+
+    def main_steps(self, context):
+        """Saves the density maps as EXR files into the staging folder with Blender's image
+        writer (so on the main thread), one image per step."""
+        self.sheets = []
+        total = sum(len(images) for images in self.maps)
+        done = 0
+        for i, images in enumerate(self.maps):
+            for n, image in enumerate(images):
+                self.set_progress(done, total, "density map image")
+                yield
+                build.write_sheet_images(self.staging.path, i, self.frame_start + n, [image])
+                done += 1
+            self.sheets.append((cache.sheet_path(self.folder, i, self.frame_start),
+                                images[0].shape[1], images[0].shape[0], len(images)))
+
+    def finish(self, context):
+        domain = bpy.data.objects[self.domain_name]
+        self.staging.commit(replaced=cache.surface_files(self.folder))
+        objs = build.build_surfaces(context, domain, self.folder, self.frame_start, self.anims,
+                                    self.sheets, self.settings)
+        return 'INFO', (f"Plume: {len(objs)} surfaces from {self.lines} streaklines "
+                        f"({time.perf_counter() - self.t0:.1f} s)")
+
+    def refusal_text(self, exc):
+        return self.error_text(exc)
+
+    def error_text(self, exc):
+        if isinstance(exc, BakeError):
+            return str(exc)
+        return f"Plume: surfaces of '{self.domain_name}': {exc}"
+
+    def busy_text(self):
+        return (f"Plume: domain '{self.domain_name}' is building its surfaces (Esc cancels): "
+                "wait for it")
+
+
+class PLUME_OT_surfaces_build(JobOperator, bpy.types.Operator):
+    """Build streak surfaces (NURBS smoke sheets) from the active domain's streak bake"""
+
+    bl_idname = "plume.surfaces_build"
+    bl_label = "Build Surfaces"
+    bl_options = {'REGISTER'}  # writes cache files, which undo would not restore
+
+    def make_runner(self, context):
+        return SurfacesJob()
 
 
 class PLUME_OT_surfaces_pick_threshold(bpy.types.Operator):

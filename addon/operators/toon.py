@@ -1,7 +1,9 @@
 """plume.toon_build on the active baked domain (cartoon_smoke.txt §2): toon particles from the
 bake's volume frames -> toon_####.bin, a point object following them, billboards with a stencil
-cut-out material, and the "Plume Depth Differences" compositor outlines. Every input is checked
-before anything is written or created, so bad input changes nothing."""
+cut-out material, and the "Plume Depth Differences" compositor outlines. A job (jobs/): every
+input is checked on the main thread before anything is written or created, the particles run on
+the worker thread into a staging folder, and the files move into place and the objects are built
+only when that succeeded, so bad input or a cancel changes nothing."""
 
 import time
 
@@ -9,9 +11,11 @@ import bpy
 
 from .. import _native, toon
 from ..build import toon_compositor, toon_nodes, toon_points
+from ..jobs import JobOperator, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of, emitter_snapshots
 from ..toon_stencils import write_stencil
+from .bake import domain_key
 
 
 def toon_settings(d):
@@ -26,63 +30,68 @@ def toon_settings(d):
     return s
 
 
-class PLUME_OT_toon_build(bpy.types.Operator):
-    """Build toon smoke (stencil billboards with depth-difference outlines) from the active
-    domain's bake"""
+class ToonJob(JobRunner):
+    """Build Toon Smoke as a job: toon.ToonRunner on the worker thread writing toon_####.bin
+    (and the generated stencil) into the staging folder; finish() commits and builds."""
 
-    bl_idname = "plume.toon_build"
-    bl_label = "Build Toon Smoke"
-    bl_options = {'REGISTER'}  # writes cache files, which undo would not restore
+    title = "Build Toon Smoke"
 
-    def execute(self, context):
-        t0 = time.perf_counter()
+    def prepare(self, context):
+        self.t0 = time.perf_counter()
         scene = context.scene
-        try:
-            domain = active_domain(context)
-            d = domain.plume.domain
-            settings = toon_settings(d)
-            toon.validate(settings, domain.name)
-            folder = cache_folder_of(domain)
-            manifest = toon.toon_manifest(folder, domain.name)
-            toon.check_bake(settings, manifest, domain.name)
-            if scene.camera is None:
-                raise BakeError(f"Plume: scene '{scene.name}' has no camera: the billboards face "
-                                "the scene camera and the outlines need its Depth pass; set "
-                                "scene.camera")
-            frame_start = int(manifest["frame_start"])
-            emitters = emitter_snapshots(context, domain, frame_start, frame_start)
-            runner = toon.ToonRunner(_native, folder, manifest, settings, domain.name,
-                                     progress=self._progress(context),
-                                     source_cells=toon.source_cells(
-                                         _native, toon.toon_grid(manifest), emitters))
-        except BakeError as e:
-            self.report({'ERROR'}, str(e))
-            return {'CANCELLED'}
-        # Checked: now the files, then the scene.
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        try:
-            result = runner.run()
-            stencil = (settings.stencil_image if settings.stencil == 'IMAGE'
-                       else write_stencil(folder, settings.stencil))
-        except (BakeError, OSError) as e:
-            self.report({'ERROR'}, str(e))
-            return {'CANCELLED'}
-        finally:
-            wm.progress_end()
-        ob = self._build(context, domain, folder, result, stencil, settings)
-        self.report({'INFO'}, f"Plume: toon smoke '{ob.name}', frames {result.frame_start}-"
-                              f"{result.last_frame}, {result.max_count_seen} particles at most "
-                              f"({time.perf_counter() - t0:.1f} s)")
-        return {'FINISHED'}
+        domain = active_domain(context)
+        d = domain.plume.domain
+        self.domain_name = domain.name
+        settings = toon_settings(d)
+        toon.validate(settings, domain.name)
+        folder = cache_folder_of(domain)
+        manifest = toon.toon_manifest(folder, domain.name)
+        toon.check_bake(settings, manifest, domain.name)
+        if scene.camera is None:
+            raise BakeError(f"Plume: scene '{scene.name}' has no camera: the billboards face "
+                            "the scene camera and the outlines need its Depth pass; set "
+                            "scene.camera")
+        self.objects = (domain.name, scene.camera.name)  # the billboards face the camera
+        self.claim(domain_key(domain.name))
+        frame_start = int(manifest["frame_start"])
+        emitters = emitter_snapshots(context, domain, frame_start, frame_start)
+        self.toon = toon.ToonRunner(_native, folder, manifest, settings, domain.name,
+                                    progress=self._frame_done, cancel=lambda: self.cancelled,
+                                    source_cells=toon.source_cells(
+                                        _native, toon.toon_grid(manifest), emitters))
+        self.folder, self.settings = folder, settings
+        self.set_progress(0, self.toon.last_frame - self.toon.frame_start + 1, "frame")
 
-    @staticmethod
-    def _progress(context):
-        wm = context.window_manager
+    def _frame_done(self, done, total):
+        self.set_progress(done, total, "frame")
 
-        def progress(done, total):
-            wm.progress_update(int(100 * done / max(total, 1)))
-        return progress
+    def run(self):
+        self.toon.out_folder = self.stage(self.folder)
+        self.result = self.toon.run()
+        if self.cancelled:
+            return
+        s = self.settings
+        self.stencil = (s.stencil_image if s.stencil == 'IMAGE'
+                        else self.staging.final_path(write_stencil(self.toon.out_folder,
+                                                                   s.stencil)))
+
+    def finish(self, context):
+        domain = bpy.data.objects[self.domain_name]
+        folder, result = self.folder, self.result
+        self.staging.commit(replaced=[toon.toon_path(folder, f) for f in toon.toon_frames(folder)])
+        ob = self._build(context, domain, folder, result, self.stencil, self.settings)
+        return 'INFO', (f"Plume: toon smoke '{ob.name}', frames {result.frame_start}-"
+                        f"{result.last_frame}, {result.max_count_seen} particles at most "
+                        f"({time.perf_counter() - self.t0:.1f} s)")
+
+    def error_text(self, exc):
+        if isinstance(exc, (BakeError, OSError)):
+            return str(exc)
+        return super().error_text(exc)
+
+    def busy_text(self):
+        return (f"Plume: domain '{self.domain_name}' is building its toon smoke (Esc cancels): "
+                "wait for it")
 
     @staticmethod
     def _build(context, domain, folder, result, stencil, settings):
@@ -100,6 +109,18 @@ class PLUME_OT_toon_build(bpy.types.Operator):
         toon_compositor.set_freestyle(scene, view_layer, t.use_freestyle, t.outline_color)
         t.object_name = ob.name
         return ob
+
+
+class PLUME_OT_toon_build(JobOperator, bpy.types.Operator):
+    """Build toon smoke (stencil billboards with depth-difference outlines) from the active
+    domain's bake"""
+
+    bl_idname = "plume.toon_build"
+    bl_label = "Build Toon Smoke"
+    bl_options = {'REGISTER'}  # writes cache files, which undo would not restore
+
+    def make_runner(self, context):
+        return ToonJob()
 
 
 classes = (PLUME_OT_toon_build,)

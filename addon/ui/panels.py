@@ -4,7 +4,7 @@ Mantaflow's): role buttons, then the settings of the object's role."""
 import bpy
 
 from .. import _native, streak_count
-from ..operators.bake import cache_status, is_baking
+from ..operators.bake import cache_status, is_baking, is_busy
 from ..operators.surfaces import live_summary
 from ..properties import ROLE_ITEMS
 
@@ -45,7 +45,7 @@ class PHYSICS_PT_plume(PlumePanel, bpy.types.Panel):
             op.role = ident
         if p.role == 'DOMAIN':
             row = layout.row(align=True)
-            row.enabled = not is_baking(context.object)
+            row.enabled = not is_busy(context.object)
             row.operator("plume.bake", icon='PHYSICS')
             row.operator("plume.cache_free", icon='TRASH')
 
@@ -183,7 +183,7 @@ class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
         layout.prop(d, "velocity_everywhere")
         baking = is_baking(ob)
         row = layout.row(align=True)
-        row.enabled = not baking
+        row.enabled = not is_busy(ob)
         row.operator("plume.bake", icon='PHYSICS')
         row.operator("plume.cache_free", icon='TRASH')
         done, total = cache_status(ob)
@@ -228,7 +228,7 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         col.prop(d, "sheet_brightness")
         col.prop(d, "sheet_opacity")
         row = col.row()
-        row.enabled = not is_baking(ob)
+        row.enabled = not is_busy(ob)
         row.operator("plume.surfaces_build", icon='SURFACE_NSURFACE')
         # On the built surfaces (all of this domain's; §5 hand edits, keyframes, mesh export).
         if d.surfaces_collection:
@@ -273,7 +273,7 @@ class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
         col.prop(t, "ignore_background")
         col.prop(t, "use_freestyle")
         row = layout.row()
-        row.enabled = not is_baking(ob)
+        row.enabled = not is_busy(ob)
         row.operator("plume.toon_build", icon='MOD_PARTICLES')
         if t.object_name:
             layout.label(text=f"Toon: {t.object_name}", icon='OUTLINER_OB_POINTCLOUD')
@@ -295,7 +295,9 @@ class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
         sub.active = not g.auto_weights
         sub.prop(g, "alpha")
         sub.prop(g, "beta")
-        layout.operator("plume.flowgraph_build", icon='NODETREE')
+        row = layout.row()
+        row.enabled = not is_busy(context.object)
+        row.operator("plume.flowgraph_build", icon='NODETREE')
         if g.summary:
             layout.label(text=g.state_names, icon='INFO')
             layout.label(text=g.summary)
@@ -313,7 +315,9 @@ class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
         sub.active = g.point_preview
         sub.prop(g, "preview_points")
         col.prop(g, "group_cache")
-        layout.operator("plume.fire_synthesize", icon='PLAY')
+        row = layout.row()
+        row.enabled = not is_busy(context.object)
+        row.operator("plume.fire_synthesize", icon='PLAY')
         if g.fire_object:
             layout.label(text=f"Fire: {g.fire_object}", icon='OUTLINER_OB_VOLUME')
         if g.points_object:

@@ -1,0 +1,29 @@
+"""Jobs: every long Plume operation (bake, flames bake, Build Surfaces, toon build, graph build,
+fire synthesis, mesh export) as one runner protocol and one operator mixin.
+
+- runner.py   JobRunner: prepare() (main thread, snapshot + validation), run() (worker thread, no
+              bpy), main_steps() and finish() (main thread, Blender data); cancel(), progress()
+- operator.py JobOperator: execute() blocking, invoke() worker thread + modal timer + status bar
+              + Esc; cancel() when Blender drops the handler
+- worker.py   the thread run() executes on
+- registry.py which jobs run, by the keys they hold (one job per domain at a time)
+- staging.py  new files kept in a hidden folder until the job succeeds (atomic renames)
+- handlers.py file load, quit and add-on disable abort the running jobs
+"""
+
+from . import handlers, registry
+from .operator import JobOperator
+from .runner import JobCancelled, JobProgress, JobRunner
+from .staging import Staging
+from .worker import Worker
+
+__all__ = ("JobOperator", "JobRunner", "JobProgress", "JobCancelled", "Staging", "Worker",
+           "registry", "register", "unregister")
+
+
+def register():
+    handlers.register()
+
+
+def unregister():
+    handlers.unregister()

@@ -1,0 +1,208 @@
+"""The operator mixin of every job (BLENDER_NOTES §5): one shape for Bake, Bake Flames, Build
+Surfaces, Build Toon Smoke, Build Flow Graph, Synthesize Fire and Export Mesh.
+
+    class PLUME_OT_x(JobOperator, bpy.types.Operator):
+        def make_runner(self, context):
+            return XJob()
+
+execute() runs the job blocking (``blender -b``, scripts, tests: bad input raises RuntimeError).
+invoke() (a button) runs prepare() at once, then run() on a worker thread while a modal timer
+shows "<label> i of N, ~s left (Esc cancels)" in the status bar and the progress cursor; Esc
+cancels within one unit of work; deleting an object the job works on cancels it; the result is
+built on the main thread when the worker is done. Blender calls cancel() when it removes the
+modal handler (quit, window closed, file load): the job is aborted and nothing is built."""
+
+import time
+import traceback
+
+import bpy
+
+from ..settings import BakeError
+from . import registry
+from .worker import Worker
+
+#: Seconds between two polls of the modal timer (progress, cancel, deleted objects).
+POLL_S = 0.1
+#: Seconds of main-thread steps per poll, and between two such polls: the interface stays
+#: responsive while main_steps() take most of the time.
+STEP_BUDGET_S = 0.05
+STEP_POLL_S = 0.01
+
+
+def status_text(title, p, seconds_left):
+    """The status bar's line for JobProgress `p`."""
+    if p.total <= 0:
+        return f"Plume {title}: {p.label}... (Esc cancels)"
+    left = f", ~{seconds_left:.0f} s left" if seconds_left is not None else ""
+    return f"Plume {title}: {p.label} {p.done} of {p.total}{left} (Esc cancels)"
+
+
+class JobOperator:
+    """Mixin (before bpy.types.Operator) running a JobRunner from make_runner()."""
+
+    def make_runner(self, context):
+        """A new JobRunner for this call (properties of the operator passed in)."""
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ blocking
+    def execute(self, context):
+        runner = self._prepare(context)
+        if runner is None:
+            return {'CANCELLED'}
+        error = Worker(runner).run_here().error
+        if error is None and not runner.cancelled:
+            try:
+                for _ in runner.main_steps(context):
+                    if runner.cancelled:
+                        break
+            except Exception as e:
+                error = e
+        return self._conclude(context, runner, error, None)
+
+    # ------------------------------------------------------------------ in the background
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)  # no event loop: modal handlers would never run
+        runner = self._prepare(context)
+        if runner is None:
+            return {'CANCELLED'}
+        self._runner, self._steps, self._error, self._gone = runner, None, None, None
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(POLL_S, window=context.window)
+        wm.progress_begin(0, 100)
+        wm.modal_handler_add(self)
+        Worker(runner).start()
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context, event):
+        runner = self._runner
+        if event.type == 'ESC' and event.value == 'PRESS':
+            runner.cancel()
+            return {'RUNNING_MODAL'}  # Esc is the job's; nothing else sees it
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}
+        if runner.aborted:  # a file load or quit stopped it: nothing to build
+            self._end_ui(context)
+            registry.release(runner)
+            return {'CANCELLED'}
+        self._check_objects(runner)
+        if not runner.worker.finished:
+            self._show(context, runner)
+            return {'PASS_THROUGH'}
+        if not self._main_steps_done(context, runner):
+            self._show(context, runner)
+            return {'PASS_THROUGH'}
+        self._end_ui(context)
+        result = self._conclude(context, runner, self._error or runner.worker.error, self._gone)
+        for area in context.screen.areas if context.screen else ():
+            area.tag_redraw()
+        return result
+
+    def cancel(self, context):
+        """Called by Blender when it drops the modal handler (quit, window closed, file load):
+        stop the worker and remove what it wrote; the scene is not touched."""
+        runner = getattr(self, "_runner", None)
+        if runner is None:
+            return
+        registry.abort(runner)
+        try:
+            self._end_ui(context)
+        except Exception:  # the window may be half torn down already
+            pass
+
+    # ------------------------------------------------------------------ parts
+    def _prepare(self, context):
+        """runner.prepare(); None (the error reported, nothing held) on bad input."""
+        runner = self.make_runner(context)
+        try:
+            runner.prepare(context)
+        except runner.prepare_errors as e:
+            registry.release(runner)
+            self.report({'ERROR'}, runner.refusal_text(e))
+            return None
+        except BaseException:
+            registry.release(runner)
+            raise
+        return runner
+
+    def _check_objects(self, runner):
+        """Cancels the job when an object it works on is gone (deleted, or renamed away from
+        the name its cache folder and outputs are keyed by)."""
+        if self._gone is not None:
+            return
+        for name in runner.objects:
+            if bpy.data.objects.get(name) is None:
+                self._gone = name
+                runner.cancel()
+                return
+
+    def _main_steps_done(self, context, runner):
+        """Runs the runner's main-thread steps for up to STEP_BUDGET_S; True when none are
+        left (or the job was cancelled, or failed)."""
+        if runner.worker.error is not None or self._error is not None or runner.cancelled:
+            return True
+        if self._steps is None:
+            self._steps = runner.main_steps(context)
+            wm = context.window_manager  # poll faster: the steps are short and many
+            wm.event_timer_remove(self._timer)
+            self._timer = wm.event_timer_add(STEP_POLL_S, window=context.window)
+        end = time.perf_counter() + STEP_BUDGET_S
+        try:
+            while time.perf_counter() < end:
+                next(self._steps)
+                if runner.cancelled:
+                    return True
+        except StopIteration:
+            return True
+        except Exception as e:
+            self._error = e
+            return True
+        return False
+
+    def _show(self, context, runner):
+        """Status bar and progress cursor from the runner's latest progress."""
+        p = runner.progress()
+        runner.status_text = status_text(runner.title, p, p.estimate_left(time.perf_counter()))
+        if p.total > 0:
+            context.window_manager.progress_update(int(100 * p.done / p.total))
+        if context.workspace is not None:
+            context.workspace.status_text_set(runner.status_text)
+
+    def _end_ui(self, context):
+        wm = context.window_manager
+        if getattr(self, "_timer", None) is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+        if context.workspace is not None:
+            context.workspace.status_text_set(None)
+
+    def _conclude(self, context, runner, error, gone):
+        """Reports how the job ended; finish() when it succeeded (or a bake was cancelled),
+        discard() otherwise. Frees the job's keys."""
+        try:
+            if error is not None:
+                runner.discard()
+                self.report({'ERROR'}, runner.error_text(error))
+                return {'CANCELLED'}
+            if gone is not None:
+                runner.discard()
+                self.report({'WARNING'}, f"Plume: {runner.title} cancelled: object '{gone}' "
+                                         "was deleted or renamed; nothing was built")
+                return {'CANCELLED'}
+            if runner.cancelled and not runner.keeps_partial:
+                runner.discard()
+                self.report({'WARNING'}, runner.cancelled_text())
+                return {'CANCELLED'}
+            try:
+                kind, text = runner.finish(context)
+            except Exception as e:
+                if not isinstance(e, BakeError):
+                    traceback.print_exc()
+                runner.discard()
+                self.report({'ERROR'}, runner.error_text(e))
+                return {'CANCELLED'}
+            self.report({kind}, text)
+            return {'FINISHED'}
+        finally:
+            registry.release(runner)

@@ -1,0 +1,73 @@
+"""The jobs running now, by the keys they hold, no ``bpy``.
+
+A key names what one job at a time may work on: ("domain", name) for a domain's bake, surfaces,
+toon smoke, flow graph and synthesis, ("flames",) for the scene's flames bake. A second job on a
+held key is refused with the holder's busy_text(); Free Bake and the panels ask busy().
+abort_all() stops every job for a file load or quit: cancel, wait for the worker, discard."""
+
+from ..settings import BakeError
+
+#: key -> the JobRunner holding it
+_held = {}
+
+#: Seconds abort_all() waits for a cancelled worker (cancel acts within one unit of work).
+ABORT_WAIT_S = 30.0
+
+
+def claim(runner, keys):
+    """Gives `keys` to `runner`; BakeError (nothing held) when another job holds one."""
+    for key in keys:
+        holder = _held.get(key)
+        if holder is not None and holder is not runner:
+            raise BakeError(holder.busy_text())
+    for key in keys:
+        _held[key] = runner
+    runner.keys = tuple(runner.keys) + tuple(k for k in keys if k not in runner.keys)
+
+
+def release(runner):
+    """Frees every key of `runner` (no-op when it holds none)."""
+    for key in list(runner.keys):
+        if _held.get(key) is runner:
+            del _held[key]
+
+
+def holder(key):
+    """The JobRunner holding `key`, or None."""
+    return _held.get(key)
+
+
+def busy(key):
+    return key in _held
+
+
+def running():
+    """Every running JobRunner, once each."""
+    out = []
+    for runner in _held.values():
+        if runner not in out:
+            out.append(runner)
+    return out
+
+
+def abort(runner, wait_s=ABORT_WAIT_S):
+    """Stops a job from outside its operator: cancel, wait for its worker thread, remove its
+    temporaries, free its keys. Its operator then ends without touching the scene."""
+    runner.aborted = True
+    runner.cancel()
+    worker = getattr(runner, "worker", None)
+    if worker is not None:
+        worker.join(wait_s)
+    runner.discard()
+    release(runner)
+
+
+def abort_all(wait_s=ABORT_WAIT_S):
+    """abort() for every running job (file load, quit, add-on disabled); how many."""
+    jobs = running()
+    for runner in jobs:
+        runner.aborted = True
+        runner.cancel()  # all at once, then wait: they stop in parallel
+    for runner in jobs:
+        abort(runner, wait_s)
+    return len(jobs)

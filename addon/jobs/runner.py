@@ -1,0 +1,188 @@
+"""The runner protocol of every long Plume operation (a *job*), no ``bpy``.
+
+A job is split in four parts, so that one operator mixin (operator.py) can run any of them
+blocking (``blender -b``, scripts) or on a worker thread with progress and Esc (the UI):
+
+    runner.prepare(context)   main thread: settings snapshot + validation; BakeError on bad
+                              input, nothing written and nothing changed
+    runner.run()              worker thread: the computation; touches no bpy data; polls
+                              runner.cancelled between units of work; new files go to a Staging
+    runner.main_steps(ctx)    main thread, optional: short bpy steps (saving images into the
+                              staging folder), each yielding progress; Esc cancels between them
+    runner.finish(context)    main thread: commits the staged files, builds the Blender data,
+                              returns the report (kind, text)
+
+and, when the job is cancelled or fails, ``runner.discard()`` removes whatever it wrote, so the
+scene and the cache folder are left as they were. Bakes (keeps_partial) are the exception: their
+per-frame files are complete and resumable, so a cancelled bake keeps them and finish() builds
+what is there.
+
+cancel() is thread-safe and may come from the main thread (Esc, file load, a deleted object) at
+any time; native objects that run long register with watch() and are cancelled with it.
+"""
+
+import threading
+import time
+from dataclasses import dataclass
+from typing import Optional
+
+from ..settings import BakeError
+from . import registry
+from .staging import Staging
+
+
+class JobCancelled(Exception):
+    """Raised by check_cancel() inside run(): the job stops between two units of work."""
+
+
+@dataclass(frozen=True)
+class JobProgress:
+    """What the status bar shows: `done` of `total` units named by `label` ("frame",
+    "surface"); total 0 while unknown. seconds_left None: estimated from the rate since
+    `stage_started` (time.perf_counter() when this label and total were first reported)."""
+
+    done: int = 0
+    total: int = 0
+    label: str = ""
+    seconds_left: Optional[float] = None
+    stage_started: float = 0.0
+
+    def estimate_left(self, now):
+        """Seconds left: the runner's own figure, else the stage's rate so far; None when
+        nothing is known yet."""
+        if self.seconds_left is not None:
+            return self.seconds_left
+        if self.total <= 0 or self.done <= 0:
+            return None
+        return (now - self.stage_started) / self.done * (self.total - self.done)
+
+
+class JobRunner:
+    """Base of every job (see the module docstring for the protocol)."""
+
+    #: Name in reports and the status bar: the operator's label ("Bake", "Build Surfaces").
+    title = "Job"
+    #: Exceptions of prepare() that mean bad input (reported as refusal_text, nothing changed).
+    prepare_errors = (BakeError,)
+    #: True for bakes: a cancelled run keeps its complete frames and finish() still builds them.
+    keeps_partial = False
+
+    def __init__(self):
+        self._cancel = threading.Event()
+        self._lock = threading.Lock()
+        self._watched = []
+        self._progress = JobProgress()
+        #: Called with each JobProgress from the thread that reports it (tests use it).
+        self.on_progress = None
+        #: Registry keys this job holds ("domain", name): one job per key at a time.
+        self.keys = ()
+        #: Names of the objects the job works on: deleting one cancels the job.
+        self.objects = ()
+        #: The job's Staging (files written by run(), moved into place by finish()), if any.
+        self.staging = None
+        #: Set when the job was stopped from outside its operator (file load, quit): the
+        #: operator must neither finish() nor touch the scene.
+        self.aborted = False
+        #: The Worker running run() (worker.py), once started.
+        self.worker = None
+        #: The status bar's last line (operator.py), for scripts and tests.
+        self.status_text = ""
+        #: time.perf_counter() of the first cancel() (None while not cancelled).
+        self.cancelled_at = None
+
+    # ------------------------------------------------------------------ the four parts
+    def prepare(self, context):
+        raise NotImplementedError
+
+    def run(self):
+        raise NotImplementedError
+
+    def main_steps(self, context):
+        """Main-thread steps after run(), each yielding a JobProgress; none by default."""
+        return iter(())
+
+    def finish(self, context):
+        """Commits and builds; returns (report kind, text), e.g. ('INFO', "Plume: ...")."""
+        raise NotImplementedError
+
+    def stage(self, folder):
+        """A Staging in the cache folder `folder` for run()'s new files (made now); its path."""
+        self.staging = Staging(folder)
+        return self.staging.create()
+
+    def discard(self):
+        """Removes the job's temporaries (cancelled or failed); safe to call twice."""
+        if self.staging is not None:
+            self.staging.discard()
+
+    # ------------------------------------------------------------------ messages
+    def refusal_text(self, exc):
+        """The report of bad input found by prepare()."""
+        return str(exc)
+
+    def error_text(self, exc):
+        """The report of an error in run(), main_steps() or finish()."""
+        if isinstance(exc, BakeError):
+            return str(exc)
+        return f"Plume: {self.title} failed: {exc}"
+
+    def cancelled_text(self):
+        return f"Plume: {self.title} cancelled: nothing was changed"
+
+    def busy_text(self):
+        """What a second job on one of this job's keys is told."""
+        return f"Plume: {self.title} is running on the same data (Esc cancels it): wait for it"
+
+    # ------------------------------------------------------------------ cancel
+    def claim(self, *keys):
+        """Holds registry keys for the job's life (BakeError with the holder's busy_text when
+        another job holds one); call it in prepare() as soon as the keys are known."""
+        registry.claim(self, keys)
+
+    def cancel(self):
+        """Thread-safe: run() stops within one unit of work; watched native objects too."""
+        if self.cancelled_at is None:
+            self.cancelled_at = time.perf_counter()
+        self._cancel.set()
+        with self._lock:
+            watched = list(self._watched)
+        for obj in watched:
+            obj.cancel()
+
+    @property
+    def cancelled(self):
+        return self._cancel.is_set()
+
+    def check_cancel(self):
+        """Raises JobCancelled when cancel() was called (for Python loops in run())."""
+        if self._cancel.is_set():
+            raise JobCancelled()
+
+    def watch(self, native_object):
+        """cancel() also cancels `native_object` (anything with a thread-safe cancel())."""
+        with self._lock:
+            self._watched.append(native_object)
+        if self._cancel.is_set():
+            native_object.cancel()
+        return native_object
+
+    def unwatch(self, native_object):
+        with self._lock:
+            if native_object in self._watched:
+                self._watched.remove(native_object)
+
+    # ------------------------------------------------------------------ progress
+    def set_progress(self, done, total, label=None, seconds_left=None):
+        """Called by run() (any thread): `done` of `total` units."""
+        last = self._progress
+        label = last.label if label is None else label
+        same = (label, int(total)) == (last.label, last.total) and last.stage_started
+        p = JobProgress(int(done), int(total), label, seconds_left,
+                        last.stage_started if same else time.perf_counter())
+        self._progress = p  # one reference swap: readers see the old or the new value
+        if self.on_progress is not None:
+            self.on_progress(p)
+
+    def progress(self):
+        """The latest JobProgress (polled by the operator's timer on the main thread)."""
+        return self._progress

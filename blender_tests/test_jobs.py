@@ -1,0 +1,221 @@
+"""The job mechanism headless (addon/jobs/): a cancelled job leaves nothing behind, one job per
+domain at a time, loading a file aborts a running job, and the staging folder commits atomically.
+
+A 24³ streak bake of 20 frames with a camera is built once; Build Surfaces, Build Toon Smoke and
+Export Mesh then run through their operators (blocking, as scripts call them) with a runner
+cancelled from its own progress report after a unit or two of work, in run() and in the
+main-thread steps: the operator returns CANCELLED, and the scene's datablocks and the cache
+folder's files are exactly as before. Flow Graph and Synthesize Fire are cancelled the same way
+in test_flowgraph_fire.py.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_jobs.py
+"""
+
+import os
+import subprocess
+import sys
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+
+from helpers import (add_domain, reset_scene, rmtree, run, run_cancelled,  # noqa: E402
+                     select_only, temp_dir, tree_listing)
+
+RESOLUTION = 24
+FRAMES = 20
+
+
+def streak_scene(cache_dir):
+    """Two source cells of 10 point sources low in a 24³ domain, streaks on, and a camera."""
+    cell = 2.0 / RESOLUTION
+    bpy.ops.mesh.primitive_cube_add(size=cell * 1.8, location=(0.5 * cell, 0.5 * cell,
+                                                                 0.2 + 0.5 * cell))
+    src = bpy.context.active_object
+    src.name = "Incense"
+    bpy.ops.plume.role_set(role='SOURCE')
+    s = src.plume.source
+    s.point_sources, s.velocity, s.density, s.temperature = 10, (0.0, 0.0, 1.0), 1.0, 2.0
+    dom = add_domain(resolution=RESOLUTION, frame_end=FRAMES, cache_directory=cache_dir + "/")
+    dom.plume.domain.streaks = True
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    bpy.context.scene.collection.objects.link(cam)
+    cam.location = (0.0, -3.6, 0.9)
+    bpy.context.scene.camera = cam
+    select_only(dom)
+    return dom
+
+
+class JobsTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = temp_dir("plume_jobs_")
+        reset_scene()
+        cls.dom = streak_scene(cls.tmp)
+        assert bpy.ops.plume.bake() == {'FINISHED'}
+
+    @classmethod
+    def tearDownClass(cls):
+        rmtree(cls.tmp)
+
+    def setUp(self):
+        select_only(self.dom)
+
+    def tearDown(self):
+        from plume.jobs import registry
+        self.assertEqual(registry.running(), [], "a job still holds its keys")
+
+    def state(self):
+        d = bpy.data
+        return dict(objects=sorted(o.name for o in d.objects), meshes=len(d.meshes),
+                    curves=len(d.curves), materials=len(d.materials), images=len(d.images),
+                    collections=len(d.collections), node_groups=len(d.node_groups),
+                    files=tree_listing(self.tmp))
+
+    def assert_cancel_leaves_nothing(self, op_class, make_job, after):
+        before = self.state()
+        job = make_job()
+        self.assertEqual(run_cancelled(op_class, job, after), {'CANCELLED'})
+        self.assertTrue(job.cancelled)
+        self.assertEqual(self.state(), before)
+        return job
+
+    # ------------------------------------------------------------------ cancel
+    def test_0_surfaces_cancelled_in_run(self):
+        from plume.operators.surfaces import PLUME_OT_surfaces_build, SurfacesJob
+        job = self.assert_cancel_leaves_nothing(PLUME_OT_surfaces_build, SurfacesJob, 2)
+        self.assertEqual(job.progress().label, "density map of frame")
+
+    def test_1_surfaces_cancelled_in_main_steps(self):
+        """Cancelled while the density-map images are saved into the staging folder."""
+        from plume.operators.surfaces import PLUME_OT_surfaces_build, SurfacesJob
+
+        def job():
+            j = SurfacesJob()
+            j.main_steps_seen = []
+            steps = j.main_steps
+
+            def counted(context):
+                for s in steps(context):
+                    j.main_steps_seen.append(j.progress().done)
+                    yield s
+            j.main_steps = counted
+            return j
+        job = self.assert_cancel_leaves_nothing(
+            PLUME_OT_surfaces_build, job, lambda p: p.label == "density map image" and p.done >= 3)
+        self.assertEqual(job.progress().label, "density map image")
+        self.assertGreaterEqual(len(job.main_steps_seen), 3)
+
+    def test_2_toon_cancelled(self):
+        from plume.operators.toon import PLUME_OT_toon_build, ToonJob
+        self.assert_cancel_leaves_nothing(PLUME_OT_toon_build, ToonJob, 2)
+
+    def test_3_cancelled_before_run(self):
+        """Cancelled at the first progress report (end of prepare()): nothing is computed."""
+        from plume.operators.toon import PLUME_OT_toon_build, ToonJob
+        job = self.assert_cancel_leaves_nothing(PLUME_OT_toon_build, ToonJob, 0)
+        self.assertEqual(job.progress().done, 0)
+
+    def test_4_export_mesh_cancelled(self):
+        from plume.operators.surface_edits import ExportMeshJob, PLUME_OT_surfaces_export_mesh
+        self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})
+        self.assert_cancel_leaves_nothing(PLUME_OT_surfaces_export_mesh,
+                                          lambda: ExportMeshJob(1), 1)
+        self.assertEqual(bpy.ops.plume.surfaces_export_mesh(level=1), {'FINISHED'})
+
+    def test_5_jobs_complete_after_cancels(self):
+        """The same operators finish normally afterwards, and a rebuild replaces the files."""
+        for _ in range(2):
+            self.assertEqual(bpy.ops.plume.toon_build(), {'FINISHED'})
+        files = os.listdir(os.path.join(self.tmp, "Domain"))
+        self.assertEqual(len([n for n in files if n.startswith("toon_")]), FRAMES)
+        self.assertFalse([n for n in files if n.startswith(".plume_job_")], files)
+
+    # ------------------------------------------------------------------ one job per domain
+    def test_6_busy_domain_refuses_a_second_job(self):
+        from plume.jobs import JobRunner, registry
+
+        class Holder(JobRunner):
+            title = "Build Surfaces"
+        holder = Holder()
+        registry.claim(holder, [("domain", "Domain")])
+        try:
+            before = self.state()
+            for op in (bpy.ops.plume.toon_build, bpy.ops.plume.bake, bpy.ops.plume.cache_free):
+                with self.assertRaises(RuntimeError) as cm:
+                    op()
+                self.assertRegex(str(cm.exception), "Build Surfaces|busy")
+            self.assertEqual(self.state(), before)
+        finally:
+            registry.release(holder)
+
+    # ------------------------------------------------------------------ file load
+    def test_7_loading_a_file_aborts_a_running_job(self):
+        """A job on its worker thread when another file is loaded: the persistent load_pre
+        handler cancels it, waits for the worker and removes its staging folder."""
+        from plume.jobs import Worker, registry
+        from plume.operators.toon import ToonJob
+        before = tree_listing(self.tmp)
+        job = ToonJob()
+        started = []
+        job.on_progress = lambda p: started.append(p.done) or time.sleep(0.05)
+        job.prepare(bpy.context)
+        Worker(job).start()
+        t0 = time.perf_counter()
+        while len(started) < 3 and time.perf_counter() - t0 < 30:
+            time.sleep(0.01)
+        path = os.path.join(self.tmp, "other.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+        bpy.ops.wm.open_mainfile(filepath=path)
+        try:
+            self.assertTrue(job.aborted and job.cancelled and job.worker.finished)
+            self.assertIsNone(job.staging.path)
+            self.assertEqual(registry.running(), [])
+            os.remove(path)
+            self.assertEqual(tree_listing(self.tmp), before)
+        finally:
+            type(self).dom = bpy.data.objects["Domain"]
+
+    # ------------------------------------------------------------------ staging
+    def test_8_staging_commit_discard_sweep(self):
+        from plume.jobs import Staging
+        folder = os.path.join(self.tmp, "staging_test")
+        old = os.path.join(folder, "a_old.bin")
+        os.makedirs(folder)
+        for name, text in (("a_old.bin", "old"), ("b.bin", "old b")):
+            with open(os.path.join(folder, name), "w") as f:
+                f.write(text)
+        s = Staging(folder)
+        staged = s.create()
+        for rel in ("b.bin", os.path.join("sub", "c.bin"), "d.bin.tmp"):
+            os.makedirs(os.path.dirname(os.path.join(staged, rel)), exist_ok=True)
+            with open(os.path.join(staged, rel), "w") as f:
+                f.write("new")
+        self.assertEqual(s.final_path(os.path.join(staged, "b.bin")),
+                         os.path.join(folder, "b.bin"))
+        s.commit(replaced=[old, os.path.join(folder, "b.bin")])
+        self.assertEqual(tree_listing(folder), ["b.bin", "sub", os.path.join("sub", "c.bin")])
+        with open(os.path.join(folder, "b.bin")) as f:
+            self.assertEqual(f.read(), "new")
+        # Discard: the folder is as it was; a made cache folder goes too.
+        s = Staging(os.path.join(folder, "new_cache"))
+        with open(os.path.join(s.create(), "x.bin"), "w") as f:
+            f.write("x")
+        s.discard()
+        self.assertFalse(os.path.exists(os.path.join(folder, "new_cache")))
+        # A killed Blender's staging folder is removed by the next job in the folder.
+        dead = subprocess.Popen([sys.executable, "-c", "pass"])
+        dead.wait()
+        os.makedirs(os.path.join(folder, f".plume_job_{dead.pid}_deadbeef", "x"))
+        s = Staging(folder)
+        s.create()
+        s.discard()
+        self.assertEqual(tree_listing(folder), ["b.bin", "sub", os.path.join("sub", "c.bin")])
+        rmtree(folder)
+
+
+if __name__ == "__main__":
+    run(JobsTest)
