@@ -91,6 +91,27 @@ def add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35), name="Source"):
     return ob
 
 
+def incense_streak_scene(cache_dir, resolution, frames):
+    """Two source cells of 10 point sources low in a 2 m domain of `resolution` cells, streaks
+    on, and a camera: a small streak scene (about 190 streaklines at 24³ over 60 frames)."""
+    cell = 2.0 / resolution
+    bpy.ops.mesh.primitive_cube_add(size=cell * 1.8, location=(0.5 * cell, 0.5 * cell,
+                                                                 0.2 + 0.5 * cell))
+    src = bpy.context.active_object
+    src.name = "Incense"
+    bpy.ops.plume.role_set(role='SOURCE')
+    s = src.plume.source
+    s.point_sources, s.velocity, s.density, s.temperature = 10, (0.0, 0.0, 1.0), 1.0, 2.0
+    dom = add_domain(resolution=resolution, frame_end=frames, cache_directory=cache_dir + "/")
+    dom.plume.domain.streaks = True
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    bpy.context.scene.collection.objects.link(cam)
+    cam.location = (0.0, -3.6, 0.9)
+    bpy.context.scene.camera = cam
+    select_only(dom)
+    return dom
+
+
 def add_cube_obstacle(size=0.3, location=(0.45, 0.0, 1.1), name="Obstacle"):
     bpy.ops.mesh.primitive_cube_add(size=size, location=location)
     ob = bpy.context.active_object

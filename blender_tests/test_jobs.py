@@ -22,31 +22,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
 
-from helpers import (add_domain, reset_scene, rmtree, run, run_cancelled,  # noqa: E402
+from helpers import (incense_streak_scene, reset_scene, rmtree, run, run_cancelled,  # noqa: E402
                      select_only, temp_dir, tree_listing)
 
 RESOLUTION = 24
 FRAMES = 20
-
-
-def streak_scene(cache_dir):
-    """Two source cells of 10 point sources low in a 24³ domain, streaks on, and a camera."""
-    cell = 2.0 / RESOLUTION
-    bpy.ops.mesh.primitive_cube_add(size=cell * 1.8, location=(0.5 * cell, 0.5 * cell,
-                                                                 0.2 + 0.5 * cell))
-    src = bpy.context.active_object
-    src.name = "Incense"
-    bpy.ops.plume.role_set(role='SOURCE')
-    s = src.plume.source
-    s.point_sources, s.velocity, s.density, s.temperature = 10, (0.0, 0.0, 1.0), 1.0, 2.0
-    dom = add_domain(resolution=RESOLUTION, frame_end=FRAMES, cache_directory=cache_dir + "/")
-    dom.plume.domain.streaks = True
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    bpy.context.scene.collection.objects.link(cam)
-    cam.location = (0.0, -3.6, 0.9)
-    bpy.context.scene.camera = cam
-    select_only(dom)
-    return dom
 
 
 class JobsTest(unittest.TestCase):
@@ -54,7 +34,7 @@ class JobsTest(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = temp_dir("plume_jobs_")
         reset_scene()
-        cls.dom = streak_scene(cls.tmp)
+        cls.dom = incense_streak_scene(cls.tmp, RESOLUTION, FRAMES)
         assert bpy.ops.plume.bake() == {'FINISHED'}
 
     @classmethod

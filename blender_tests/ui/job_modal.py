@@ -31,8 +31,8 @@ import traceback
 import bpy
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from helpers import (add_domain, add_sphere_source, enable_addon, select_only,  # noqa: E402
-                     tree_listing)
+from helpers import (add_domain, add_sphere_source, enable_addon, incense_streak_scene,  # noqa: E402
+                     select_only, tree_listing)
 
 ARGS = sys.argv[sys.argv.index("--") + 1:]
 RESULT, CASES = ARGS[0], [tuple(c.split(":")) for c in ARGS[1:]]
@@ -77,23 +77,9 @@ def bake_scene(cache):
 
 
 def streak_scene(cache):
-    """A small streak scene (24³, 60 frames, ~190 streaklines) with a camera, baked blocking;
-    the cache is complete after the first case, so later cases' bakes return at once."""
-    cell = 2.0 / 24
-    bpy.ops.mesh.primitive_cube_add(size=cell * 1.8, location=(0.5 * cell, 0.5 * cell,
-                                                                 0.2 + 0.5 * cell))
-    src = bpy.context.active_object
-    src.name = "Incense"
-    bpy.ops.plume.role_set(role='SOURCE')
-    s = src.plume.source
-    s.point_sources, s.velocity, s.density, s.temperature = 10, (0.0, 0.0, 1.0), 1.0, 2.0
-    dom = add_domain(resolution=24, frame_end=60, cache_directory=cache + "/")
-    dom.plume.domain.streaks = True
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    bpy.context.scene.collection.objects.link(cam)
-    cam.location = (0.0, -3.6, 0.9)
-    bpy.context.scene.camera = cam
-    select_only(dom)
+    """The shared small streak scene (24³, 60 frames, ~190 streaklines), baked blocking; the
+    cache is complete after the first case, so later cases' bakes return at once."""
+    dom = incense_streak_scene(cache, 24, 60)
     assert bpy.ops.plume.bake() == {'FINISHED'}
     return dom
 
