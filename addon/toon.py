@@ -46,6 +46,7 @@ class ToonSettings:
     # Particles (§2.1, §2.3) -> _native.ToonParams
     emission_count: int = 10
     birth_density: float = 0.5      # ρ_birth
+    birth_spacing: float = 0.5      # σ (stencil sizes)
     death_density: float = 0.05     # ρ_death
     ramp_density_low: float = 0.0   # d0
     ramp_density_high: float = 1.0  # d1
@@ -69,10 +70,10 @@ class ToonSettings:
 
 
 #: ToonSettings fields copied one to one into _native.ToonParams (enums converted by name).
-PARAM_FIELDS = ('emission_count', 'birth_density', 'death_density', 'ramp_density_low',
-                'ramp_density_high', 'size_low', 'size_high', 'max_size_change', 'max_count',
-                'integration', 'cfl', 'seed', 'stretch_factor', 'color_driver', 'color_low',
-                'color_high', 'threads')
+PARAM_FIELDS = ('emission_count', 'birth_density', 'birth_spacing', 'death_density',
+                'ramp_density_low', 'ramp_density_high', 'size_low', 'size_high',
+                'max_size_change', 'max_count', 'integration', 'cfl', 'seed', 'stretch_factor',
+                'color_driver', 'color_low', 'color_high', 'threads')
 
 
 def _finite(name, value, where):

@@ -41,7 +41,13 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
     birth_density: FloatProperty(
         name="Birth Density (ρ_birth)", default=0.5, soft_min=0.0, soft_max=10.0,
         description="ρ_birth: an empty cell denser than this gets a new particle of size 0 "
-                    "(§2.3); must be > ρ_death")
+                    "(§2.3), at least Birth Spacing from the others; must be > ρ_death")
+    birth_spacing: FloatProperty(
+        name="Birth Spacing (σ)", default=0.5, soft_min=0.0, soft_max=2.0,
+        description="σ: a new particle is born only where no particle lies closer than σ times "
+                    "the stencil size its density gives, so new particles stay apart like puffs "
+                    "instead of merging into one blob; 0 = one in every empty dense cell (the "
+                    "paper's rule); in [0, 10]")
     death_density: FloatProperty(
         name="Death Density (ρ_death)", default=0.05, soft_min=0.0, soft_max=10.0,
         description="ρ_death: a particle in thinner smoke shrinks to 0, then is removed (§2.3: "

@@ -251,8 +251,8 @@ class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
         ob = context.object
         t = ob.plume.domain.toon
         col = layout.column(heading="Particles")
-        for name in ("emission_count", "birth_density", "death_density", "max_count",
-                     "integration", "cfl", "seed"):
+        for name in ("emission_count", "birth_density", "birth_spacing", "death_density",
+                     "max_count", "integration", "cfl", "seed"):
             col.prop(t, name)
         col = layout.column(heading="Size Ramp", align=True)
         for name in ("ramp_density_low", "ramp_density_high", "size_low", "size_high",

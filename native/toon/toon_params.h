@@ -24,6 +24,7 @@ constexpr int kMaxToonEmission = 1000000;
 constexpr float kMinToonCfl = 0.05f;
 constexpr float kMaxToonCfl = 10.f;
 constexpr int kMaxToonSubsteps = 4096;
+constexpr float kMaxToonBirthSpacing = 10.f;
 
 /// Every setting of the toon particles. Densities are in the field's units, sizes in metres
 /// (stencil diameter in world space), speeds in m/s.
@@ -33,6 +34,10 @@ struct ToonParams {
   int emissionCount = 10;
   /// ρ_birth: a cell denser than this that holds no particle gets a new one (§2.2 last paragraph).
   float birthDensity = 0.5f;
+  /// σ: a newborn is kept only when no particle lies closer than σ s(ρ) to it, s(ρ) the size
+  /// ramp at its cell's density (birth_spacing.h), so newborns stay apart like puffs instead of
+  /// filling every dense cell; 0 = the paper's rule (every empty dense cell), in stencil sizes.
+  float birthSpacing = 0.5f;
   /// ρ_death: a particle in thinner smoke shrinks to size 0, then is removed (§2.3).
   float deathDensity = 0.05f;
   /// Size ramp (§2.3 "the higher the density the larger the particle"): density d0..d1 maps
