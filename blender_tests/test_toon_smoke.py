@@ -125,9 +125,10 @@ class ToonSmokeTest(unittest.TestCase):
         dom = self.scene()
         from plume import cache, toon
         from plume.snapshot import emitter_snapshots
+        from plume.toon_sources import ToonSourceCells
         m = cache.read_manifest(self.folder)
-        cells = toon.source_cells(native(), toon.toon_grid(m),
-                                  emitter_snapshots(bpy.context, dom, 1, 1))
+        cells = ToonSourceCells(native(), toon.toon_grid(m),
+                                emitter_snapshots(bpy.context, dom, 1, 1), 1).cells_at(1)
         self.assertIsNotNone(cells)
         self.assertGreater(len(cells), 4)
         h = float(m["cell_size"])
