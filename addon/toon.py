@@ -50,9 +50,9 @@ class ToonSettings:
     death_density: float = 0.05     # ρ_death
     ramp_density_low: float = 0.0   # d0
     ramp_density_high: float = 1.0  # d1
-    size_low: float = 0.02          # s0 (m)
-    size_high: float = 0.1          # s1 (m)
-    max_size_change: float = 0.1
+    size_low: float = 0.1           # s0 (m)
+    size_high: float = 0.25         # s1 (m)
+    max_size_change: float = 0.25
     max_count: int = 200000
     integration: str = 'EULER'
     cfl: float = 1.0
@@ -63,7 +63,7 @@ class ToonSettings:
     color_high: float = 1.0
     threads: int = 0
     # Rendering (§2.2), used by the Blender side only
-    depth_threshold: float = 0.1    # γ
+    depth_threshold: float = 0.15   # γ (m of depth per pixel)
     stencil: str = 'PUFFY'
     stencil_image: str = ""         # absolute path when stencil == 'IMAGE'
     ignore_background: bool = False

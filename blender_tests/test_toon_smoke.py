@@ -301,6 +301,10 @@ class ToonSmokeTest(unittest.TestCase):
         d.toon.birth_density = 0.01
         assert_reports_error(self, op, "death_density", lambda: state(self.folder))
         d.toon.birth_density = 0.3
+        d.toon.birth_spacing = -0.5
+        assert_reports_error(self, op, r"birth_spacing must be in \[0, 10\] stencil sizes",
+                             lambda: state(self.folder))
+        d.toon.birth_spacing = 0.5
         cam = bpy.context.scene.camera
         bpy.context.scene.camera = None
         assert_reports_error(self, op, "has no camera", lambda: state(self.folder))
