@@ -355,6 +355,9 @@ void ToonParticles::emit(const ToonSources& sources) {
 void ToonParticles::birth(const ToonFields& b, std::size_t emitted) {
   const glm::ivec3 n = mGrid.resolution;
   const std::size_t slab = std::size_t(n.x) * std::size_t(n.y);
+  const std::size_t room =
+      std::size_t(mParams.maxCount) - std::min(mState.count(), std::size_t(mParams.maxCount));
+  if (room == 0) return;  // the budget is spent: nothing to look for
   // The survivors marked their cells in sampleGroup(); the particles just emitted mark theirs.
   for (std::size_t m = emitted; m < mState.count(); ++m)
     if (insideBox(mState.positions[m])) mOccupied[cellIndex(mState.positions[m])] = 1;
@@ -398,7 +401,6 @@ void ToonParticles::birth(const ToonFields& b, std::size_t emitted) {
     });
   }
   for (int k = 0; k < n.z; ++k) mSlabOffset[std::size_t(k) + 1] += mSlabOffset[std::size_t(k)];
-  const std::size_t room = std::size_t(mParams.maxCount) - std::min(mState.count(), std::size_t(mParams.maxCount));
   const std::size_t births = std::min(mSlabOffset.back(), room);
   if (births == 0) return;
   const std::size_t first = mState.count();
