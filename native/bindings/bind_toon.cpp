@@ -1,5 +1,5 @@
 /// \file bind_toon.cpp
-/// Toon smoke (cartoon_smoke.txt, issue 5): ToonParams, the fields of a frame, ToonParticles
+/// Toon smoke (cartoon_smoke.txt): ToonParams, the fields of a frame, ToonParticles
 /// driven by NumPy fields or by Plume volume frames, stencil billboards (Figure 4), the
 /// depth-differences reference filter (§2.2) and the toon cache files. Conversions and docstrings
 /// only; frames, file reads and writes, billboards and the filter release the GIL.
