@@ -46,12 +46,13 @@ class ToonSettings:
     # Particles (§2.1, §2.3) -> _native.ToonParams
     emission_count: int = 10
     birth_density: float = 0.5      # ρ_birth
+    birth_spacing: float = 0.5      # σ (stencil sizes)
     death_density: float = 0.05     # ρ_death
     ramp_density_low: float = 0.0   # d0
     ramp_density_high: float = 1.0  # d1
-    size_low: float = 0.02          # s0 (m)
-    size_high: float = 0.1          # s1 (m)
-    max_size_change: float = 0.1
+    size_low: float = 0.1           # s0 (m)
+    size_high: float = 0.25         # s1 (m)
+    max_size_change: float = 0.25
     max_count: int = 200000
     integration: str = 'EULER'
     cfl: float = 1.0
@@ -62,17 +63,17 @@ class ToonSettings:
     color_high: float = 1.0
     threads: int = 0
     # Rendering (§2.2), used by the Blender side only
-    depth_threshold: float = 0.1    # γ
+    depth_threshold: float = 0.15   # γ (m of depth per pixel)
     stencil: str = 'PUFFY'
     stencil_image: str = ""         # absolute path when stencil == 'IMAGE'
     ignore_background: bool = False
 
 
 #: ToonSettings fields copied one to one into _native.ToonParams (enums converted by name).
-PARAM_FIELDS = ('emission_count', 'birth_density', 'death_density', 'ramp_density_low',
-                'ramp_density_high', 'size_low', 'size_high', 'max_size_change', 'max_count',
-                'integration', 'cfl', 'seed', 'stretch_factor', 'color_driver', 'color_low',
-                'color_high', 'threads')
+PARAM_FIELDS = ('emission_count', 'birth_density', 'birth_spacing', 'death_density',
+                'ramp_density_low', 'ramp_density_high', 'size_low', 'size_high',
+                'max_size_change', 'max_count', 'integration', 'cfl', 'seed', 'stretch_factor',
+                'color_driver', 'color_low', 'color_high', 'threads')
 
 
 def _finite(name, value, where):
@@ -189,31 +190,6 @@ def check_bake(settings: ToonSettings, manifest, domain_name=""):
                         "density and velocity only: set the toon color_driver to DENSITY or SPEED")
 
 
-def source_cells(native, grid, emitters):
-    """(N, 3) int32 cells (i, j, k) of the Source emitters (snapshots) voxelized on the toon
-    grid at the bake's first frame, where §2.1 introduces the marker particles; None when there
-    are none. BakeError naming a source whose mesh cannot be voxelized."""
-    params = native.SmokeParams()
-    params.resolution = grid.resolution
-    params.cell_size = grid.cell_size
-    params.origin = grid.origin
-    nx, ny, _nz = params.resolution
-    cells = []
-    for e in emitters:
-        if e.role != "SOURCE":
-            continue
-        try:
-            linear, _motion = native.source_cells(e.vertices, e.triangles, e.matrix_at(0),
-                                                  e.matrix_at(1), params, e.name)
-        except ValueError as err:
-            raise BakeError(f"Plume: source '{e.name}': {err}") from None
-        linear = np.asarray(linear, dtype=np.int64)
-        cells.append(np.stack([linear % nx, (linear // nx) % ny, linear // (nx * ny)], axis=1))
-    if not cells or sum(len(c) for c in cells) == 0:
-        return None
-    return np.ascontiguousarray(np.concatenate(cells), dtype=np.int32)
-
-
 def frame_dt(manifest):
     """Seconds per frame of the bake (time scale / fps, as the solver used)."""
     dt = manifest.get("settings", {}).get("solver", {}).get("frame_dt")
@@ -232,15 +208,16 @@ class ToonResult:
 
 
 class ToonRunner:
-    """Walks the bake frame by frame: frame_start advances from its own fields (birth only),
-    each next frame from the previous volume to its own (§2.1 advection, §2.3 evolution), and
+    """Walks the bake frame by frame: frame_start advances from its own fields, each next frame
+    from the previous volume to its own (§2.1 advection, §2.3 evolution), introducing particles
+    at the cells `sources` gives for the frame (the Sources where and when they emit), and
     writes toon_<frame>.bin after each, into out_folder (default: the bake's folder; the toon job
     gives its staging folder). progress(frames_done, frames_total) and cancel() are optional
     callables; a cancelled run keeps the frames written so far."""
 
     def __init__(self, native, folder, manifest, settings: ToonSettings, domain_name="",
                  progress: Optional[Callable[[int, int], None]] = None,
-                 cancel: Optional[Callable[[], bool]] = None, source_cells=None,
+                 cancel: Optional[Callable[[], bool]] = None, sources=None,
                  out_folder=None):
         self.native = native
         self.folder = folder
@@ -249,8 +226,9 @@ class ToonRunner:
         self.params = to_params(native, settings, domain_name)
         self.progress = progress
         self.cancel = cancel
-        #: (N, 3) int cells of the domain's Sources: emission_count particles per frame (§2.1)
-        self.source_cells = source_cells
+        #: toon_sources.ToonSourceCells (or None): the Sources' cells of each frame, where
+        #: emission_count particles per frame are introduced (§2.1)
+        self.sources = sources
         self.frame_start = int(manifest["frame_start"])
         self.last_frame = int(manifest["last_complete_frame"])
         self.dt = frame_dt(manifest)
@@ -274,8 +252,8 @@ class ToonRunner:
             before = cache.volume_path(folder, max(frame - 1, self.frame_start))
             after = cache.volume_path(folder, frame)
             try:
-                particles.advance_frame_from_vdb(before, after, self.dt,
-                                                 source_cells=self.source_cells)
+                cells = self.sources.cells_at(frame) if self.sources else None
+                particles.advance_frame_from_vdb(before, after, self.dt, source_cells=cells)
                 particles.write(toon_path(out, frame))
             except (RuntimeError, ValueError) as e:
                 raise BakeError(f"Plume: toon frame {frame}: {e} (bake the domain again)") from None

@@ -41,7 +41,13 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
     birth_density: FloatProperty(
         name="Birth Density (ρ_birth)", default=0.5, soft_min=0.0, soft_max=10.0,
         description="ρ_birth: an empty cell denser than this gets a new particle of size 0 "
-                    "(§2.3); must be > ρ_death")
+                    "(§2.3), at least Birth Spacing from the others; must be > ρ_death")
+    birth_spacing: FloatProperty(
+        name="Birth Spacing (σ)", default=0.5, soft_min=0.0, soft_max=2.0,
+        description="σ: a new particle is born only where no particle lies closer than σ times "
+                    "the stencil size its density gives, so new particles stay apart like puffs "
+                    "instead of merging into one blob; 0 = one in every empty dense cell (the "
+                    "paper's rule); in [0, 10]")
     death_density: FloatProperty(
         name="Death Density (ρ_death)", default=0.05, soft_min=0.0, soft_max=10.0,
         description="ρ_death: a particle in thinner smoke shrinks to 0, then is removed (§2.3: "
@@ -53,13 +59,15 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
         name="Ramp Density d1", default=1.0, soft_min=0.0, soft_max=10.0,
         description="d1 of the size ramp: density at and above which the size is s1 (> d0)")
     size_low: FloatProperty(
-        name="Size s0", default=0.02, soft_min=0.0, soft_max=1.0, unit='LENGTH',
-        description="s0: stencil diameter at density <= d0 (§2.3 size ramp), >= 0")
+        name="Size s0", default=0.1, soft_min=0.0, soft_max=1.0, unit='LENGTH',
+        description="s0: stencil diameter at density <= d0 (§2.3 size ramp), >= 0. Give the "
+                    "stencils a few cells: smaller ones read as specks with outlines")
     size_high: FloatProperty(
-        name="Size s1", default=0.1, soft_min=0.0, soft_max=1.0, unit='LENGTH',
-        description="s1: stencil diameter at density >= d1 (the denser, the larger), >= 0")
+        name="Size s1", default=0.25, soft_min=0.0, soft_max=1.0, unit='LENGTH',
+        description="s1: stencil diameter at density >= d1 (the denser, the larger), >= 0; "
+                    "the default 0.25 m is 5 cells of a 2 m domain at resolution 40")
     max_size_change: FloatProperty(
-        name="Max Size Change", default=0.1, soft_min=0.0001, soft_max=1.0,
+        name="Max Size Change", default=0.25, soft_min=0.0001, soft_max=1.0,
         description="Largest size change per frame, as a fraction of max(s0, s1), in [1e-4, 1] "
                     "(temporal coherence, §2.3)")
     max_count: IntProperty(
@@ -100,9 +108,11 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
         name="Stencil Image", subtype='FILE_PATH', default="",
         description="Image file of the IMAGE stencil; its alpha channel is the cut-out")
     depth_threshold: FloatProperty(
-        name="Depth Threshold (γ)", default=0.1, soft_min=0.0, soft_max=10.0, precision=4,
+        name="Depth Threshold (γ)", default=0.15, soft_min=0.0, soft_max=10.0, precision=4,
         description="γ: a pixel is outlined when any of its four one-sided depth differences "
-                    "divided by the pixel size exceeds γ (§2.2); >= 0",
+                    "divided by the pixel size (1) exceeds γ (§2.2), i.e. where one stencil lies "
+                    "more than γ metres in front of its neighbour; about half the largest "
+                    "stencil (s1) outlines the puffs, a much smaller γ speckles the inside; >= 0",
         update=_look_changed)
     outline_color: _color("Outline Colour", (0.0, 0.0, 0.0, 1.0),
                           "Silhouette colour of the outline pixels (§2.2: e.g. black)")

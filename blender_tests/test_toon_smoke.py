@@ -1,4 +1,4 @@
-"""Toon smoke end to end (cartoon_smoke.txt §2, issue 5): a small bake (24³, 20 frames), then
+"""Toon smoke end to end (cartoon_smoke.txt §2): a small bake (24³, 20 frames), then
 plume.toon_build makes a point object that follows toon_####.bin on frame changes, billboards
 with a stencil cut-out, and the "Plume Depth Differences" compositor group. A 320x240 Cycles
 render saves the Depth pass and the group's outline as 32-bit EXR: the outline equals
@@ -125,9 +125,10 @@ class ToonSmokeTest(unittest.TestCase):
         dom = self.scene()
         from plume import cache, toon
         from plume.snapshot import emitter_snapshots
+        from plume.toon_sources import ToonSourceCells
         m = cache.read_manifest(self.folder)
-        cells = toon.source_cells(native(), toon.toon_grid(m),
-                                  emitter_snapshots(bpy.context, dom, 1, 1))
+        cells = ToonSourceCells(native(), toon.toon_grid(m),
+                                emitter_snapshots(bpy.context, dom, 1, 1), 1).cells_at(1)
         self.assertIsNotNone(cells)
         self.assertGreater(len(cells), 4)
         h = float(m["cell_size"])
@@ -300,6 +301,10 @@ class ToonSmokeTest(unittest.TestCase):
         d.toon.birth_density = 0.01
         assert_reports_error(self, op, "death_density", lambda: state(self.folder))
         d.toon.birth_density = 0.3
+        d.toon.birth_spacing = -0.5
+        assert_reports_error(self, op, r"birth_spacing must be in \[0, 10\] stencil sizes",
+                             lambda: state(self.folder))
+        d.toon.birth_spacing = 0.5
         cam = bpy.context.scene.camera
         bpy.context.scene.camera = None
         assert_reports_error(self, op, "has no camera", lambda: state(self.folder))

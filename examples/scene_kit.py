@@ -205,94 +205,7 @@ def run_op(op, tag, what):
     return time.perf_counter() - t0
 
 
-# --- Toon smoke (cartoon_smoke.txt) ---------------------------------------------------------
-
-
-def toon_look(scene, background, width, height, samples, filepath):
-    """Cycles set up for flat toon colours: the Standard view transform (Filmic would grey the
-    flat colours), a plain world of colour `background` and no lights (the toon material is
-    emission only)."""
-    cycles(scene, width, height, samples, filepath)
-    scene.view_settings.view_transform = 'Standard'
-    scene.view_settings.look = 'None'
-    plain_world(scene, background)
-
-
-def bake_toon(dom, tag):
-    """Bake, then Build Toon Smoke (plume.toon_build, the artist's button) on domain `dom`; the
-    domain box and its Volume object are hidden from renders so only the billboards show, and
-    the .blend is saved. Returns (bake seconds, build seconds); exits on failure."""
-    bpy.context.view_layer.objects.active = dom
-    bake_s = run_op(bpy.ops.plume.bake, tag, "the bake")
-    build_s = build_toon(dom, tag)
-    for ob in (dom, bpy.data.objects.get(dom.plume.domain.volume_object)):
-        if ob is not None:
-            ob.hide_render = True
-    bpy.ops.wm.save_mainfile()
-    return bake_s, build_s
-
-
-def build_toon(dom, tag):
-    """Build Toon Smoke on `dom` again (e.g. after changing its toon settings), checks that the
-    compositor's result is the "Plume Depth Differences" group's image (so the rendered and saved
-    frames carry the outlines); returns the seconds."""
-    bpy.context.view_layer.objects.active = dom
-    seconds = run_op(bpy.ops.plume.toon_build, tag, "Build Toon Smoke")
-    scene = bpy.context.scene
-    tree = compat().compositor_tree(scene)
-    result = compat().compositor_output(tree) if tree is not None else None
-    link = result.links[0] if result is not None and result.is_linked else None
-    if not (scene.render.use_compositing and link is not None
-            and link.from_node.type == 'GROUP'
-            and link.from_node.node_tree.name == "Plume Depth Differences"):
-        sys.exit(f"{tag}: the compositor's result is not the outline group's image")
-    return seconds
-
-
-def source_puffs(t, emission_count, sizes, densities, death_density, depth_threshold):
-    """The toon settings `t` (obj.plume.domain.toon) the examples share: particles only from the
-    Sources, `emission_count` per frame (§2.1; ρ_birth = 2 is above any density of a bake whose
-    Sources set 1, so none is born elsewhere), puffy stencil of diameter sizes[0]..sizes[1] over
-    the density ramp densities[0]..[1], ρ_death, γ. The puffs stay a few cells apart: that gives
-    the paper's big puffy shapes (a particle born in every dense cell merges into one smooth
-    blob). Sizes change by at most a quarter of the largest per frame; a slight stretch."""
-    t.emission_count = emission_count
-    t.birth_density, t.death_density = 2.0, death_density
-    t.ramp_density_low, t.ramp_density_high = densities
-    t.size_low, t.size_high = sizes
-    t.max_size_change = 0.25
-    t.stretch_factor = 0.1
-    t.stencil = 'PUFFY'
-    t.depth_threshold = depth_threshold
-
-
-def sphere_source(name, radius, location, density=1.0, temperature=0.0,
-                  velocity=(0.0, 0.0, 0.0)):
-    """A UV sphere made a Plume Source (hidden from renders) with these settings."""
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=radius, location=location)
-    src = bpy.context.active_object
-    src.name = name
-    bpy.ops.plume.role_set(role='SOURCE')
-    s = src.plume.source
-    s.density, s.temperature, s.velocity = density, temperature, velocity
-    src.hide_render = True
-    return src
-
-
-def burst(src, frames_on):
-    """Keyframes the source's density, temperature and velocity (constant interpolation): as set
-    on frames 1..frames_on, 0 from frames_on + 1 on - a short burst of smoke."""
-    s = src.plume.source
-    on, off = (s.density, s.temperature, tuple(s.velocity)), (0.0, 0.0, (0.0, 0.0, 0.0))
-    for frame, (density, temperature, velocity) in ((1, on), (frames_on + 1, off)):
-        s.density, s.temperature, s.velocity = density, temperature, velocity
-        for name in ("density", "temperature", "velocity"):
-            src.keyframe_insert("plume.source." + name, frame=frame)
-    s.density, s.temperature, s.velocity = on
-    for fc in compat().fcurves(src):
-        for k in fc.keyframe_points:
-            k.interpolation = 'CONSTANT'
-    return src
+# --- Shared by the toon and flame examples ------------------------------------------------
 
 
 def flat_box(name, location, size, color, add_primitive=None):
@@ -321,33 +234,6 @@ def flat_box(name, location, size, color, add_primitive=None):
 def shown_frames(fractions, frames):
     """The frames at `fractions` of a shot of `frames` frames (1 .. frames, sorted, once each)."""
     return sorted({max(1, min(frames, round(f * frames))) for f in fractions})
-
-
-def toon_summary(tag, grid, frames, bake_s, build_s, dom, render_s, strip_path):
-    """Prints a toon example's times (bake, Build Toon Smoke, render per frame) and its strip."""
-    scene = bpy.context.scene
-    particles = len(bpy.data.objects[dom.plume.domain.toon.object_name].data.vertices)
-    print(f"{tag}: {frames} frames at {grid}, bake {bake_s:.1f} s ({bake_s / frames:.2f} "
-          f"s/frame), Build Toon Smoke {build_s:.1f} s, {particles} particles on frame "
-          f"{scene.frame_current}, render {render_s:.1f} s/frame ({scene.render.resolution_x}x"
-          f"{scene.render.resolution_y}, {scene.cycles.samples} samples) -> {strip_path}",
-          flush=True)
-
-
-def toon_example(tag, usage, default_frames, setup, show, grid):
-    """A toon example from the command line: OUT_DIR [FRAMES]; setup(scene, frames, out_dir)
-    builds the scene (sources, domain, camera, look) and returns the domain; then the .blend is
-    saved to OUT_DIR/TAG.blend, baked, Build Toon Smoke runs, the frames at fractions `show` of
-    the shot are rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are
-    printed (`grid` names the grid in the summary)."""
-    out_dir, frames = parse_args(usage, default_frames)
-    scene = new_scene()
-    dom = setup(scene, frames, out_dir)
-    scene.frame_start, scene.frame_end = 1, frames
-    save_blend(out_dir, tag)
-    bake_s, build_s = bake_toon(dom, tag)
-    render_s, strip_path = render_strip(scene, shown_frames(show, frames), out_dir, tag)
-    toon_summary(tag, grid, frames, bake_s, build_s, dom, render_s, strip_path)
 
 
 # --- Flow-graph fire (graph_fire_synthesis.txt) ---------------------------------------------

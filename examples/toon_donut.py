@@ -6,8 +6,9 @@ Two spherical Sources face each other across a 1.2 m domain (64³, open on every
 buoyancy) and blow smoke at each other at 3 m/s for the first 5 frames only (their density and
 velocity are keyframed to 0 after that). Each puff rolls up into a vortex ring; where they meet,
 the rings stop each other and spread out sideways into one ring: a donut. Build Toon Smoke
-(puffy stencil, depth-difference outlines) follows the topology change; the camera looks at the
-ring's plane at an angle, so the hole shows.
+(puffy stencil, depth-difference outlines; particles from the Sources, and born where the smoke
+is denser than 0.3, 0.8 stencil sizes apart, so the ring stays whole as it spreads) follows the
+topology change; the camera looks at the ring's plane at an angle, so the hole shows.
 
 Writes OUT_DIR/toon_donut.blend (cache in OUT_DIR/plume_cache), toon_donut_####.png for a few
 frames and toon_donut_strip.png (the README's image); prints the bake, build and render times.
@@ -19,6 +20,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import scene_kit  # noqa: E402
+import toon_kit  # noqa: E402
 
 TAG = "toon_donut"
 USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
@@ -33,16 +35,16 @@ CENTRE = (0.0, 0.0, 0.6)
 
 def make_scene(frames):
     for name, x in (("PuffLeft", -0.42), ("PuffRight", 0.42)):
-        src = scene_kit.sphere_source(name, 0.1, (x, CENTRE[1], CENTRE[2]), density=1.0,
+        src = toon_kit.sphere_source(name, 0.1, (x, CENTRE[1], CENTRE[2]), density=1.0,
                                       velocity=(-SPEED if x > 0 else SPEED, 0.0, 0.0))
-        scene_kit.burst(src, BURST_FRAMES)
+        toon_kit.burst(src, BURST_FRAMES)
     dom = scene_kit.domain_cube("Donut", 1.2, CENTRE, RESOLUTION, frames)
     d = dom.plume.domain
     d.alpha = d.beta = 0.0           # no buoyancy: the puffs move only as they were pushed
     d.boundary_neg_z = 'OPEN'        # no floor
     d.vorticity = 0.3
     t = d.toon
-    scene_kit.source_puffs(t, 60, sizes=(0.08, 0.2), densities=(0.03, 0.4), death_density=0.03,
+    toon_kit.puffs(t, 60, sizes=(0.08, 0.2), densities=(0.03, 0.4), death_density=0.03,
                            depth_threshold=0.1)
     t.color_driver = 'DENSITY'
     t.color_low, t.color_high = 0.03, 0.4
@@ -53,12 +55,12 @@ def make_scene(frames):
 def setup(scene, frames, out_dir):
     dom = make_scene(frames)
     scene_kit.camera(scene, (1.8, -1.6, 1.35), lens=50.0, target=CENTRE)
-    scene_kit.toon_look(scene, BACKGROUND, 320, 320, 16, os.path.join(out_dir, TAG + "_"))
+    toon_kit.toon_look(scene, BACKGROUND, 320, 320, 16, os.path.join(out_dir, TAG + "_"))
     return dom
 
 
 def main():
-    scene_kit.toon_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, f"{RESOLUTION}^3")
+    toon_kit.toon_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, f"{RESOLUTION}^3")
 
 
 if __name__ == "__main__":

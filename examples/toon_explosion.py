@@ -11,7 +11,9 @@ with no fuel, so only T changes: the hot burst cools by c ((T - T_amb) / (T_max 
 second, and conduction κ spreads its heat into the clear air), so the cloud slows down, sinks
 and falls to the floor. Build Toon Smoke colours each particle by its speed (Colour Driver:
 Speed): dark while it flies, light once it slows down (the paper: "the darkness is proportional
-to the magnitude of the particle velocity"). The floor is drawn as a flat box.
+to the magnitude of the particle velocity"); particles come from the Source and are born
+where the smoke is denser than 0.3, 0.8 stencil sizes apart, which keeps the slumped cloud
+whole. The floor is drawn as a flat box.
 
 Writes OUT_DIR/toon_explosion.blend (cache in OUT_DIR/plume_cache), toon_explosion_####.png for
 a few frames and toon_explosion_strip.png (the README's image); prints the bake, build and
@@ -23,6 +25,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import scene_kit  # noqa: E402
+import toon_kit  # noqa: E402
 
 TAG = "toon_explosion"
 USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
@@ -36,9 +39,9 @@ SLOW, FAST = (0.95, 0.93, 0.88), (0.08, 0.07, 0.07)  # ramp colours: light when 
 
 
 def make_scene(frames):
-    src = scene_kit.sphere_source("Blast", 0.15, (-0.95, 0.0, 0.95), density=1.0,
+    src = toon_kit.sphere_source("Blast", 0.15, (-0.95, 0.0, 0.95), density=1.0,
                                   temperature=1.0, velocity=(6.0, 0.0, 0.3))
-    scene_kit.burst(src, BURST_FRAMES)
+    toon_kit.burst(src, BURST_FRAMES)
     dom = scene_kit.domain_cube("Explosion", 1.0, (0.0, 0.0, 0.8), RESOLUTION, frames)
     dom.scale = (2.4, 1.2, 1.6)
     d = dom.plume.domain
@@ -49,7 +52,7 @@ def make_scene(frames):
     d.conductivity = 0.04            # κ (m²/s): ... then loses its heat to the air around it
     d.vorticity = 0.3
     t = d.toon
-    scene_kit.source_puffs(t, 80, sizes=(0.08, 0.2), densities=(0.03, 0.4), death_density=0.05,
+    toon_kit.puffs(t, 80, sizes=(0.08, 0.2), densities=(0.03, 0.4), death_density=0.05,
                            depth_threshold=0.1)
     t.color_driver = 'SPEED'
     t.color_low, t.color_high = 0.1, 1.5  # m/s
@@ -61,12 +64,12 @@ def setup(scene, frames, out_dir):
     dom = make_scene(frames)
     scene_kit.flat_box("Floor", (0.0, 0.0, -0.05), (4.0, 1.2, 0.1), FLOOR)  # the domain's floor
     scene_kit.camera(scene, (0.0, -4.2, 0.8), (90.0, 0.0, 0.0), lens=50.0)
-    scene_kit.toon_look(scene, BACKGROUND, 384, 256, 16, os.path.join(out_dir, TAG + "_"))
+    toon_kit.toon_look(scene, BACKGROUND, 384, 256, 16, os.path.join(out_dir, TAG + "_"))
     return dom
 
 
 def main():
-    scene_kit.toon_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, "64x32x43")
+    toon_kit.toon_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, "64x32x43")
 
 
 if __name__ == "__main__":

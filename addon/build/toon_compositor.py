@@ -28,7 +28,7 @@ OUTSIDE_DEPTH = 5.0e10
 #: Group inputs: (name, socket type, default).
 INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
           ("Depth", 'NodeSocketFloat', 0.0),
-          ("Gamma", 'NodeSocketFloat', 0.1),
+          ("Gamma", 'NodeSocketFloat', 0.15),
           ("Outline Color", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
           ("Ignore Background", 'NodeSocketFloat', 0.0),
           ("Far", 'NodeSocketFloat', 1.0e9),

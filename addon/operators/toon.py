@@ -14,6 +14,7 @@ from ..build import toon_compositor, toon_nodes, toon_points
 from ..jobs import JobOperator, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of, emitter_snapshots
+from ..toon_sources import ToonSourceCells
 from ..toon_stencils import write_stencil
 from .bake import domain_key
 
@@ -53,12 +54,15 @@ class ToonJob(JobRunner):
                             "scene.camera")
         self.objects = (domain.name, scene.camera.name)  # the billboards face the camera
         self.claim(domain_key(domain.name))
-        frame_start = int(manifest["frame_start"])
-        emitters = emitter_snapshots(context, domain, frame_start, frame_start)
+        # The Sources over the bake's frames: their matrices per frame when they move, their
+        # keyed Density / Emit Particles per frame (§2.1 emission follows both).
+        frame_start, last = int(manifest["frame_start"]), int(manifest["last_complete_frame"])
+        emitters = emitter_snapshots(context, domain, frame_start, last)
+        sources = ToonSourceCells(_native, toon.toon_grid(manifest), emitters, frame_start)
+        sources.check()
         self.toon = toon.ToonRunner(_native, folder, manifest, settings, domain.name,
                                     progress=self._frame_done, cancel=lambda: self.cancelled,
-                                    source_cells=toon.source_cells(
-                                        _native, toon.toon_grid(manifest), emitters))
+                                    sources=sources)
         self.folder, self.settings = folder, settings
         self.set_progress(0, self.toon.last_frame - self.toon.frame_start + 1, "frame")
 

@@ -251,13 +251,18 @@ class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
         ob = context.object
         t = ob.plume.domain.toon
         col = layout.column(heading="Particles")
-        for name in ("emission_count", "birth_density", "death_density", "max_count",
-                     "integration", "cfl", "seed"):
+        for name in ("emission_count", "birth_density", "birth_spacing", "death_density",
+                     "max_count", "integration", "cfl", "seed"):
             col.prop(t, name)
         col = layout.column(heading="Size Ramp", align=True)
         for name in ("ramp_density_low", "ramp_density_high", "size_low", "size_high",
                      "max_size_change"):
             col.prop(t, name)
+        # Stencils under a cell read as specks with outlines (§2.2): show s0, s1 in cells.
+        cell = max(ob.dimensions) / max(1, ob.plume.domain.resolution)
+        if cell > 0.0:
+            col.label(text=f"Stencils {t.size_low / cell:.1f} to {t.size_high / cell:.1f} cells",
+                      icon='INFO')
         layout.prop(t, "stretch_factor")
         col = layout.column(heading="Colour", align=True)
         for name in ("color_driver", "color_low", "color_high", "ramp_color_low",

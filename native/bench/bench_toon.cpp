@@ -1,6 +1,6 @@
-// Benchmark of the toon pipeline (issue 5, cartoon_smoke.txt): the particle update of one frame
-// for 10^5 particles (issue: <= 5 ms) and the depth-differences filter at 1920x1080 (issue:
-// <= 1 ms).
+// Benchmark of the toon pipeline (cartoon_smoke.txt): the particle update of one frame for 10^5
+// particles (budget: <= 5 ms), with and without the birth spacing, and the depth-differences
+// filter at 1920x1080 (budget: <= 1 ms).
 // Run: build/native/plume_bench_toon
 #include "tests/toon_plume.h"
 #include "toon/depth_differences.h"
@@ -23,6 +23,7 @@ ToonParticles plumeParticles(const GridFrame& g, ToonIntegration integration, in
   ToonParams p;
   p.threads = threads;
   p.birthDensity = 0.5f;
+  p.birthSpacing = 0.f;  // the paper's birth rule (BM_ToonParticleUpdateBirthSpacing: σ > 0)
   p.deathDensity = 0.05f;
   p.maxCount = kParticles;
   p.integration = integration;
@@ -54,6 +55,28 @@ void particleUpdate(benchmark::State& state, ToonIntegration integration) {
   for (auto _ : state) substeps = t.advanceFrame(a, b, 1.f / 24.f, sources);
   state.counters["particles"] = double(t.count());
   state.counters["substeps"] = substeps;
+}
+
+/// The same frame with room for births (budget 2·10^5), at birth spacing σ = range(0) / 10:
+/// every frame starts from the same 10^5 particles, so each iteration does the same births.
+void BM_ToonParticleUpdateBirthSpacing(benchmark::State& state) {
+  const GridFrame g = testing::plumeGrid(48, 0.05f);
+  const ToonFields a = testing::plumeFields(g, 1.f), b = testing::plumeFields(g, 1.f, 0.35f);
+  const ToonSources sources = testing::plumeSources(g);
+  ToonParticles full = plumeParticles(g, ToonIntegration::Euler, int(state.range(1)));
+  ToonParams p = full.params();
+  p.maxCount = 2 * kParticles;
+  p.birthSpacing = 0.1f * float(state.range(0));
+  ToonParticles t(p, g);
+  std::size_t born = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    t.setState(full.state());
+    state.ResumeTiming();
+    t.advanceFrame(a, b, 1.f / 24.f, sources);
+    born = t.count() - full.count();
+  }
+  state.counters["born"] = double(born);
 }
 
 void BM_ToonParticleUpdateEuler(benchmark::State& state) { particleUpdate(state, ToonIntegration::Euler); }
@@ -98,5 +121,6 @@ void BM_DepthDifferences1080p(benchmark::State& state) {
 
 BENCHMARK(plume::BM_ToonParticleUpdateEuler)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(plume::BM_ToonParticleUpdateMidpoint)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_ToonParticleUpdateBirthSpacing)->ArgsProduct({{0, 5}, {1, 0}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(plume::BM_DepthDifferences1080p)->ArgsProduct({{0, 1}, {1, 0}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_MAIN();

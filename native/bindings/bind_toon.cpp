@@ -1,5 +1,5 @@
 /// \file bind_toon.cpp
-/// Toon smoke (cartoon_smoke.txt, issue 5): ToonParams, the fields of a frame, ToonParticles
+/// Toon smoke (cartoon_smoke.txt): ToonParams, the fields of a frame, ToonParticles
 /// driven by NumPy fields or by Plume volume frames, stencil billboards (Figure 4), the
 /// depth-differences reference filter (§2.2) and the toon cache files. Conversions and docstrings
 /// only; frames, file reads and writes, billboards and the filter release the GIL.
@@ -156,6 +156,9 @@ void bindParams(py::module_& m) {
                   "Particles emitted per frame at the source, over its cells/points in turn.");
   c.def_readwrite("birth_density", &ToonParams::birthDensity,
                   "rho_birth: an empty cell denser than this gets a particle (> death_density).");
+  c.def_readwrite("birth_spacing", &ToonParams::birthSpacing,
+                  "sigma: a newborn is kept only when no particle lies closer than sigma times the "
+                  "stencil size of its cell's density, in [0, 10]; 0 = every empty dense cell.");
   c.def_readwrite("death_density", &ToonParams::deathDensity,
                   "rho_death: a particle in thinner smoke shrinks to 0, then is removed.");
   c.def_readwrite("ramp_density_low", &ToonParams::rampDensityLow, "d0 of the size ramp.");
@@ -216,7 +219,8 @@ void bindParticles(py::module_& m) {
       "advected through the frame (Euler or midpoint substeps, at most cfl cells each), sampled "
       "from the frame-end fields, sized by the density ramp at most max_size_change per frame "
       "(a particle below death_density shrinks to 0 before it goes: no popping), emitted at the "
-      "source and born (size 0) in every empty cell denser than birth_density, up to max_count. "
+      "source and born (size 0) in empty cells denser than birth_density, at least birth_spacing "
+      "stencil sizes from any particle, up to max_count. "
       "Same settings and seed give the same particles at any thread count; ids never repeat.");
   c.def(py::init([](const ToonParams& p, const std::array<int, 3>& res,
                     const std::array<float, 3>& origin, float cell, bool resample) {

@@ -47,11 +47,13 @@ inline ToonFields plumeFields(const GridFrame& g, float scale = 1.f, float swirl
   return f;
 }
 
-/// Toon settings for the plume: birth above density 0.5, death below 0.1, sizes 1 to 5 cm over
+/// Toon settings for the plume: birth above density 0.5 in every empty cell (the paper's rule,
+/// birth spacing 0; toon_birth_test covers the spacing), death below 0.1, sizes 1 to 5 cm over
 /// densities 0.1 to 1, at most 10% of the largest size per frame, 8 particles emitted per frame.
 inline ToonParams plumeParams() {
   ToonParams p;
   p.birthDensity = 0.5f;
+  p.birthSpacing = 0.f;
   p.deathDensity = 0.1f;
   p.rampDensityLow = 0.1f;
   p.rampDensityHigh = 1.f;

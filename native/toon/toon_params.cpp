@@ -40,6 +40,8 @@ void ToonParams::validate() const {
     throw std::invalid_argument("birth_density must be > death_density (" + number(deathDensity) +
                                 ") so that a newborn particle is not dying (got " +
                                 number(birthDensity) + ")");
+  requireRange("birth_spacing", birthSpacing, 0.0, kMaxToonBirthSpacing,
+               " stencil sizes (0 = a particle in every empty dense cell)");
   requireFinite("ramp_density_low", rampDensityLow, "finite");
   requireFinite("ramp_density_high", rampDensityHigh, "finite");
   if (!(rampDensityHigh > rampDensityLow))

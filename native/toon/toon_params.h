@@ -24,6 +24,7 @@ constexpr int kMaxToonEmission = 1000000;
 constexpr float kMinToonCfl = 0.05f;
 constexpr float kMaxToonCfl = 10.f;
 constexpr int kMaxToonSubsteps = 4096;
+constexpr float kMaxToonBirthSpacing = 10.f;
 
 /// Every setting of the toon particles. Densities are in the field's units, sizes in metres
 /// (stencil diameter in world space), speeds in m/s.
@@ -33,17 +34,24 @@ struct ToonParams {
   int emissionCount = 10;
   /// ρ_birth: a cell denser than this that holds no particle gets a new one (§2.2 last paragraph).
   float birthDensity = 0.5f;
+  /// σ: a newborn is kept only when no particle lies closer than σ s(ρ) to it, s(ρ) the size
+  /// ramp at its cell's density (birth_spacing.h), so newborns stay apart like puffs instead of
+  /// filling every dense cell; 0 = the paper's rule (every empty dense cell), in stencil sizes.
+  float birthSpacing = 0.5f;
   /// ρ_death: a particle in thinner smoke shrinks to size 0, then is removed (§2.3).
   float deathDensity = 0.05f;
   /// Size ramp (§2.3 "the higher the density the larger the particle"): density d0..d1 maps
-  /// linearly onto size s0..s1, clamped outside.
+  /// linearly onto size s0..s1, clamped outside. The defaults are 2 to 5 cells of a 2 m domain
+  /// at 40 cells: stencils smaller than a cell are a cloud of specks whose front is rough in
+  /// depth, which the depth differences (§2.2) outline as speckles all over the smoke.
   float rampDensityLow = 0.f;
   float rampDensityHigh = 1.f;
-  float sizeLow = 0.02f;
-  float sizeHigh = 0.1f;
+  float sizeLow = 0.1f;
+  float sizeHigh = 0.25f;
   /// Largest size change per frame as a fraction of the ramp's largest size max(s0, s1): a full
-  /// size particle needs at least 1 / fraction frames to vanish, so it never pops (§2.3).
-  float maxSizeChange = 0.1f;
+  /// size particle needs at least 1 / fraction frames to vanish, so it never pops (§2.3). The
+  /// default grows a newborn in 4 frames: growing ones are small specks in front of the smoke.
+  float maxSizeChange = 0.25f;
   /// Particle budget: birth and emission stop (in their deterministic order) when it is reached.
   int maxCount = 200000;
   ToonIntegration integration = ToonIntegration::Euler;

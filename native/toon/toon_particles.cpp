@@ -7,6 +7,7 @@
 #include "core/rng.h"
 #include "toon/field_sampler.h"
 #include "toon/ramp_lanes.h"
+#include "toon/toon_random.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,28 +21,12 @@
 namespace plume {
 namespace {
 
+using toon::Stream;
+using toon::streamRng;
+using toon::uniform3;
+
 /// Particles per parallel task: enough work to pay for the task, small enough to balance.
 constexpr int kChunk = 512;
-
-/// Random streams of the two stages that create particles.
-enum class Stream : std::uint64_t { Emission = 1, Birth = 2, EmissionOffset = 3 };
-
-/// The generator of one emission or birth: a seed per (frame, stage), a stream per index, so a
-/// particle's position does not depend on which thread creates it or on the other particles.
-Rng streamRng(std::uint64_t seed, std::int64_t frame, Stream stage, std::uint64_t index) {
-  const std::uint64_t key = std::uint64_t(frame) * 0x9E3779B97F4A7C15ull +
-                            std::uint64_t(stage) * 0xC2B2AE3D27D4EB4Full;
-  return Rng(seed ^ key, index);
-}
-
-/// A random point of the unit cube, kept 1e-3 away from its faces so that rounding never moves a
-/// particle born in a cell into its neighbour (birth counts the particles per cell).
-glm::vec3 uniform3(Rng& r) {
-  constexpr double kMargin = 1e-3;
-  auto u = [&] { return float(kMargin + (1.0 - 2.0 * kMargin) * r.uniform()); };
-  const float x = u(), y = u(), z = u();
-  return {x, y, z};
-}
 
 bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -370,11 +355,16 @@ void ToonParticles::emit(const ToonSources& sources) {
 void ToonParticles::birth(const ToonFields& b, std::size_t emitted) {
   const glm::ivec3 n = mGrid.resolution;
   const std::size_t slab = std::size_t(n.x) * std::size_t(n.y);
+  const std::size_t room =
+      std::size_t(mParams.maxCount) - std::min(mState.count(), std::size_t(mParams.maxCount));
+  if (room == 0) return;  // the budget is spent: nothing to look for
   // The survivors marked their cells in sampleGroup(); the particles just emitted mark theirs.
   for (std::size_t m = emitted; m < mState.count(); ++m)
     if (insideBox(mState.positions[m])) mOccupied[cellIndex(mState.positions[m])] = 1;
   // Pass 1: mWanted[m] = 1 for an empty cell denser than ρ_birth; the count per slab gives each
-  // slab's first rank. Pass 2 fills the wanted cells in cell order from that rank.
+  // slab's first rank. With a birth spacing, spaceBirths() keeps those far enough from every
+  // particle and the slabs are counted again. Pass 2 fills the wanted cells in cell order from
+  // that rank.
   const float threshold = mParams.birthDensity;
   const float* density = b.density.data();
   mWanted.resize(mOccupied.size());
@@ -402,8 +392,15 @@ void ToonParticles::birth(const ToonFields& b, std::size_t emitted) {
     }
     mSlabOffset[std::size_t(k) + 1] = c;
   });
+  if (mParams.birthSpacing > 0.f && std::any_of(mSlabOffset.begin(), mSlabOffset.end(),
+                                                [](std::size_t c) { return c > 0; })) {
+    spaceBirths(mParams, mGrid, density, mState.positions, mState.frame, mWanted, mSpacing);
+    parallelFor(0, n.z, [&](int k) {
+      const std::uint8_t* w = mWanted.data() + std::size_t(k) * slab;
+      mSlabOffset[std::size_t(k) + 1] = std::size_t(std::count(w, w + slab, std::uint8_t(1)));
+    });
+  }
   for (int k = 0; k < n.z; ++k) mSlabOffset[std::size_t(k) + 1] += mSlabOffset[std::size_t(k)];
-  const std::size_t room = std::size_t(mParams.maxCount) - std::min(mState.count(), std::size_t(mParams.maxCount));
   const std::size_t births = std::min(mSlabOffset.back(), room);
   if (births == 0) return;
   const std::size_t first = mState.count();
@@ -425,10 +422,9 @@ void ToonParticles::birth(const ToonFields& b, std::size_t emitted) {
       }
       if (!mWanted[base + r]) continue;
       const int i = int(r % std::size_t(n.x)), j = int(r / std::size_t(n.x));
-      Rng rng = streamRng(mParams.seed, mState.frame, Stream::Birth, base + r);
       const std::size_t p = first + rank;
       mState.ids[p] = firstId + rank;
-      mState.positions[p] = mGrid.origin + (glm::vec3(i, j, k) + uniform3(rng)) * mGrid.cellSize;
+      mState.positions[p] = toon::birthPosition(mParams.seed, mState.frame, mGrid, {i, j, k}, base + r);
       mState.velocities[p] = glm::vec3(0.f);
       mState.density[p] = mState.temperature[p] = mState.size[p] = 0.f;
       mState.targetSize[p] = mState.color[p] = 0.f;

@@ -16,7 +16,8 @@
 ///   4. emit     - emissionCount particles at the sources, in turn over cells then points;
 ///   5. birth    - every cell whose density in B exceeds ρ_birth and that holds no particle gets
 ///                 one at a random position in it (§2.2: "new particles should be added in areas of
-///                 sufficient density").
+///                 sufficient density"), unless a particle lies closer than birthSpacing times the
+///                 stencil size of the cell's density (birth_spacing.h; spacing 0: every such cell).
 /// New particles start at size 0 and grow by the same bounded step. Emission then birth stop
 /// when maxCount particles exist, in their fixed order (entries in turn; cells in index order).
 /// Every random position comes from Rng(seed, stream of (frame, stage, cell or emission index)),
@@ -25,6 +26,7 @@
 /// bit-identical at any thread count. Ids are given in creation order and never reused, so
 /// Blender can follow a particle from frame to frame.
 
+#include "toon/birth_spacing.h"
 #include "toon/field_sampler.h"
 #include "toon/toon_fields.h"
 #include "toon/toon_params.h"
@@ -138,6 +140,7 @@ class ToonParticles {
   ToonParticleState mState;
   std::vector<std::uint8_t> mOccupied, mWanted;  ///< per cell, scratch of a frame's birth()
   std::vector<std::size_t> mSlabOffset;          ///< per z slab, scratch of birth()
+  BirthSpacingScratch mSpacing;                  ///< scratch of birth()'s spacing
   std::vector<std::uint32_t> mOrder, mRowStart, mRow;  ///< scratch of sortByRow()
 };
 

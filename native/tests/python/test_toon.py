@@ -1,4 +1,4 @@
-"""Toon smoke from Python (issue 5, cartoon_smoke.txt): ToonParams, particles driven by NumPy
+"""Toon smoke from Python (cartoon_smoke.txt): ToonParams, particles driven by NumPy
 fields and by Plume volume frames, coherence (bounded size changes, shrink before death), birth,
 the particle budget, determinism, billboards (Figure 4), the depth-differences filter (§2.2) and
 toon files."""
@@ -35,6 +35,7 @@ def plume_fields(scale=1.0, swirl=0.3):
 def params(**overrides):
     p = _native.ToonParams()
     p.birth_density, p.death_density = 0.5, 0.1
+    p.birth_spacing = 0.0  # the paper's rule: a particle in every empty dense cell
     p.ramp_density_low, p.ramp_density_high = 0.1, 1.0
     p.size_low, p.size_high = 0.01, 0.05
     p.max_size_change = 0.1
@@ -60,7 +61,7 @@ def test_params_are_snake_case_and_bad_values_name_the_setting():
     assert p.ramp_size(0.55) == pytest.approx(0.03)
     for name, value in [("birth_density", 0.1), ("max_size_change", 0.0), ("max_count", 0),
                         ("cfl", 20.0), ("stretch_factor", -1.0), ("size_low", -0.5),
-                        ("emission_count", -3)]:
+                        ("emission_count", -3), ("birth_spacing", -0.5), ("birth_spacing", 11.0)]:
         with pytest.raises(ValueError, match=name):
             params(**{name: value}).validate()
         with pytest.raises(ValueError, match=name):
@@ -98,6 +99,27 @@ def test_birth_fills_every_dense_empty_cell_within_one_frame():
         t.advance_frame(f, f, DT, SOURCE)
         cells = {tuple(c) for c in np.floor(t.snapshot()["positions"] / CELL).astype(int)}
         assert all(tuple(c) in cells for c in dense), frame
+
+
+def test_birth_spacing_keeps_newborns_apart_at_any_thread_count():
+    """σ > 0: no two particles of a still, uniformly dense box closer than σ s(ρ) (their sizes
+    are all s1 there), far fewer than one per cell, the same at one and two threads."""
+    res = (16, 16, 16)
+    still = _native.ToonFields(np.ones(res, np.float32),
+                               tuple(np.zeros(tuple(n + (a == b) for b, n in enumerate(res)),
+                                              np.float32) for a in range(3)))
+    snaps = []
+    for threads in (1, 2):
+        t = _native.ToonParticles(params(birth_spacing=0.8, size_high=0.2, threads=threads), res,
+                                  ORIGIN, CELL)
+        for _ in range(4):
+            t.advance_frame(still, still, DT)
+        snaps.append(t.snapshot())
+    x = snaps[0]["positions"].astype(np.float64)
+    gaps = np.linalg.norm(x[:, None] - x[None], axis=2) + np.eye(len(x)) * 1e9
+    assert gaps.min() >= 0.8 * 0.2 * (1 - 1e-5)
+    assert 20 < len(x) < 16 ** 3 // 4  # measured 690 of 4096 cells (radius 1.6 cells)
+    assert snaps[0]["positions"].tobytes() == snaps[1]["positions"].tobytes()
 
 
 def test_count_stays_within_max_count_over_300_frames():
