@@ -58,7 +58,8 @@ py::tuple pairsToNumpy(const StreakDistances& d) {
 
 void checkMember(const StreakDistances& d, int a) {
   if (a < 0 || a >= d.size())
-    throw py::index_error("member " + std::to_string(a) + " is not in h (size " + std::to_string(d.size()) + ")");
+    throw py::index_error("member " + std::to_string(a) + " is not in h (size " +
+                          std::to_string(d.size()) + ")");
 }
 
 void bindDistances(py::module_& m) {
@@ -73,7 +74,10 @@ void bindDistances(py::module_& m) {
            py::arg("snapshots"), "ValueError on inconsistent sizes (naming the snapshot).")
       .def("__len__", [](const PyStreakFrames& f) { return f.frames->size(); })
       .def_property_readonly(
-          "source_count", [](const PyStreakFrames& f) { return f.frames->empty() ? 0 : f.frames->back().sourceCount(); },
+          "source_count",
+          [](const PyStreakFrames& f) {
+            return f.frames->empty() ? 0 : f.frames->back().sourceCount();
+          },
           "Point sources of the last snapshot.");
 
   py::class_<StreakDistances> c(
@@ -148,7 +152,8 @@ void bindDistances(py::module_& m) {
         py::gil_scoped_release release;
         return StreakDistances(StreakGroup(std::move(shared), std::move(ids)), params);
       },
-      py::arg("frames"), py::arg("source_ids"), py::arg("reach") = -1.0, py::arg("projection_rank") = 16,
+      py::arg("frames"), py::arg("source_ids"), py::arg("reach") = -1.0,
+      py::arg("projection_rank") = ProjectionParams{}.rank,
       "smoke_surfaces §3.3: the StreakDistances of the sources source_ids (member a is "
       "source_ids[a]) over frames (a StreakFrames, or a sequence of snapshot dicts), frames with "
       "N(t) = 0 skipped. reach < 0 (default): the group's default h0, the mean of h. Pairs are "

@@ -61,8 +61,9 @@ DistanceMatrix bruteForceDistances(const StreakGroup& g) {
 double bruteForceMean(const DistanceMatrix& h) {
   h.validate();
   if (h.size < 2)
-    throw std::invalid_argument("a candidate group needs at least 2 point sources for a default h0 (got " +
-                                std::to_string(h.size) + ")");
+    throw std::invalid_argument(
+        "a candidate group needs at least 2 point sources for a default h0 (got " +
+        std::to_string(h.size) + ")");
   double sum = 0.0;
   for (int a = 0; a < h.size; ++a)
     for (int b = a + 1; b < h.size; ++b) sum += h(a, b);
@@ -97,7 +98,8 @@ std::vector<int> bruteForceOrder(const DistanceMatrix& h, const std::vector<int>
     if (m < 0 || m >= h.size)
       throw std::invalid_argument("member " + std::to_string(m) + " is not in h (size " +
                                   std::to_string(h.size) + ")");
-    if (seen[std::size_t(m)]) throw std::invalid_argument("member " + std::to_string(m) + " repeats");
+    if (seen[std::size_t(m)])
+      throw std::invalid_argument("member " + std::to_string(m) + " repeats");
     seen[std::size_t(m)] = 1;
   }
   const std::size_t n = members.size();

@@ -16,7 +16,7 @@ namespace {
 
 using CellKey = std::array<std::int64_t, 3>;
 
-/// Pairs found from one member, and the work it took.
+/// Pairs found from one tile of members, and the work it took.
 struct MemberPairs {
   std::vector<DistancePair> pairs;
   CandidateStats stats;
@@ -29,24 +29,16 @@ void decide(const StreakGroup& g, int a, int b, double reach, MemberPairs& out) 
   if (h < reach) out.pairs.push_back({std::min(a, b), std::max(a, b), h});
 }
 
-/// Every pair, exactly (reach = +inf).
-std::vector<MemberPairs> allPairs(const StreakGroup& g) {
-  const int n = g.size();
-  std::vector<MemberPairs> found(static_cast<std::size_t>(n));
-  parallelFor(0, n, [&](int a) {
-    MemberPairs& out = found[std::size_t(a)];
-    for (int b = a + 1; b < n; ++b) {
-      ++out.stats.examined;
-      decide(g, a, b, std::numeric_limits<double>::infinity(), out);
-    }
-  });
-  return found;
-}
+/// Members of one grid cell read together: each streakline of a neighbouring cell is then
+/// loaded once per tile instead of once per member (the exact h of many pairs is bound by memory
+/// otherwise: every pair streams two streaklines of 3 Σ_t N(t) floats).
+constexpr int kTile = 16;
 
-/// Pairs through the grid over projected coordinates 0..2 (fewer if the rank is lower).
+/// Pairs through the grid over projected coordinates 0..2 (fewer if the rank is lower; one cell
+/// holding everyone when reach is +inf).
 std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection& q, double reach) {
   const int n = g.size();
-  const int dims = std::min(q.rank(), 3);
+  const int dims = std::isinf(reach) ? 0 : std::min(q.rank(), 3);
   const double limit = reach + q.slack(reach);
   const double cell = std::sqrt(limit) * (1.0 + 1e-6);  // rounding of the cell index
   std::array<double, 3> lo{0.0, 0.0, 0.0};
@@ -58,12 +50,14 @@ std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection&
   for (int a = 0; a < n; ++a)
     for (int j = 0; j < dims; ++j) {
       // The coordinate range is <= 2 max|y| and the cell >= √margin ∝ max|y|: no overflow.
-      key[std::size_t(a)][std::size_t(j)] = std::int64_t(std::floor((q.coords(a)[j] - lo[std::size_t(j)]) / cell));
+      const double x = (q.coords(a)[j] - lo[std::size_t(j)]) / cell;
+      key[std::size_t(a)][std::size_t(j)] = std::int64_t(std::floor(x));
     }
   std::vector<int> order(static_cast<std::size_t>(n));
   for (int a = 0; a < n; ++a) order[std::size_t(a)] = a;
   std::sort(order.begin(), order.end(), [&](int x, int y) {
-    return key[std::size_t(x)] != key[std::size_t(y)] ? key[std::size_t(x)] < key[std::size_t(y)] : x < y;
+    const CellKey &kx = key[std::size_t(x)], &ky = key[std::size_t(y)];
+    return kx != ky ? kx < ky : x < y;
   });
   // Cells as runs of `order`: cellStart[c] .. cellStart[c + 1].
   std::vector<CellKey> cellKey;
@@ -78,30 +72,39 @@ std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection&
   }
   cellStart.push_back(n);
 
-  std::vector<MemberPairs> found(static_cast<std::size_t>(n));
-  parallelFor(0, n, [&](int p) {
-    const int a = order[std::size_t(p)];
-    const int c = cellOf[std::size_t(p)];
-    MemberPairs& out = found[std::size_t(p)];
-    auto visit = [&](int from, int to) {
-      for (int r = from; r < to; ++r) {
-        const int b = order[std::size_t(r)];
-        ++out.stats.examined;
-        if (q.lowerBound(a, b, limit) >= limit) continue;  // proves h >= reach
-        decide(g, a, b, reach, out);
-      }
+  struct Tile {
+    int begin, end, cell;
+  };
+  std::vector<Tile> tiles;
+  for (std::size_t c = 0; c + 1 < cellStart.size(); ++c)
+    for (int p = cellStart[c]; p < cellStart[c + 1]; p += kTile)
+      tiles.push_back({p, std::min(p + kTile, cellStart[c + 1]), int(c)});
+
+  std::vector<MemberPairs> found(tiles.size());
+  parallelFor(0, int(tiles.size()), [&](int t) {
+    const Tile& tile = tiles[std::size_t(t)];
+    MemberPairs& out = found[std::size_t(t)];
+    auto visit = [&](int p, int r) {
+      const int a = order[std::size_t(p)], b = order[std::size_t(r)];
+      ++out.stats.examined;
+      if (q.lowerBound(a, b, limit) >= limit) return;  // proves h >= reach
+      decide(g, a, b, reach, out);
     };
-    visit(p + 1, cellStart[std::size_t(c) + 1]);  // own cell: later members only
+    // Own cell: the pairs (p, r) with p in the tile and p < r.
+    const int cellEnd = cellStart[std::size_t(tile.cell) + 1];
+    for (int r = tile.begin + 1; r < cellEnd; ++r)
+      for (int p = tile.begin; p < std::min(tile.end, r); ++p) visit(p, r);
+    const CellKey& own = cellKey[std::size_t(tile.cell)];
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
-          const CellKey k{cellKey[std::size_t(c)][0] + dx, cellKey[std::size_t(c)][1] + dy,
-                          cellKey[std::size_t(c)][2] + dz};
-          if (!(cellKey[std::size_t(c)] < k)) continue;  // each pair of cells once, from the lower
+          const CellKey k{own[0] + dx, own[1] + dy, own[2] + dz};
+          if (!(own < k)) continue;  // each pair of cells once, from the lower
           const auto it = std::lower_bound(cellKey.begin(), cellKey.end(), k);
           if (it == cellKey.end() || *it != k) continue;
           const std::size_t other = std::size_t(it - cellKey.begin());
-          visit(cellStart[other], cellStart[other + 1]);
+          for (int r = cellStart[other]; r < cellStart[other + 1]; ++r)
+            for (int p = tile.begin; p < tile.end; ++p) visit(p, r);
         }
   });
   return found;
@@ -112,11 +115,11 @@ std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection&
 CandidatePairs findCandidatePairs(const StreakGroup& g, const StreakProjection& q, double reach) {
   if (std::isnan(reach)) throw std::invalid_argument("reach must be a number (got NaN)");
   if (q.size() != g.size())
-    throw std::invalid_argument("projection of " + std::to_string(q.size()) + " members for a group of " +
-                                std::to_string(g.size()));
+    throw std::invalid_argument("projection of " + std::to_string(q.size()) +
+                                " members for a group of " + std::to_string(g.size()));
   CandidatePairs result;
   if (!(reach > 0.0) || g.size() < 2) return result;  // h < reach <= 0 never holds
-  std::vector<MemberPairs> found = std::isinf(reach) ? allPairs(g) : gridPairs(g, q, reach);
+  std::vector<MemberPairs> found = gridPairs(g, q, reach);
   std::size_t total = 0;
   for (const MemberPairs& m : found) {
     total += m.pairs.size();
@@ -129,9 +132,11 @@ CandidatePairs findCandidatePairs(const StreakGroup& g, const StreakProjection& 
     std::vector<DistancePair>().swap(m.pairs);  // the pairs are held once, not twice
   }
   result.stats.kept = total;
-  tbb::parallel_sort(result.pairs.begin(), result.pairs.end(), [](const DistancePair& x, const DistancePair& y) {
-    return x.a != y.a ? x.a < y.a : x.b < y.b;  // unique keys: one order at any thread count
-  });
+  // Unique keys: one order at any thread count.
+  tbb::parallel_sort(result.pairs.begin(), result.pairs.end(),
+                     [](const DistancePair& x, const DistancePair& y) {
+                       return x.a != y.a ? x.a < y.a : x.b < y.b;
+                     });
   return result;
 }
 

@@ -12,21 +12,21 @@
 
 namespace plume {
 
-/// Two members of a group (a < b) and their distance h(a, b).
+/// Two members of a group (a < b) and their distance h(a, b) (§3.3).
 struct DistancePair {
   int a = 0;
   int b = 0;
   double h = 0.0;
 };
 
-/// How much work the search did (for benchmarks and reports; not part of the result).
+/// How much work the pair search of §3.3 did (for benchmarks and reports; not part of the result).
 struct CandidateStats {
   std::uint64_t examined = 0;  ///< pairs in neighbouring grid cells
-  std::uint64_t exact = 0;     ///< pairs the bound did not rule out: h computed (maybe stopped early)
+  std::uint64_t exact = 0;     ///< pairs the bound left: h computed (maybe stopped early)
   std::uint64_t kept = 0;      ///< pairs with h < reach
 };
 
-/// Result of findCandidatePairs().
+/// Result of findCandidatePairs() (§3.3).
 struct CandidatePairs {
   std::vector<DistancePair> pairs;  ///< sorted by (a, b)
   CandidateStats stats;

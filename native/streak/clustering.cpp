@@ -33,7 +33,8 @@ std::vector<std::vector<int>> clusterSources(const StreakDistances& h, double h0
   DisjointSets sets(n);
   for (int a = 0; a < n; ++a)
     for (int i = 0; i < h.degree(a); ++i)
-      if (h.neighbours(a)[i] > a && h.neighbourDistances(a)[i] < h0) sets.join(a, h.neighbours(a)[i]);
+      if (h.neighbours(a)[i] > a && h.neighbourDistances(a)[i] < h0)
+        sets.join(a, h.neighbours(a)[i]);
   std::vector<std::vector<int>> byRoot(static_cast<std::size_t>(n));
   for (int a = 0; a < n; ++a) byRoot[std::size_t(sets.find(a))].push_back(a);
   // Roots are the smallest members, so walking roots in order sorts clusters by first member.
@@ -48,8 +49,8 @@ ClusterSummary clusterSummary(const StreakDistances& h, double h0) {
   return h.curve().at(h0);
 }
 
-std::vector<std::pair<int, std::vector<int>>> candidateGroups(const std::vector<StreakFrame>& frames,
-                                                              const std::vector<int>& groups) {
+std::vector<std::pair<int, std::vector<int>>> candidateGroups(
+    const std::vector<StreakFrame>& frames, const std::vector<int>& groups) {
   if (frames.empty()) throw std::invalid_argument("no streak frames: bake the streaklines first");
   const std::vector<int>& g = groups.empty() ? frames.back().groups : groups;
   if (int(g.size()) != frames.back().sourceCount())

@@ -47,7 +47,7 @@ std::vector<StreakSurface> buildSurfaces(const std::vector<StreakFrame>& frames,
 
 /// The sources of each candidate group, ascending group number (`groups` as in buildSurfaces()).
 /// Throws std::invalid_argument on a group with a single point source, or on a size mismatch.
-std::vector<std::pair<int, std::vector<int>>> candidateGroups(const std::vector<StreakFrame>& frames,
-                                                              const std::vector<int>& groups);
+std::vector<std::pair<int, std::vector<int>>> candidateGroups(
+    const std::vector<StreakFrame>& frames, const std::vector<int>& groups);
 
 }  // namespace plume

@@ -39,7 +39,8 @@ class GreedyChain {
       if (m < 0 || m >= d.size())
         throw std::invalid_argument("member " + std::to_string(m) + " is not in h (size " +
                                     std::to_string(d.size()) + ")");
-      if (mPosOf[std::size_t(m)] >= 0) throw std::invalid_argument("member " + std::to_string(m) + " repeats");
+      if (mPosOf[std::size_t(m)] >= 0)
+        throw std::invalid_argument("member " + std::to_string(m) + " repeats");
       mPosOf[std::size_t(m)] = int(p);
     }
   }

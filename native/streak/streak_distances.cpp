@@ -47,7 +47,8 @@ void DistanceParams::validate() const {
 }
 
 ClusterSummary ThresholdCurve::at(double h0) const {
-  const std::size_t below = std::size_t(std::lower_bound(values.begin(), values.end(), h0) - values.begin());
+  const auto first = std::lower_bound(values.begin(), values.end(), h0);  // values >= h0
+  const auto below = std::size_t(first - values.begin());
   return below == 0 ? ClusterSummary{} : counts[below - 1];
 }
 
@@ -55,16 +56,19 @@ StreakDistances::StreakDistances(StreakGroup group, const DistanceParams& params
     : mGroup(std::move(group)) {
   params.validate();
   if (params.reach < 0.0 && mGroup.size() < 2)
-    throw std::invalid_argument("a candidate group needs at least 2 point sources for a default h0 (got " +
-                                std::to_string(mGroup.size()) + ")");
+    throw std::invalid_argument(
+        "a candidate group needs at least 2 point sources for a default h0 (got " +
+        std::to_string(mGroup.size()) + ")");
   const StreakMoments moments = streakMoments(mGroup);
   mMean = moments.meanDistance;
-  mProjection = std::make_shared<const StreakProjection>(projectStreaks(mGroup, moments.meanLine, params.projection));
+  mProjection = std::make_shared<const StreakProjection>(
+      projectStreaks(mGroup, moments.meanLine, params.projection));
   build(params.reach < 0.0 ? mMean : params.reach);
 }
 
-StreakDistances::StreakDistances(StreakGroup group, std::shared_ptr<const StreakProjection> projection,
-                                 double mean, double reach)
+StreakDistances::StreakDistances(StreakGroup group,
+                                 std::shared_ptr<const StreakProjection> projection, double mean,
+                                 double reach)
     : mGroup(std::move(group)), mProjection(std::move(projection)), mMean(mean) {
   build(reach);
 }
@@ -102,8 +106,9 @@ StreakDistances StreakDistances::withReach(double reach) const {
 
 double StreakDistances::meanDistance() const {
   if (size() < 2)
-    throw std::invalid_argument("a candidate group needs at least 2 point sources for a default h0 (got " +
-                                std::to_string(size()) + ")");
+    throw std::invalid_argument(
+        "a candidate group needs at least 2 point sources for a default h0 (got " +
+        std::to_string(size()) + ")");
   return mMean;
 }
 

@@ -14,7 +14,7 @@
 
 namespace plume {
 
-/// What StreakDistances keeps.
+/// §3.3: what StreakDistances keeps.
 struct DistanceParams {
   /// Keep every pair with h < reach (+inf: all pairs). < 0: the default h0 (the mean of h).
   double reach = -1.0;
@@ -23,14 +23,14 @@ struct DistanceParams {
   void validate() const;
 };
 
-/// Number of surfaces and of the streaklines they use for one threshold h0 (Figure 4).
+/// §3.3 Figure 4: number of surfaces and of the streaklines they use for one threshold h0.
 struct ClusterSummary {
   int surfaces = 0;
   int streaklines = 0;
 };
 
-/// Figure 4 as a step function of h0: single linkage (Kruskal over the pairs sorted by h) joins
-/// sets only at values of h, so the counts are constant between them.
+/// §3.3 Figure 4 as a step function of h0: single linkage (Kruskal over the pairs sorted by h)
+/// joins sets only at values of h, so the counts are constant between them.
 struct ThresholdCurve {
   std::vector<double> values;           ///< ascending, distinct: the h where the counts change
   std::vector<ClusterSummary> counts;   ///< with every pair of h <= values[k] joined
@@ -61,7 +61,9 @@ class StreakDistances {
   /// The members b with h(a, b) < reach(), ascending, and those h.
   int degree(int a) const { return int(mOffsets[std::size_t(a) + 1] - mOffsets[std::size_t(a)]); }
   const int* neighbours(int a) const { return mNeighbours.data() + mOffsets[std::size_t(a)]; }
-  const double* neighbourDistances(int a) const { return mDistances.data() + mOffsets[std::size_t(a)]; }
+  const double* neighbourDistances(int a) const {
+    return mDistances.data() + mOffsets[std::size_t(a)];
+  }
   /// h(a, b) of any pair, computed now (streakDistance()).
   double distance(int a, int b) const { return streakDistance(mGroup, a, b); }
   /// The lower bound used to prune pairs (also by orderGreedy() beyond the reach).

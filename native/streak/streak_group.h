@@ -12,9 +12,9 @@
 
 namespace plume {
 
-/// The frames of one shot, shared by its groups and by the distance objects built on them (only
-/// counts and positions are read). A non-owning pointer (aliasing constructor) does for callers
-/// that keep the frames alive themselves.
+/// §3.2 streak frames of one shot, shared by its groups and by the distance objects built on them
+/// (only counts and positions are read). A non-owning pointer (aliasing constructor) does for
+/// callers that keep the frames alive themselves.
 using SharedStreakFrames = std::shared_ptr<const std::vector<StreakFrame>>;
 
 /// §3.3: the positions p(α,t,i) of a candidate group's point sources. Member a (0..size-1) is
@@ -47,9 +47,9 @@ class StreakGroup {
   std::size_t mCoordinates = 0;
 };
 
-/// Σ_k (a_k − b_k)² over `count` floats, in double, element k added to partial sum k mod 8, the
-/// partial sums added pairwise, ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)): the one
-/// summation order of h.
+/// §3.3 inner sum of h: Σ_k (a_k − b_k)² over `count` floats, in double, element k added to partial
+/// sum k mod 8, the partial sums added pairwise, ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)):
+/// the one summation order of h.
 double squaredDifference(const float* a, const float* b, std::size_t count);
 
 /// §3.3: h(α,β) = Σ_t [Σ_{i=1}^{N(t)} |p(α,t,i) − p(β,t,i)|²] / N(t) for members a and b, over
@@ -57,10 +57,10 @@ double squaredDifference(const float* a, const float* b, std::size_t count);
 /// streakDistanceBelow(), so equal inputs give bit-identical h.
 double streakDistance(const StreakGroup& g, int a, int b);
 
-/// streakDistance(g, a, b) when that is below `limit`. Otherwise it may stop after the first
-/// frame whose running sum reaches `limit` and return that partial sum, which is then <= h and
-/// >= limit (the terms are >= 0, and rounding is monotonic), so "result < limit" decides
-/// "h < limit" exactly.
+/// §3.3 h(α,β) decided against a limit: streakDistance(g, a, b) when that is below `limit`.
+/// Otherwise it may stop after the first frame whose running sum reaches `limit` and return that
+/// partial sum, which is then <= h and >= limit (the terms are >= 0, and rounding is monotonic), so
+/// "result < limit" decides "h < limit" exactly.
 double streakDistanceBelow(const StreakGroup& g, int a, int b, double limit);
 
 }  // namespace plume

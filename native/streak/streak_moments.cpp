@@ -10,7 +10,8 @@ StreakMoments streakMoments(const StreakGroup& g) {
   m.meanLine.assign(g.coordinateCount(), 0.0);
   if (n == 0) return m;
   std::vector<std::size_t> first(std::size_t(frames) + 1, 0);  // first coordinate of each frame
-  for (int f = 0; f < frames; ++f) first[std::size_t(f) + 1] = first[std::size_t(f)] + 3 * std::size_t(g.particleCount(f));
+  for (int f = 0; f < frames; ++f)
+    first[std::size_t(f) + 1] = first[std::size_t(f)] + 3 * std::size_t(g.particleCount(f));
   std::vector<double> frameDeviation(std::size_t(frames), 0.0);
   parallelFor(0, frames, [&](int f) {
     const std::size_t count = 3 * std::size_t(g.particleCount(f));
@@ -34,7 +35,8 @@ StreakMoments streakMoments(const StreakGroup& g) {
     frameDeviation[std::size_t(f)] = s;
   });
   double perSource = 0.0;  // Σ_t (1/N(t)) Σ_i Σ_α |p − m|²
-  for (int f = 0; f < frames; ++f) perSource += frameDeviation[std::size_t(f)] / double(g.particleCount(f));
+  for (int f = 0; f < frames; ++f)
+    perSource += frameDeviation[std::size_t(f)] / double(g.particleCount(f));
   m.pairSum = double(n) * perSource;
   m.meanDistance = n < 2 ? 0.0 : 2.0 * perSource / double(n - 1);
   return m;

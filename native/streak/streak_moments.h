@@ -10,7 +10,7 @@
 
 namespace plume {
 
-/// First and second moments of a group's streaklines.
+/// §3.3: first and second moments of a group's streaklines, which give the default h0.
 struct StreakMoments {
   /// m(t,i) = (1/n) Σ_α p(α,t,i): D = 3 Σ_t N(t) values, used frames in order, x y z per particle.
   std::vector<double> meanLine;

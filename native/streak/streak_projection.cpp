@@ -12,7 +12,9 @@ namespace plume {
 namespace {
 
 /// Column j of a column-major matrix with `rows` rows.
-double* column(std::vector<double>& m, std::size_t rows, int j) { return m.data() + rows * std::size_t(j); }
+double* column(std::vector<double>& m, std::size_t rows, int j) {
+  return m.data() + rows * std::size_t(j);
+}
 
 double dot(const double* a, const double* b, std::size_t n) {
   double s = 0.0;
@@ -64,7 +66,8 @@ std::vector<bool> orthonormalize(std::vector<double>& m, std::size_t rows, int c
 
 void ProjectionParams::validate() const {
   if (rank < 0 || rank > 64)
-    throw std::invalid_argument("projection rank must be in [0, 64] (got " + std::to_string(rank) + ")");
+    throw std::invalid_argument("projection rank must be in [0, 64] (got " +
+                                std::to_string(rank) + ")");
   if (sampleSize < 2 || sampleSize > 4096)
     throw std::invalid_argument("projection sample size must be in [2, 4096] (got " +
                                 std::to_string(sampleSize) + ")");
@@ -72,7 +75,8 @@ void ProjectionParams::validate() const {
     throw std::invalid_argument("projection iterations must be in [1, 1000] (got " +
                                 std::to_string(iterations) + ")");
   if (minSize < 0)
-    throw std::invalid_argument("projection min size must be >= 0 (got " + std::to_string(minSize) + ")");
+    throw std::invalid_argument("projection min size must be >= 0 (got " +
+                                std::to_string(minSize) + ")");
 }
 
 StreakProjection::StreakProjection(int size, int rank, std::vector<double> coords, double margin)
@@ -103,7 +107,8 @@ StreakProjection projectStreaks(const StreakGroup& g, const std::vector<double>&
   std::vector<double> scale;
   scale.reserve(D);
   for (int f = 0; f < g.usedFrameCount(); ++f)
-    scale.insert(scale.end(), 3 * std::size_t(g.particleCount(f)), 1.0 / std::sqrt(double(g.particleCount(f))));
+    scale.insert(scale.end(), 3 * std::size_t(g.particleCount(f)),
+                 1.0 / std::sqrt(double(g.particleCount(f))));
   // Embedding of member a, centred: y = (x − m)/√N.
   auto embed = [&](int a, double* y) {
     std::size_t k = 0;
@@ -125,8 +130,9 @@ StreakProjection projectStreaks(const StreakGroup& g, const std::vector<double>&
     std::vector<double> G(std::size_t(s) * std::size_t(s));
     parallelFor(0, s, [&](int i) {
       for (int j = i; j < s; ++j)
-        G[std::size_t(i) * std::size_t(s) + std::size_t(j)] = G[std::size_t(j) * std::size_t(s) + std::size_t(i)] =
-            fastDot(column(Y, D, i), column(Y, D, j), D);
+        G[std::size_t(i) * std::size_t(s) + std::size_t(j)] =
+            G[std::size_t(j) * std::size_t(s) + std::size_t(i)] =
+                fastDot(column(Y, D, i), column(Y, D, j), D);
     });
     // Subspace iteration from a seeded start: Q ← orth(G Q). Column j tends to the j-th
     // principal direction (modified Gram–Schmidt keeps the earlier columns first).
@@ -138,7 +144,8 @@ StreakProjection projectStreaks(const StreakGroup& g, const std::vector<double>&
       parallelFor(0, r, [&](int j) {
         const double* q = column(Q, std::size_t(s), j);
         double* z = column(Z, std::size_t(s), j);
-        for (int i = 0; i < s; ++i) z[i] = dot(G.data() + std::size_t(i) * std::size_t(s), q, std::size_t(s));
+        for (int i = 0; i < s; ++i)
+          z[i] = dot(G.data() + std::size_t(i) * std::size_t(s), q, std::size_t(s));
       });
       Q.swap(Z);
       orthonormalize(Q, std::size_t(s), r, 1e-12);
@@ -201,7 +208,8 @@ StreakProjection projectStreaks(const StreakGroup& g, const std::vector<double>&
   // Rounding of q_j is <= (D + 2) u |y_α| per coordinate (Cauchy–Schwarz, |V_j| = 1); squared
   // and summed over the rank, the bound moves by < 8 (D + 2) u √rank max|y|². Allow 4× that.
   const double maxNorm2 = n > 0 ? *std::max_element(norm2.begin(), norm2.end()) : 0.0;
-  const double margin = 32.0 * double(D + 16) * 0x1p-53 * (std::sqrt(double(rank)) + 1.0) * maxNorm2;
+  const double margin =
+      32.0 * double(D + 16) * 0x1p-53 * (std::sqrt(double(rank)) + 1.0) * maxNorm2;
   return StreakProjection(n, rank, std::move(coords), margin);
 }
 

@@ -15,7 +15,7 @@
 
 namespace plume {
 
-/// How the pruning directions are found.
+/// §3.3 pruning of the pairs: how the directions of the lower bound on h are found.
 struct ProjectionParams {
   int rank = 8;          ///< principal directions kept (0: none; every pair is then checked)
   int sampleSize = 128;  ///< evenly spaced members whose PCA gives the directions
@@ -28,9 +28,9 @@ struct ProjectionParams {
   void validate() const;
 };
 
-/// Coordinates q_α = Vᵀ(x_α − m) of every member of a group on orthonormal directions V; the
-/// bound |q_α − q_β|² <= h(α,β) holds for any V with orthonormal columns and any m, so the
-/// quality of the PCA only affects speed, never results.
+/// §3.3 lower bound on h: coordinates q_α = Vᵀ(x_α − m) of every member of a group on orthonormal
+/// directions V; the bound |q_α − q_β|² <= h(α,β) holds for any V with orthonormal columns and any
+/// m, so the quality of the PCA only affects speed, never results.
 class StreakProjection {
  public:
   StreakProjection() = default;

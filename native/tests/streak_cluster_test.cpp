@@ -32,9 +32,10 @@ std::vector<Shot> shots() {
   const std::vector<int> counts{0, 2, 3, 0, 5, 8, 0, 13, 9};
   std::vector<Shot> out;
   for (std::uint64_t seed : {1u, 2u, 3u}) {
-    out.push_back({"clustered seed " + std::to_string(seed), plumeFrames(90, counts, Layout::Clustered, 12, seed)});
-    out.push_back({"uniform seed " + std::to_string(seed), plumeFrames(60, counts, Layout::Uniform, 1, seed)});
-    out.push_back({"coincident seed " + std::to_string(seed), plumeFrames(75, counts, Layout::Coincident, 9, seed)});
+    const std::string s = " seed " + std::to_string(seed);
+    out.push_back({"clustered" + s, plumeFrames(90, counts, Layout::Clustered, 12, seed)});
+    out.push_back({"uniform" + s, plumeFrames(60, counts, Layout::Uniform, 1, seed)});
+    out.push_back({"coincident" + s, plumeFrames(75, counts, Layout::Coincident, 9, seed)});
   }
   return out;
 }
@@ -63,7 +64,8 @@ std::vector<double> upperValues(const DistanceMatrix& h) {
 std::vector<int> shuffled(int n, std::uint64_t seed) {
   std::vector<int> v = iota(n);
   Rng rng(seed, 7);
-  for (int i = n - 1; i > 0; --i) std::swap(v[std::size_t(i)], v[std::size_t(rng.next() % std::uint64_t(i + 1))]);
+  for (int i = n - 1; i > 0; --i)
+    std::swap(v[std::size_t(i)], v[std::size_t(rng.next() % std::uint64_t(i + 1))]);
   return v;
 }
 
@@ -77,8 +79,8 @@ void expectSameAsBruteForce(const StreakDistances& sparse, const DistanceMatrix&
     for (int b = 0; b < h.size; ++b)
       if (b != a && h(a, b) < sparse.reach()) expected.push_back(b);
     below += expected.size();
-    ASSERT_EQ(std::vector<int>(sparse.neighbours(a), sparse.neighbours(a) + sparse.degree(a)), expected)
-        << what << " member " << a;
+    const int* held = sparse.neighbours(a);
+    ASSERT_EQ(std::vector<int>(held, held + sparse.degree(a)), expected) << what << " member " << a;
     for (int i = 0; i < sparse.degree(a); ++i)
       ASSERT_EQ(sparse.neighbourDistances(a)[i], h(a, sparse.neighbours(a)[i])) << what;
   }
@@ -117,7 +119,8 @@ TEST(SparseClustering, EqualsBruteForceOnRandomShots) {
       for (double h0 : {v, std::nextafter(v, 1e300)}) {
         if (h0 > sparse.reach()) continue;
         const ClusterSummary s = bruteForceSummary(h, h0), t = clusterSummary(sparse, h0);
-        ASSERT_TRUE(s.surfaces == t.surfaces && s.streaklines == t.streaklines) << shot.name << " h0 " << h0;
+        ASSERT_TRUE(s.surfaces == t.surfaces && s.streaklines == t.streaklines)
+            << shot.name << " h0 " << h0;
       }
     }
     // An explicit reach below the default, and orders far beyond it (every member, shuffled):
@@ -138,7 +141,8 @@ TEST(SparseClustering, ProjectionRankChangesWorkNotResults) {
   std::vector<std::uint64_t> exact;
   for (int rank : {0, 1, 3, 16, 40}) {
     const StreakDistances sparse = pruned(group, reach, rank);
-    expectSameAsBruteForce(sparse, h, {reach * 0.3, reach * 0.7, reach}, "rank " + std::to_string(rank));
+    expectSameAsBruteForce(sparse, h, {reach * 0.3, reach * 0.7, reach},
+                           "rank " + std::to_string(rank));
     exact.push_back(sparse.stats().exact);
   }
   // The bound earns its keep: with 16 directions far fewer pairs need exact h than with none.
@@ -172,7 +176,7 @@ TEST(SparseClustering, IdenticalStreaklinesGiveZeroDefault) {
   for (StreakFrame& f : frames) {
     const std::vector<std::size_t> o = f.offsets();
     for (int s = 1; s < 10; ++s)
-      std::copy(f.positions.begin() + std::ptrdiff_t(o[0]), f.positions.begin() + std::ptrdiff_t(o[1]),
+      std::copy(f.positions.begin(), f.positions.begin() + std::ptrdiff_t(o[1]),
                 f.positions.begin() + std::ptrdiff_t(o[std::size_t(s)]));
   }
   const StreakGroup group(share(frames), iota(10));
@@ -201,8 +205,9 @@ TEST(SparseClustering, SameResultWithOneAndTwoThreads) {
   ASSERT_EQ(d1.pairCount(), d2.pairCount());
   for (int a = 0; a < d1.size(); ++a) {
     ASSERT_EQ(d1.degree(a), d2.degree(a));
-    EXPECT_EQ(std::memcmp(d1.neighbours(a), d2.neighbours(a), sizeof(int) * std::size_t(d1.degree(a))), 0);
-    EXPECT_EQ(std::memcmp(d1.neighbourDistances(a), d2.neighbourDistances(a), sizeof(double) * std::size_t(d1.degree(a))), 0);
+    const std::size_t k = std::size_t(d1.degree(a));
+    EXPECT_EQ(std::memcmp(d1.neighbours(a), d2.neighbours(a), sizeof(int) * k), 0);
+    EXPECT_EQ(std::memcmp(d1.neighbourDistances(a), d2.neighbourDistances(a), sizeof(double) * k), 0);
   }
   EXPECT_EQ(d1.curve().values, d2.curve().values);
   EXPECT_EQ(d1.stats().exact, d2.stats().exact);
@@ -214,7 +219,8 @@ TEST(SparseClustering, BuildSurfacesEqualsBruteForcePerGroup) {
   // Three candidate groups over one shot, default and explicit thresholds.
   const Shot shot = shots()[0];
   std::vector<int> groups;
-  for (int s = 0; s < shot.frames.back().sourceCount(); ++s) groups.push_back(s % 3 == 0 ? 5 : (s % 3 == 1 ? 2 : 9));
+  for (int s = 0; s < shot.frames.back().sourceCount(); ++s)
+    groups.push_back(s % 3 == 0 ? 5 : (s % 3 == 1 ? 2 : 9));
   const StreakGroup g2(share(shot.frames), {1, 4, 7});
   ProjectionParams projection;
   projection.minSize = 0;

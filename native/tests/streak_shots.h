@@ -16,7 +16,8 @@
 namespace plume {
 
 /// Random frames: `sources` streaklines, N(t) = n[t] particles each (N may be 0 or shrink).
-inline std::vector<StreakFrame> randomFrames(int sources, const std::vector<int>& n, std::uint64_t seed) {
+inline std::vector<StreakFrame> randomFrames(int sources, const std::vector<int>& n,
+                                             std::uint64_t seed) {
   Rng rng(seed);
   std::vector<StreakFrame> frames;
   for (int count : n) {
@@ -51,7 +52,8 @@ inline std::vector<StreakFrame> plumeFrames(int sources, const std::vector<int>&
   Rng rng(seed, /*stream=*/1);
   std::vector<glm::vec3> start(static_cast<std::size_t>(sources));
   std::vector<glm::vec3> blobCentre(static_cast<std::size_t>(blobs));
-  for (glm::vec3& c : blobCentre) c = glm::vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(0, 0.3));
+  for (glm::vec3& c : blobCentre)
+    c = glm::vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(0, 0.3));
   for (int s = 0; s < sources; ++s)
     start[std::size_t(s)] = blobCentre[std::size_t(s % blobs)] +
                             0.03f * glm::vec3(rng.normal(), rng.normal(), rng.normal());
@@ -82,7 +84,8 @@ inline std::vector<StreakFrame> plumeFrames(int sources, const std::vector<int>&
       const std::vector<std::size_t> o = f.offsets();
       for (int s = 2; s < sources; s += 3)  // a copy of the source before it
         for (int i = 0; i < count; ++i)
-          f.positions[o[std::size_t(s)] + std::size_t(i)] = f.positions[o[std::size_t(s) - 1] + std::size_t(i)];
+          f.positions[o[std::size_t(s)] + std::size_t(i)] =
+              f.positions[o[std::size_t(s) - 1] + std::size_t(i)];
     }
     frames.push_back(std::move(f));
   }
@@ -91,7 +94,8 @@ inline std::vector<StreakFrame> plumeFrames(int sources, const std::vector<int>&
 
 /// Frames of parallel straight streaklines: source s at slot slotOfSource[s] · d along x,
 /// particles rising along z and fanning out with height.
-inline std::vector<StreakFrame> parallelStreaks(const std::vector<int>& slotOfSource, float d, int frames) {
+inline std::vector<StreakFrame> parallelStreaks(const std::vector<int>& slotOfSource, float d,
+                                                int frames) {
   std::vector<StreakFrame> out;
   const int n = int(slotOfSource.size());
   for (int t = 0; t < frames; ++t) {
@@ -102,7 +106,8 @@ inline std::vector<StreakFrame> parallelStreaks(const std::vector<int>& slotOfSo
     for (int s = 0; s < n; ++s)
       for (int i = 0; i < N; ++i) {
         const float slot = float(slotOfSource[std::size_t(s)]);
-        f.positions.push_back(glm::vec3(slot * d * (1.f + 0.01f * float(N - i)), 0.f, 0.1f * float(N - i)));
+        const float height = float(N - i);
+        f.positions.push_back(glm::vec3(slot * d * (1.f + 0.01f * height), 0.f, 0.1f * height));
         f.density.push_back(1.f);
         f.outside.push_back(0);
       }
