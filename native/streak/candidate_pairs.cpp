@@ -22,16 +22,32 @@ struct MemberPairs {
   CandidateStats stats;
 };
 
-/// Keeps (a, b) if its exact h is below reach.
-void decide(const StreakGroup& g, int a, int b, double reach, MemberPairs& out) {
-  ++out.stats.exact;
-  const double h = streakDistanceBelow(g, a, b, reach);
-  if (h < reach) out.pairs.push_back({std::min(a, b), std::max(a, b), h});
+/// Keeps the pairs of a block whose exact h is below reach. The sums run frame by frame over the
+/// whole block, so each frame's lines of the block's members are read once for all its pairs
+/// (from cache) instead of once per pair (from memory); each pair still adds the same terms in
+/// the same order as streakDistanceBelow(), stopping once it reaches reach, so its h is the
+/// same bit for bit.
+void decideBlock(const StreakGroup& g, const std::vector<std::pair<int, int>>& block, double reach,
+                 std::vector<double>& total, MemberPairs& out) {
+  out.stats.exact += block.size();
+  total.assign(block.size(), 0.0);
+  for (int f = 0; f < g.usedFrameCount(); ++f) {
+    const std::size_t count = 3 * std::size_t(g.particleCount(f));
+    const double N = double(g.particleCount(f));
+    for (std::size_t k = 0; k < block.size(); ++k)
+      if (total[k] < reach)
+        total[k] += squaredDifference(g.line(f, block[k].first), g.line(f, block[k].second), count) / N;
+  }
+  for (std::size_t k = 0; k < block.size(); ++k)
+    if (total[k] < reach) {
+      const auto [a, b] = block[k];
+      out.pairs.push_back({std::min(a, b), std::max(a, b), total[k]});
+    }
 }
 
-/// Members of one grid cell read together: each streakline of a neighbouring cell is then
-/// loaded once per tile instead of once per member (the exact h of many pairs is bound by memory
-/// otherwise: every pair streams two streaklines of 3 Σ_t N(t) floats).
+/// Members of one grid cell taken together, against as many of a neighbouring cell: see
+/// decideBlock() (the exact h of many pairs is bound by memory otherwise: every pair streams two
+/// streaklines of 3 Σ_t N(t) floats).
 constexpr int kTile = 16;
 
 /// Pairs through the grid over projected coordinates 0..2 (fewer if the rank is lower; one cell
@@ -61,14 +77,13 @@ std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection&
   });
   // Cells as runs of `order`: cellStart[c] .. cellStart[c + 1].
   std::vector<CellKey> cellKey;
-  std::vector<int> cellStart, cellOf(static_cast<std::size_t>(n));
+  std::vector<int> cellStart;
   for (int p = 0; p < n; ++p) {
     const CellKey& k = key[std::size_t(order[std::size_t(p)])];
     if (cellKey.empty() || cellKey.back() != k) {
       cellKey.push_back(k);
       cellStart.push_back(p);
     }
-    cellOf[std::size_t(p)] = int(cellKey.size()) - 1;
   }
   cellStart.push_back(n);
 
@@ -84,16 +99,24 @@ std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection&
   parallelFor(0, int(tiles.size()), [&](int t) {
     const Tile& tile = tiles[std::size_t(t)];
     MemberPairs& out = found[std::size_t(t)];
-    auto visit = [&](int p, int r) {
-      const int a = order[std::size_t(p)], b = order[std::size_t(r)];
-      ++out.stats.examined;
-      if (q.lowerBound(a, b, limit) >= limit) return;  // proves h >= reach
-      decide(g, a, b, reach, out);
+    std::vector<std::pair<int, int>> block;
+    std::vector<double> total;
+    // The pairs (p, r), p in the tile, r in [from, to) (p < r within the own cell), that the
+    // bound does not rule out, decided together.
+    auto visit = [&](int from, int to, bool ownCell) {
+      block.clear();
+      for (int r = from; r < to; ++r)
+        for (int p = tile.begin; p < tile.end; ++p) {
+          if (ownCell && p >= r) continue;
+          const int a = order[std::size_t(p)], b = order[std::size_t(r)];
+          ++out.stats.examined;
+          if (q.lowerBound(a, b, limit) >= limit) continue;  // proves h >= reach
+          block.emplace_back(a, b);
+        }
+      decideBlock(g, block, reach, total, out);
     };
-    // Own cell: the pairs (p, r) with p in the tile and p < r.
     const int cellEnd = cellStart[std::size_t(tile.cell) + 1];
-    for (int r = tile.begin + 1; r < cellEnd; ++r)
-      for (int p = tile.begin; p < std::min(tile.end, r); ++p) visit(p, r);
+    for (int r = tile.begin; r < cellEnd; r += kTile) visit(r, std::min(r + kTile, cellEnd), true);
     const CellKey& own = cellKey[std::size_t(tile.cell)];
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
@@ -103,8 +126,8 @@ std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection&
           const auto it = std::lower_bound(cellKey.begin(), cellKey.end(), k);
           if (it == cellKey.end() || *it != k) continue;
           const std::size_t other = std::size_t(it - cellKey.begin());
-          for (int r = cellStart[other]; r < cellStart[other + 1]; ++r)
-            for (int p = tile.begin; p < tile.end; ++p) visit(p, r);
+          for (int r = cellStart[other]; r < cellStart[other + 1]; r += kTile)
+            visit(r, std::min(r + kTile, cellStart[other + 1]), false);
         }
   });
   return found;

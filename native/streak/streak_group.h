@@ -53,8 +53,9 @@ class StreakGroup {
 double squaredDifference(const float* a, const float* b, std::size_t count);
 
 /// §3.3: h(α,β) = Σ_t [Σ_{i=1}^{N(t)} |p(α,t,i) − p(β,t,i)|²] / N(t) for members a and b, over
-/// the used frames in order. Every path (sparse, on demand, brute force) calls this or
-/// streakDistanceBelow(), so equal inputs give bit-identical h.
+/// the used frames in order: total += squaredDifference(...) / N(t). Every path (sparse, on
+/// demand, brute force) adds these terms in this order (this function, streakDistanceBelow() or
+/// the blocked sums of findCandidatePairs()), so equal inputs give bit-identical h.
 double streakDistance(const StreakGroup& g, int a, int b);
 
 /// §3.3 h(α,β) decided against a limit: streakDistance(g, a, b) when that is below `limit`.
