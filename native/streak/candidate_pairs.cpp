@@ -17,7 +17,7 @@ namespace {
 using CellKey = std::array<std::int64_t, 3>;
 
 /// Pairs found from one tile of members, and the work it took.
-struct MemberPairs {
+struct TilePairs {
   std::vector<DistancePair> pairs;
   CandidateStats stats;
 };
@@ -28,15 +28,17 @@ struct MemberPairs {
 /// the same order as streakDistanceBelow(), stopping once it reaches reach, so its h is the
 /// same bit for bit.
 void decideBlock(const StreakGroup& g, const std::vector<std::pair<int, int>>& block, double reach,
-                 std::vector<double>& total, MemberPairs& out) {
+                 std::vector<double>& total, TilePairs& out) {
   out.stats.exact += block.size();
   total.assign(block.size(), 0.0);
   for (int f = 0; f < g.usedFrameCount(); ++f) {
     const std::size_t count = 3 * std::size_t(g.particleCount(f));
     const double N = double(g.particleCount(f));
-    for (std::size_t k = 0; k < block.size(); ++k)
-      if (total[k] < reach)
-        total[k] += squaredDifference(g.line(f, block[k].first), g.line(f, block[k].second), count) / N;
+    for (std::size_t k = 0; k < block.size(); ++k) {
+      if (total[k] >= reach) continue;  // decided: h >= reach
+      const auto [a, b] = block[k];
+      total[k] += squaredDifference(g.line(f, a), g.line(f, b), count) / N;
+    }
   }
   for (std::size_t k = 0; k < block.size(); ++k)
     if (total[k] < reach) {
@@ -52,7 +54,7 @@ constexpr int kTile = 16;
 
 /// Pairs through the grid over projected coordinates 0..2 (fewer if the rank is lower; one cell
 /// holding everyone when reach is +inf).
-std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection& q, double reach) {
+std::vector<TilePairs> gridPairs(const StreakGroup& g, const StreakProjection& q, double reach) {
   const int n = g.size();
   const int dims = std::isinf(reach) ? 0 : std::min(q.rank(), 3);
   const double limit = reach + q.slack(reach);
@@ -95,10 +97,10 @@ std::vector<MemberPairs> gridPairs(const StreakGroup& g, const StreakProjection&
     for (int p = cellStart[c]; p < cellStart[c + 1]; p += kTile)
       tiles.push_back({p, std::min(p + kTile, cellStart[c + 1]), int(c)});
 
-  std::vector<MemberPairs> found(tiles.size());
+  std::vector<TilePairs> found(tiles.size());
   parallelFor(0, int(tiles.size()), [&](int t) {
     const Tile& tile = tiles[std::size_t(t)];
-    MemberPairs& out = found[std::size_t(t)];
+    TilePairs& out = found[std::size_t(t)];
     std::vector<std::pair<int, int>> block;
     std::vector<double> total;
     // The pairs (p, r), p in the tile, r in [from, to) (p < r within the own cell), that the
@@ -142,15 +144,15 @@ CandidatePairs findCandidatePairs(const StreakGroup& g, const StreakProjection& 
                                 " members for a group of " + std::to_string(g.size()));
   CandidatePairs result;
   if (!(reach > 0.0) || g.size() < 2) return result;  // h < reach <= 0 never holds
-  std::vector<MemberPairs> found = gridPairs(g, q, reach);
+  std::vector<TilePairs> found = gridPairs(g, q, reach);
   std::size_t total = 0;
-  for (const MemberPairs& m : found) {
+  for (const TilePairs& m : found) {
     total += m.pairs.size();
     result.stats.examined += m.stats.examined;
     result.stats.exact += m.stats.exact;
   }
   result.pairs.reserve(total);
-  for (MemberPairs& m : found) {
+  for (TilePairs& m : found) {
     result.pairs.insert(result.pairs.end(), m.pairs.begin(), m.pairs.end());
     std::vector<DistancePair>().swap(m.pairs);  // the pairs are held once, not twice
   }
