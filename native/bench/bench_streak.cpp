@@ -20,6 +20,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -123,6 +125,15 @@ void BM_StreakPipeline(benchmark::State& state) {
 constexpr int kClump = 16;       // point sources per clump (10–20 per source cell, §3.2)
 constexpr int kShotFrames = 60;  // N(t) = t + 1
 constexpr int kModes = 8;        // stirring modes
+
+/// CPU seconds of the process so far, all threads (user + system): a figure that the load of a
+/// shared machine changes far less than the wall time.
+double processCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 /// kB from /proc/self/status ("VmRSS", "VmHWM").
 double statusKb(const std::string& key) {
@@ -269,11 +280,14 @@ void BM_StreakClusterSparse(benchmark::State& state) {
   const double framesMb = (statusKb("VmRSS") - rssBefore) / 1024.0;
   const double h0 = benchThreshold(state, frames);
   std::vector<StreakSurface> surfaces;
+  const double cpu0 = processCpuSeconds();
   for (auto _ : state) {
     surfaces = buildSurfaces(frames, {}, h0);
     benchmark::DoNotOptimize(surfaces.data());
   }
+  const double cpuPerRun = (processCpuSeconds() - cpu0) / double(state.iterations());
   clusterCounters(state, surfaces, n);
+  state.counters["cpu_s_all_threads"] = cpuPerRun;
   // The work of the pair search, outside the timing.
   DistanceParams params;
   params.reach = h0;  // < 0: the mean
@@ -287,10 +301,11 @@ void BM_StreakClusterSparse(benchmark::State& state) {
   state.counters["frames_MB"] = framesMb;
   state.counters["peak_RSS_MB"] = peakMb;
   std::printf("  n = %d: h0 = %.4g (%.3g × mean %.4g); %zu surfaces, largest %.0f; pairs examined "
-              "%.0f, exact h %.0f, kept %.0f of n²/2 = %.0f; frames %.0f MB, peak RSS %.0f MB\n",
+              "%.0f, exact h %.0f, kept %.0f of n²/2 = %.0f; %.2f s CPU (all threads) a run; "
+              "frames %.0f MB, peak RSS %.0f MB\n",
               n, d.reach(), d.reach() / d.meanDistance(), d.meanDistance(), surfaces.size(),
               state.counters["largest"].value, double(d.stats().examined), double(d.stats().exact),
-              double(d.stats().kept), allPairs, framesMb, peakMb);
+              double(d.stats().kept), allPairs, cpuPerRun, framesMb, peakMb);
 }
 
 /// The brute force over all pairs (dense matrix) on the same layout, and whether it agrees.
@@ -299,11 +314,13 @@ void BM_StreakClusterBruteForce(benchmark::State& state) {
   const std::vector<StreakFrame>& frames = shot(n);
   const double h0 = benchThreshold(state, frames);
   std::vector<StreakSurface> surfaces;
+  const double cpu0 = processCpuSeconds();
   for (auto _ : state) {
     surfaces = bruteForceSurfaces(frames, {}, h0);
     benchmark::DoNotOptimize(surfaces.data());
   }
   clusterCounters(state, surfaces, n);
+  state.counters["cpu_s_all_threads"] = (processCpuSeconds() - cpu0) / double(state.iterations());
   const std::vector<StreakSurface> sparse = buildSurfaces(frames, {}, h0);
   bool same = sparse.size() == surfaces.size();
   for (std::size_t k = 0; same && k < sparse.size(); ++k) same = sparse[k].sources == surfaces[k].sources;
