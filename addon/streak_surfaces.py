@@ -6,6 +6,11 @@ cluster into per-frame NURBS control points and density maps.
     groups = group_distances(native, frames)           # {group: GroupDistances}
     plans = plan_surfaces(native, groups, h0)          # one SurfacePlan per cluster
     anim = surface_animation(native, frames, plan)     # control points per frame
+
+The distances are sparse (native StreakDistances): each group holds every pair with h below its
+reach, exactly, and no n x n matrix. The reach starts at the group's default h0 (the mean of h)
+and grows when a build asks for a larger threshold; clusters, counts and the Figure 4 curve are
+exact up to it, the greedy order always.
 """
 
 import os
@@ -23,11 +28,12 @@ ORDER_U = ORDER_V = 4
 
 @dataclass
 class GroupDistances:
-    """h(α,β) of one candidate group (§3.3); ids are the source IDs of its rows."""
+    """h(α,β) of one candidate group (§3.3): ``h`` is a native StreakDistances holding every pair
+    with h < h.reach exactly (members 0..n-1 are the source IDs ``ids``)."""
 
     group: int
     ids: np.ndarray
-    h: np.ndarray
+    h: object
 
 
 @dataclass
@@ -77,18 +83,26 @@ def load_frames(native, folder, frame_start, last_frame):
 
 
 def group_distances(native, frames) -> Dict[int, GroupDistances]:
-    """h for all pairs inside each candidate group (groups of the last frame)."""
+    """Sparse h of each candidate group (groups of the last frame), up to the group's default
+    h0: the pairs with h < mean of h, found through a grid and a lower bound, never all n²/2."""
     groups = np.asarray(frames[-1]["groups"])
-    out = {}
-    for g in sorted(set(int(x) for x in groups)):
+    names = sorted(set(int(x) for x in groups))
+    for g in names:
         ids = np.flatnonzero(groups == g)
         if len(ids) < 2:
             raise BakeError(
                 f"Plume: candidate group {g} has a single point source (source ID {int(ids[0])}); "
                 "a surface needs at least 2: raise the source's point_sources or give it the "
                 "candidate_group of another source")
+    try:
+        shared = native.StreakFrames(frames)  # converted once for every group
+    except ValueError as e:
+        raise BakeError(f"Plume: streak files: {e} (bake the domain again)") from None
+    out = {}
+    for g in names:
+        ids = np.flatnonzero(groups == g)
         try:
-            h = native.streak_distances(frames, ids)
+            h = native.streak_distances(shared, ids)
         except ValueError as e:
             raise BakeError(f"Plume: candidate group {g}: {e}") from None
         out[g] = GroupDistances(group=g, ids=ids, h=h)
@@ -107,7 +121,11 @@ def group_threshold(native, g, h0):
 
 
 def summary(native, groups, h0):
-    """(surfaces, streaklines) for threshold h0 over all groups (Figure 4)."""
+    """(surfaces, streaklines) for threshold h0 over all groups (Figure 4), from each group's
+    curve in O(log pairs). Exact whenever each group's threshold (h0 > 0, else its default) is
+    <= its reach: always for h0 = 0 and for any h0 up to the smallest group mean, and up to the
+    largest threshold built so far. Above a group's reach, ValueError naming it (the pairs that
+    would decide are not held; Build Surfaces at that h0 widens them)."""
     surfaces = lines = 0
     for g in groups.values():
         s, n = native.cluster_summary(g.h, group_threshold(native, g, h0))
@@ -119,31 +137,42 @@ def summary(native, groups, h0):
 def most_surfaces_threshold(native, groups):
     """The h0 > 0 giving the most surfaces over all candidate groups (ties: the most streaklines,
     then the smallest h0): what an artist looks for on the (h0 -> surfaces) curve of Figure 4.
-    The counts only change where h0 passes a value of h, so h0 just above each distinct h value
-    covers every possible clustering exactly."""
-    values = np.unique(np.concatenate(
-        [g.h[np.triu_indices(len(g.ids), 1)] for g in groups.values()]))
-    values = values[np.isfinite(values)]
-    best = None
-    for v in values:
-        h0 = float(np.nextafter(v, np.inf))
-        if h0 <= 0.0:
-            continue
-        surfaces, lines = summary(native, groups, h0)
-        key = (surfaces, lines, -h0)
-        if best is None or key > best[0]:
-            best = (key, h0)
-    if best is None or best[0][0] == 0:
+    Searched over 0 < h0 <= R, R the smallest reach of the groups (their default h0, the mean of
+    h, unless a build widened them). The counts only change where h0 passes a value of h, and
+    every pair with h < R is held, so h0 just above each held value covers every clustering in
+    that range exactly, in one pass over the groups' curves (single linkage, Kruskal). Larger
+    h0 are not searched: the pairs that decide them are not held (the peak of Figure 4 lies far
+    below the mean of h in practice, where the mean joins nearly everything)."""
+    reach = min(float(g.h.reach) for g in groups.values())
+    curves = [g.h.curve() for g in groups.values()]
+    values = np.unique(np.concatenate([c[0] for c in curves]))
+    h0s = np.nextafter(values, np.inf)
+    keep = h0s <= reach
+    values, h0s = values[keep], h0s[keep]
+    surfaces = np.zeros(len(values), dtype=np.int64)
+    lines = np.zeros(len(values), dtype=np.int64)
+    for c_values, c_surfaces, c_lines in curves:
+        # Counts at h0 just above v: every pair with h <= v joined.
+        k = np.searchsorted(c_values, values, side="right") - 1
+        has = k >= 0
+        surfaces[has] += np.asarray(c_surfaces, dtype=np.int64)[k[has]]
+        lines[has] += np.asarray(c_lines, dtype=np.int64)[k[has]]
+    if len(values) == 0 or surfaces.max() == 0:
         raise BakeError("Plume: no threshold h0 joins two streaklines (all h are 0 or not "
                         "finite): check the point sources")
-    return best[1]
+    best = np.lexsort((-h0s, lines, surfaces))[-1]  # most surfaces, then lines, then smallest h0
+    return float(h0s[best])
 
 
 def plan_surfaces(native, groups, h0) -> List[SurfacePlan]:
-    """Clusters (h < h0, transitively) of every group, each in greedy minimum-length order."""
+    """Clusters (h < h0, transitively) of every group, each in greedy minimum-length order. A
+    group whose threshold is above its reach first gets the pairs up to it (``g.h`` widened in
+    place, so that the live summary covers that h0 from then on)."""
     plans = []
     for g in groups.values():
         thr = group_threshold(native, g, h0)
+        if thr > g.h.reach:
+            g.h = g.h.with_reach(thr)
         for members in native.cluster_sources(g.h, thr):
             order = native.order_greedy(g.h, list(members))
             plans.append(SurfacePlan(group=g.group, threshold=thr,

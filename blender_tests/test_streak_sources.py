@@ -228,7 +228,7 @@ class StreakSourcesTest(unittest.TestCase):
         nat = native()
         frames = ss.load_frames(nat, self.folder, 1, 4)
         h0 = 1e6
-        everything = nat.cluster_sources(nat.streak_distances(frames, np.arange(n)), h0)
+        everything = nat.cluster_sources(nat.streak_distances(frames, np.arange(n), reach=h0), h0)
         self.assertEqual(len(everything), 1)  # unsplit, all would share one surface
         plans = ss.plan_surfaces(nat, ss.group_distances(nat, frames), h0)
         self.assertEqual(len(plans), 2)

@@ -157,7 +157,7 @@ class StreakSurfacesTest(unittest.TestCase):
         dom = bpy.data.objects["Domain"]
         groups = cached_distances(dom)
         self.assertIsNotNone(groups)
-        h = np.concatenate([g.h[np.triu_indices(len(g.h), 1)] for g in groups.values()])
+        h = np.concatenate([g.h.pairs()[2] for g in groups.values()])  # every h below the mean
         for q in (30, 20, 10, 5):
             dom.plume.domain.streak_threshold = float(np.percentile(h, q))
             n_surfaces, n_lines = live_summary(dom)
@@ -203,8 +203,9 @@ class StreakSurfacesTest(unittest.TestCase):
         self.assertGreater(top, 0.5)
 
     def test_2b_most_surfaces_threshold(self):
-        """plume.surfaces_pick_threshold sets the h0 of the peak of the Figure-4 curve: no h0
-        (checked just above and below every value of h) gives more surfaces."""
+        """plume.surfaces_pick_threshold sets the h0 of the peak of the Figure-4 curve: no h0 up
+        to the mean of h, where every pair below is held (checked just above and below every
+        value of h there), gives more surfaces; above it the count is not claimed."""
         from plume import _native
         from plume import streak_surfaces as ss
         from plume.operators.surfaces import compute_distances
@@ -215,11 +216,33 @@ class StreakSurfacesTest(unittest.TestCase):
         best = ss.summary(_native, groups, h0)
         print(f"  most surfaces: h0 = {h0:.4g} -> {best[0]} surfaces, {best[1]} streaklines")
         self.assertGreaterEqual(best[0], 2)
-        h = np.concatenate([g.h[np.triu_indices(len(g.h), 1)] for g in groups.values()])
+        reach = min(g.h.reach for g in groups.values())
+        self.assertEqual(reach, min(g.h.mean for g in groups.values()))
+        h = np.concatenate([g.h.pairs()[2] for g in groups.values()])
         for v in np.unique(h):
             for t in (v * (1 + 1e-6), v * (1 - 1e-6)):
-                if t > 0:
+                if 0 < t <= reach:
                     self.assertLessEqual(ss.summary(_native, groups, t)[0], best[0], t)
+        with self.assertRaisesRegex(ValueError, "above the reach"):
+            ss.summary(_native, groups, 1.5 * reach)
+
+    def test_2c_threshold_above_the_mean(self):
+        """An explicit h0 above the mean of h: the panel has no count until a build holds the
+        pairs up to it (the build widens the cached distances), then counts live again."""
+        from plume.operators.surfaces import cached_distances, live_summary
+        dom = bpy.data.objects["Domain"]
+        d = dom.plume.domain
+        self.build()  # caches the distances up to the default h0
+        mean = min(g.h.mean for g in cached_distances(dom).values())
+        try:
+            d.streak_threshold = 1.5 * mean
+            self.assertIsNone(live_summary(dom))
+            obs = self.build()
+            counts = live_summary(dom)
+            self.assertIsNotNone(counts)
+            self.assertEqual(counts[0], len(obs))
+        finally:
+            d.streak_threshold = 0.0
 
     def test_3_render_is_semi_transparent(self):
         if not surface_objects():

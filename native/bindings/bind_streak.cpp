@@ -1,15 +1,15 @@
 /// \file bind_streak.cpp
-/// Streaklines and their clustering for Python (smoke_surfaces.txt §3.2–3.3): point sources,
-/// the tracer, the per-frame streak files, the distances h, threshold h0, clusters and order.
+/// Streaklines for Python (smoke_surfaces.txt §3.2): point sources, the tracer and the
+/// per-frame streak files (their clustering, §3.3, is in bind_streak_clusters.cpp).
 /// Conversions and docstrings only; long calls release the GIL.
 
 #include "bindings/bindings.h"
+#include "bindings/streak_frames.h"
 
 #include "io/streak_file.h"
 #include "io/tracer_state_file.h"
 #include "solver/emitters.h"
 #include "solver/smoke_solver.h"
-#include "streak/clustering.h"
 #include "tracers/point_sources.h"
 #include "tracers/streak_tracer.h"
 #include "tracers/tracer_driver.h"
@@ -111,8 +111,10 @@ py::array_t<T> vectorToNumpy(const std::vector<S>& v) {
 // --- streak frames ------------------------------------------------------------------------
 
 /// A snapshot-like dict as a StreakFrame. counts and positions are required; density too when
-/// `needDensity`; groups and outside default to zeros.
-StreakFrame toFrame(const py::handle& obj, bool needDensity, const std::string& what) {
+/// `needDensity`; groups and outside default to zeros. With `positionsOnly`, density and outside
+/// are neither read nor filled (empty), for code that reads counts, positions and groups only.
+StreakFrame toFrame(const py::handle& obj, bool needDensity, const std::string& what,
+                    bool positionsOnly = false) {
   if (!py::isinstance<py::dict>(obj))
     throw py::value_error(what + " must be a dict with counts, positions, density");
   py::dict d = py::reinterpret_borrow<py::dict>(obj);
@@ -125,6 +127,23 @@ StreakFrame toFrame(const py::handle& obj, bool needDensity, const std::string& 
   f.counts = toInts(ensureArray<LongC>(get("counts", true), what + ": counts"), "counts");
   f.positions = toPoints(ensureArray<FloatC>(get("positions", true), what + ": positions"), "positions");
   const std::size_t m = f.positions.size();
+  if (positionsOnly) {
+    const py::object groups = get("groups", false);
+    f.groups = groups.is_none() ? std::vector<int>(f.counts.size(), 0)
+                                : toInts(ensureArray<LongC>(groups, what + ": groups"), "groups");
+    std::size_t total = 0;
+    for (int c : f.counts) {
+      if (c < 0) throw py::value_error(what + ": counts hold " + std::to_string(c) + " (negative)");
+      total += std::size_t(c);
+    }
+    if (f.groups.size() != f.counts.size())
+      throw py::value_error(what + ": " + std::to_string(f.groups.size()) + " groups for " +
+                            std::to_string(f.counts.size()) + " sources");
+    if (m != total)
+      throw py::value_error(what + ": counts sum to " + std::to_string(total) + " particles but there are " +
+                            std::to_string(m) + " positions");
+    return f;
+  }
   const py::object density = get("density", needDensity);
   if (density.is_none()) {
     f.density.assign(m, 0.f);
@@ -150,13 +169,6 @@ StreakFrame toFrame(const py::handle& obj, bool needDensity, const std::string& 
   return f;
 }
 
-std::vector<StreakFrame> toFrames(const py::sequence& frames) {
-  std::vector<StreakFrame> out;
-  out.reserve(std::size_t(py::len(frames)));
-  for (std::size_t t = 0; t < std::size_t(py::len(frames)); ++t)
-    out.push_back(toFrame(frames[t], false, "snapshot " + std::to_string(t)));
-  return out;
-}
 
 py::dict frameToDict(const StreakFrame& f) {
   py::dict d;
@@ -166,24 +178,6 @@ py::dict frameToDict(const StreakFrame& f) {
   d["groups"] = vectorToNumpy<std::int32_t>(f.groups);
   d["outside"] = vectorToNumpy<bool>(f.outside);
   return d;
-}
-
-// --- distance matrices -------------------------------------------------------------------------
-
-DistanceMatrix toMatrix(const DoubleC& a) {
-  if (a.ndim() != 2 || a.shape(0) != a.shape(1))
-    throw py::value_error("h must be a square (n, n) matrix, got shape " + shapeOf(a));
-  DistanceMatrix h;
-  h.size = int(a.shape(0));
-  h.values.assign(a.data(), a.data() + a.size());
-  h.validate();
-  return h;
-}
-
-py::array_t<double> matrixToNumpy(const DistanceMatrix& h) {
-  py::array_t<double> a({py::ssize_t(h.size), py::ssize_t(h.size)});
-  if (!h.values.empty()) std::memcpy(a.mutable_data(), h.values.data(), h.values.size() * sizeof(double));
-  return a;
 }
 
 // --- grids ----------------------------------------------------------------------------------
@@ -346,6 +340,18 @@ void bindTracer(py::module_& m) {
 
 }  // namespace
 
+std::vector<StreakFrame> toStreakFrames(const py::sequence& snapshots, bool positionsOnly) {
+  std::vector<StreakFrame> out;
+  out.reserve(std::size_t(py::len(snapshots)));
+  for (std::size_t t = 0; t < std::size_t(py::len(snapshots)); ++t)
+    out.push_back(toFrame(snapshots[t], false, "snapshot " + std::to_string(t), positionsOnly));
+  return out;
+}
+
+std::vector<int> toIntVector(const py::object& values, const std::string& name) {
+  return toInts(ensureArray<LongC>(values, name), name.c_str());
+}
+
 void bindStreak(py::module_& m) {
   m.def(
       "random_points_in_cells",
@@ -428,71 +434,6 @@ void bindStreak(py::module_& m) {
       "Reads a streak file into a snapshot dict. RuntimeError naming the path if it is missing, "
       "truncated or corrupt.");
   m.def("streak_file_name", &streakFileName, py::arg("frame"), "'streaks_0007.bin' for frame 7.");
-
-  m.def(
-      "streak_distances",
-      [](const py::sequence& snapshots, const LongC& sourceIds) {
-        const std::vector<StreakFrame> frames = toFrames(snapshots);
-        const std::vector<int> ids = toInts(sourceIds, "source_ids");
-        DistanceMatrix h;
-        {
-          py::gil_scoped_release release;
-          h = streakDistances(frames, ids);
-        }
-        return matrixToNumpy(h);
-      },
-      py::arg("snapshots"), py::arg("source_ids"),
-      "smoke_surfaces §3.3: h(α,β) = Σ_t [Σ_i |p(α,t,i) − p(β,t,i)|²] / N(t) over the given "
-      "per-frame snapshots (frames with N(t) = 0 skipped), for all pairs of source_ids. "
-      "float64 (n, n), symmetric, zero diagonal.");
-  m.def("default_threshold", [](const DoubleC& h) { return defaultThreshold(toMatrix(h)); },
-        py::arg("h"), "§3.3: default h0, the mean of h over pairs α < β (ValueError if n < 2).");
-  m.def("cluster_sources",
-        [](const DoubleC& h, double h0) { return clusterSources(toMatrix(h), h0); },
-        py::arg("h"), py::arg("h0"),
-        "§3.3: clusters of sources joined (transitively) by h < h0, each of >= 2 members, as "
-        "sorted lists of row indices of h. ValueError if h0 < 0 or not finite.");
-  m.def(
-      "cluster_summary",
-      [](const DoubleC& h, double h0) {
-        const ClusterSummary s = clusterSummary(toMatrix(h), h0);
-        return py::make_tuple(s.surfaces, s.streaklines);
-      },
-      py::arg("h"), py::arg("h0"),
-      "(surfaces, streaklines) that threshold h0 gives (Figure 4); cheap enough for live UI.");
-  m.def(
-      "order_greedy",
-      [](const DoubleC& h, const LongC& members) {
-        return orderGreedy(toMatrix(h), toInts(members, "members"));
-      },
-      py::arg("h"), py::arg("members"),
-      "§3.3 Figure 5: greedy minimum-length order of a cluster's members (row indices of h).");
-  m.def(
-      "build_surfaces",
-      [](const py::sequence& snapshots, const py::object& groups, double h0) {
-        const std::vector<StreakFrame> frames = toFrames(snapshots);
-        std::vector<int> g;
-        if (!groups.is_none()) g = toInts(ensureArray<LongC>(groups, "groups"), "groups");
-        std::vector<StreakSurface> surfaces;
-        {
-          py::gil_scoped_release release;
-          surfaces = buildSurfaces(frames, g, h0);
-        }
-        py::list out;
-        for (const StreakSurface& s : surfaces) {
-          py::dict d;
-          d["group"] = s.group;
-          d["threshold"] = s.threshold;
-          d["sources"] = s.sources;
-          out.append(d);
-        }
-        return out;
-      },
-      py::arg("snapshots"), py::arg("groups") = py::none(), py::arg("h0") = -1.0,
-      "§3.3 end to end: per candidate group (groups: one per source, None = the last snapshot's), "
-      "distances, threshold (h0 >= 0, or < 0 for the group's mean), clusters and greedy order. "
-      "List of dict(group, threshold, sources = ordered source IDs). ValueError when a group has "
-      "a single point source.");
 }
 
 }  // namespace plume::bindings

@@ -16,8 +16,11 @@ void bindIo(pybind11::module_& m);
 /// Streak-surface NURBS: interpolation, evaluation, tessellation, density map, OpenSubdiv export
 /// (bind_nurbs.cpp).
 void bindNurbs(pybind11::module_& m);
-/// Point sources, StreakTracer, streak files, distances/clusters/order (bind_streak.cpp).
+/// Point sources, StreakTracer, streak files (bind_streak.cpp).
 void bindStreak(pybind11::module_& m);
+/// StreakFrames, sparse StreakDistances, threshold, clusters, counts, greedy order
+/// (bind_streak_clusters.cpp).
+void bindStreakClusters(pybind11::module_& m);
 /// Mantaflow cache frames, volumes and the tracer driven by them (bind_mantaflow.cpp).
 void bindMantaflow(pybind11::module_& m);
 /// Toon smoke: particles, billboards, depth differences, toon files (bind_toon.cpp).

@@ -42,6 +42,7 @@ PYBIND11_MODULE(_native, m) {
   plume::bindings::bindIo(m);
   plume::bindings::bindNurbs(m);
   plume::bindings::bindStreak(m);
+  plume::bindings::bindStreakClusters(m);
   plume::bindings::bindMantaflow(m);
   plume::bindings::bindToon(m);
   plume::bindings::bindPathlineGroup(m);

@@ -1,12 +1,16 @@
 /// \file streak_test.cpp
-/// Streak surfaces §3.3 (smoke_surfaces.txt): h, h0 and clusters against brute force on random
-/// data, the greedy order on shuffled parallel streaklines, the streak file format, determinism
-/// across thread counts, and the time of clustering 20 sources × 300 frames.
+/// Streak surfaces §3.3 (smoke_surfaces.txt): h and the default h0 against the paper's formula on
+/// random data, the brute-force reference (clusters by transitive closure, threshold rules,
+/// Figure 5), the greedy order on shuffled parallel streaklines, whole surfaces per candidate
+/// group, the streak file format, and the time of 20 sources × 300 frames.
 
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "io/streak_file.h"
+#include "streak/brute_force.h"
 #include "streak/clustering.h"
+#include "streak/streak_moments.h"
+#include "streak_shots.h"
 
 #include <gtest/gtest.h>
 
@@ -17,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <numeric>
 #include <set>
 #include <stdexcept>
@@ -25,27 +30,6 @@ namespace fs = std::filesystem;
 
 namespace plume {
 namespace {
-
-/// Random frames: `sources` streaklines, N(t) particles each on frame t (N may be 0 or shrink).
-std::vector<StreakFrame> randomFrames(int sources, const std::vector<int>& n, std::uint64_t seed) {
-  Rng rng(seed);
-  std::vector<StreakFrame> frames;
-  for (int count : n) {
-    StreakFrame f;
-    f.counts.assign(std::size_t(sources), count);
-    f.groups.assign(std::size_t(sources), 0);
-    for (int s = 0; s < sources; ++s)
-      for (int i = 0; i < count; ++i) {
-        // Sources drift apart by s so that h varies over a wide range.
-        f.positions.push_back(glm::vec3(float(rng.uniform(-1, 1)) + 0.1f * float(s),
-                                        float(rng.uniform(-1, 1)), float(rng.uniform(0, 2))));
-        f.density.push_back(float(rng.uniform()));
-        f.outside.push_back(rng.uniform() < 0.1 ? 1 : 0);
-      }
-    frames.push_back(std::move(f));
-  }
-  return frames;
-}
 
 /// The paper's formula, literally: h(α,β) = Σ_t [Σ_{i=1}^{N(t)} |p(α,t,i) − p(β,t,i)|²] / N(t).
 double bruteH(const std::vector<StreakFrame>& frames, int alpha, int beta) {
@@ -101,11 +85,11 @@ TEST(StreakDistance, MatchesTheFormulaOnRandomData) {
   std::uint64_t seed = 1;
   for (const Case& c : cases) {
     const auto frames = randomFrames(c.sources, c.n, seed++);
-    // A shuffled subset of the sources as the group.
-    std::vector<int> ids(std::size_t(c.sources));
-    std::iota(ids.begin(), ids.end(), 0);
+    // The sources in reverse as the group's members.
+    std::vector<int> ids = iota(c.sources);
     std::reverse(ids.begin(), ids.end());
-    const DistanceMatrix h = streakDistances(frames, ids);
+    const StreakGroup group(share(frames), ids);
+    const DistanceMatrix h = bruteForceDistances(group);
     ASSERT_EQ(h.size, c.sources);
     double mean = 0.0;
     for (int a = 0; a < h.size; ++a) {
@@ -114,53 +98,86 @@ TEST(StreakDistance, MatchesTheFormulaOnRandomData) {
         const double expected = bruteH(frames, ids[std::size_t(a)], ids[std::size_t(b)]);
         EXPECT_NEAR(h(a, b), expected, 1e-12 * std::max(1.0, expected));
         EXPECT_EQ(h.values[std::size_t(a * h.size + b)], h.values[std::size_t(b * h.size + a)]);
+        EXPECT_EQ(h(a, b), streakDistance(group, b, a));  // symmetric, bit for bit
         mean += expected;
       }
     }
     mean /= 0.5 * h.size * (h.size - 1);
-    EXPECT_NEAR(defaultThreshold(h), mean, 1e-12 * mean);
-    // Clusters for thresholds across the range of h, the default included.
+    // The default h0 from centred sums equals the mean over the pairs.
+    EXPECT_NEAR(streakMoments(group).meanDistance, mean, 1e-12 * mean);
+    EXPECT_NEAR(bruteForceMean(h), mean, 1e-12 * mean);
+    // The reference clusters equal the transitive closure, the default h0 included; the
+    // sparse clusters equal both (distances held up to the largest threshold).
     std::vector<double> values;
     for (int a = 0; a < h.size; ++a)
       for (int b = a + 1; b < h.size; ++b) values.push_back(h(a, b));
     std::sort(values.begin(), values.end());
-    std::vector<double> thresholds{0.0, defaultThreshold(h), values.back() * 2.0};
+    std::vector<double> thresholds{0.0, bruteForceMean(h), values.back() * 2.0};
     for (double q : {0.1, 0.3, 0.5, 0.7, 0.9}) thresholds.push_back(values[std::size_t(q * double(values.size() - 1))]);
+    DistanceParams params;
+    params.reach = values.back() * 2.0;
+    const StreakDistances sparse(group, params);
     for (double h0 : thresholds) {
-      const auto clusters = clusterSources(h, h0);
+      const auto clusters = bruteForceClusters(h, h0);
       EXPECT_EQ(clusters, bruteClusters(h, h0)) << "h0 " << h0;
-      const ClusterSummary s = clusterSummary(h, h0);
+      EXPECT_EQ(clusterSources(sparse, h0), clusters) << "h0 " << h0;
+      const ClusterSummary s = bruteForceSummary(h, h0);
       EXPECT_EQ(s.surfaces, int(clusters.size()));
       int used = 0;
       for (const auto& cl : clusters) used += int(cl.size());
       EXPECT_EQ(s.streaklines, used);
+      EXPECT_EQ(clusterSummary(sparse, h0).surfaces, s.surfaces);
+      EXPECT_EQ(clusterSummary(sparse, h0).streaklines, s.streaklines);
     }
   }
 }
 
 TEST(StreakDistance, SkipsEmptyFramesAndRejectsUnequalCounts) {
   auto frames = randomFrames(3, {0, 2, 0, 3}, 9);
-  const DistanceMatrix h = streakDistances(frames, {0, 1, 2});
-  EXPECT_NEAR(h(0, 2), bruteH(frames, 0, 2), 1e-12);
+  const StreakGroup group(share(frames), {0, 1, 2});
+  EXPECT_EQ(group.usedFrameCount(), 2);
+  EXPECT_EQ(group.coordinateCount(), 15u);
+  EXPECT_NEAR(streakDistance(group, 0, 2), bruteH(frames, 0, 2), 1e-12);
   frames[1].counts = {2, 1, 3};
-  EXPECT_THROW(streakDistances(frames, {0, 1, 2}), std::invalid_argument);
-  EXPECT_THROW(streakDistances(randomFrames(3, {2}, 1), {0, 3}), std::invalid_argument);
+  try {
+    StreakGroup(share(frames), {0, 1, 2});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("equal counts"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(StreakGroup(share(randomFrames(3, {2}, 1)), {0, 3}), std::invalid_argument);
+  auto short_ = randomFrames(3, {2}, 1);
+  short_[0].positions.pop_back();
+  EXPECT_THROW(StreakGroup(share(short_), {0, 1}), std::invalid_argument);
+}
+
+TEST(StreakDistance, StopsEarlyOnlyAboveTheLimit) {
+  const auto frames = randomFrames(4, {3, 5, 8, 13}, 21);
+  const StreakGroup group(share(frames), iota(4));
+  const double h = streakDistance(group, 1, 3);
+  EXPECT_EQ(streakDistanceBelow(group, 1, 3, std::nextafter(h, 1e300)), h);  // below the limit: h itself
+  const double partial = streakDistanceBelow(group, 1, 3, 0.25 * h);
+  EXPECT_GE(partial, 0.25 * h);
+  EXPECT_LE(partial, h);
+  EXPECT_LT(partial, h);  // stopped before the last frame
 }
 
 TEST(StreakDistance, SameResultWithOneAndTwoThreads) {
-  const auto frames = randomFrames(17, {3, 5, 8, 13, 21, 34}, 5);
-  std::vector<int> ids(17);
-  std::iota(ids.begin(), ids.end(), 0);
+  const StreakGroup group(share(randomFrames(17, {3, 5, 8, 13, 21, 34}, 5)), iota(17));
   DistanceMatrix h1, h2;
+  double m1 = 0, m2 = 0;
   {
     ThreadLimit limit(1);
-    h1 = streakDistances(frames, ids);
+    h1 = bruteForceDistances(group);
+    m1 = streakMoments(group).meanDistance;
   }
   {
     ThreadLimit limit(2);
-    h2 = streakDistances(frames, ids);
+    h2 = bruteForceDistances(group);
+    m2 = streakMoments(group).meanDistance;
   }
   EXPECT_EQ(std::memcmp(h1.values.data(), h2.values.data(), h1.values.size() * sizeof(double)), 0);
+  EXPECT_EQ(m1, m2);
 }
 
 TEST(Clustering, ThresholdRulesAndSingletons) {
@@ -168,60 +185,56 @@ TEST(Clustering, ThresholdRulesAndSingletons) {
   h.size = 4;
   // 0-1 close, 2-3 close, cross pairs far.
   h.values = {0, 1, 9, 9, 1, 0, 9, 9, 9, 9, 0, 2, 9, 9, 2, 0};
-  EXPECT_EQ(clusterSources(h, 1.5), (std::vector<std::vector<int>>{{0, 1}}));  // 2-3 has h = 2
-  EXPECT_EQ(clusterSources(h, 2.5), (std::vector<std::vector<int>>{{0, 1}, {2, 3}}));
-  EXPECT_EQ(clusterSources(h, 1.0).size(), 0u);  // strict: h < h0
-  const ClusterSummary s = clusterSummary(h, 100.0);
+  EXPECT_EQ(bruteForceClusters(h, 1.5), (std::vector<std::vector<int>>{{0, 1}}));  // 2-3 has h = 2
+  EXPECT_EQ(bruteForceClusters(h, 2.5), (std::vector<std::vector<int>>{{0, 1}, {2, 3}}));
+  EXPECT_EQ(bruteForceClusters(h, 1.0).size(), 0u);  // strict: h < h0
+  const ClusterSummary s = bruteForceSummary(h, 100.0);
   EXPECT_EQ(s.surfaces, 1);
   EXPECT_EQ(s.streaklines, 4);
-  EXPECT_THROW(clusterSources(h, -1.0), std::invalid_argument);
-  EXPECT_THROW(clusterSummary(h, NAN), std::invalid_argument);
+  EXPECT_THROW(bruteForceClusters(h, -1.0), std::invalid_argument);
+  EXPECT_THROW(bruteForceSummary(h, NAN), std::invalid_argument);
   DistanceMatrix one;
   one.size = 1;
   one.values = {0};
-  EXPECT_THROW(defaultThreshold(one), std::invalid_argument);
-}
+  EXPECT_THROW(bruteForceMean(one), std::invalid_argument);
 
-/// Frames of `n` parallel straight streaklines: source i at (i·d, 0, 0), particles rising along z.
-std::vector<StreakFrame> parallelStreaks(const std::vector<int>& slotOfSource, float d, int frames) {
-  std::vector<StreakFrame> out;
-  const int n = int(slotOfSource.size());
-  for (int t = 0; t < frames; ++t) {
-    StreakFrame f;
-    const int N = t + 1;
-    f.counts.assign(std::size_t(n), N);
-    f.groups.assign(std::size_t(n), 0);
-    for (int s = 0; s < n; ++s)
-      for (int i = 0; i < N; ++i) {
-        const float slot = float(slotOfSource[std::size_t(s)]);
-        // The lines fan out from their sources (straight, spacing growing with height).
-        f.positions.push_back(glm::vec3(slot * d * (1.f + 0.01f * float(N - i)), 0.f, 0.1f * float(N - i)));
-        f.density.push_back(1.f);
-        f.outside.push_back(0);
-      }
-    out.push_back(std::move(f));
-  }
-  return out;
+  // The same rules on sparse distances: one-particle streaklines with h(0,1) = 1, h(2,3) = 2,
+  // h(1,2) = 81, h(0,2) = 100, h(1,3) = 101, h(0,3) = 122 (exact in float).
+  StreakFrame f;
+  f.counts = {1, 1, 1, 1};
+  f.groups = {0, 0, 0, 0};
+  f.positions = {{0, 0, 0}, {1, 0, 0}, {10, 0, 0}, {11, 1, 0}};
+  const StreakGroup group(share({f}), iota(4));
+  DistanceParams params;
+  params.reach = 100.0;
+  const StreakDistances sparse(group, params);
+  EXPECT_EQ(sparse.pairCount(), 3u);  // h(0,2) = 100 is not below the reach 100
+  EXPECT_EQ(clusterSummary(sparse, 100.0).streaklines, 4);  // joined through h(1,2) = 81
+  EXPECT_EQ(clusterSources(sparse, 1.5), (std::vector<std::vector<int>>{{0, 1}}));
+  EXPECT_EQ(clusterSources(sparse, 2.5), (std::vector<std::vector<int>>{{0, 1}, {2, 3}}));
+  EXPECT_EQ(clusterSources(sparse, 1.0).size(), 0u);
+  EXPECT_EQ(clusterSummary(sparse, 2.0).surfaces, 1);
+  EXPECT_EQ(clusterSummary(sparse, 2.5).surfaces, 2);
+  EXPECT_THROW(clusterSources(sparse, -1.0), std::invalid_argument);
+  EXPECT_THROW(clusterSummary(sparse, NAN), std::invalid_argument);
+  EXPECT_THROW(clusterSources(sparse, 100.5), std::invalid_argument);  // above the reach
+  EXPECT_THROW(StreakDistances(StreakGroup(share({f}), {2})), std::invalid_argument);  // default h0 of 1
 }
 
 TEST(Ordering, RecoversShuffledParallelStreaklines) {
   for (int n : {2, 3, 5, 9, 16}) {
     for (std::uint64_t seed = 0; seed < 5; ++seed) {
       // slotOfSource: a random permutation of 0..n-1 (Fisher–Yates with a seeded Rng).
-      std::vector<int> slot(static_cast<std::size_t>(n));
-      std::iota(slot.begin(), slot.end(), 0);
+      std::vector<int> slot = iota(n);
       Rng rng(seed, std::uint64_t(n));
       for (int i = n - 1; i > 0; --i) std::swap(slot[std::size_t(i)], slot[std::size_t(rng.next() % std::uint64_t(i + 1))]);
-      const auto frames = parallelStreaks(slot, 0.05f, 12);
-      std::vector<int> ids(static_cast<std::size_t>(n));
-      std::iota(ids.begin(), ids.end(), 0);
-      const DistanceMatrix h = streakDistances(frames, ids);
-      const std::vector<int> order = orderGreedy(h, ids);
+      const StreakGroup group(share(parallelStreaks(slot, 0.05f, 12)), iota(n));
+      const StreakDistances h(group);  // reach: the mean; the order needs h beyond it too
+      const std::vector<int> order = orderGreedy(h, iota(n));
+      EXPECT_EQ(order, bruteForceOrder(bruteForceDistances(group), iota(n)));
       std::vector<int> slots;
       for (int m : order) slots.push_back(slot[std::size_t(m)]);
-      std::vector<int> up(static_cast<std::size_t>(n)), down(static_cast<std::size_t>(n));
-      std::iota(up.begin(), up.end(), 0);
-      std::reverse_copy(up.begin(), up.end(), down.begin());
+      std::vector<int> up = iota(n), down(up.rbegin(), up.rend());
       EXPECT_TRUE(slots == up || slots == down) << "n " << n << " seed " << seed;
     }
   }
@@ -232,17 +245,30 @@ TEST(Ordering, FigureFiveAndMembersSubset) {
   DistanceMatrix h;
   h.size = 3;
   h.values = {0, 2, 1, 2, 0, 3, 1, 3, 0};
-  const auto order = orderGreedy(h, {0, 1, 2});
+  const auto order = bruteForceOrder(h, {0, 1, 2});
   EXPECT_TRUE(order == (std::vector<int>{2, 0, 1}) || order == (std::vector<int>{1, 0, 2}));
-  EXPECT_EQ(orderGreedy(h, {2}), std::vector<int>{2});
-  EXPECT_EQ(orderGreedy(h, {1, 2}), (std::vector<int>{1, 2}));
-  EXPECT_THROW(orderGreedy(h, {0, 0}), std::invalid_argument);
-  EXPECT_THROW(orderGreedy(h, {3}), std::invalid_argument);
+  EXPECT_EQ(bruteForceOrder(h, {2}), std::vector<int>{2});
+  EXPECT_EQ(bruteForceOrder(h, {1, 2}), (std::vector<int>{1, 2}));
+  EXPECT_THROW(bruteForceOrder(h, {0, 0}), std::invalid_argument);
+  EXPECT_THROW(bruteForceOrder(h, {3}), std::invalid_argument);
+  // Figure 5 on streaklines: a at 0, c at 1, b at -1.5 (h(a,c) = 1 < h(a,b) = 2.25 < h(b,c)).
+  StreakFrame f;
+  f.counts = {1, 1, 1};
+  f.groups = {0, 0, 0};
+  f.positions = {{0, 0, 0}, {-1.5f, 0, 0}, {1, 0, 0}};
+  const StreakDistances sparse(StreakGroup(share({f}), iota(3)));
+  EXPECT_EQ(sparse.pairCount(), 2u);  // below the mean (1 + 2.25 + 6.25) / 3: a-c and a-b
+  const auto sparseOrder = orderGreedy(sparse, {0, 1, 2});
+  EXPECT_TRUE(sparseOrder == (std::vector<int>{2, 0, 1}) || sparseOrder == (std::vector<int>{1, 0, 2}));
+  EXPECT_EQ(orderGreedy(sparse, {2}), std::vector<int>{2});
+  EXPECT_EQ(orderGreedy(sparse, {1, 2}), (std::vector<int>{1, 2}));  // the one pair beyond the reach
+  EXPECT_THROW(orderGreedy(sparse, {0, 0}), std::invalid_argument);
+  EXPECT_THROW(orderGreedy(sparse, {3}), std::invalid_argument);
 }
 
 TEST(BuildSurfaces, OneOrderedSurfacePerSeparatedGroupOfLines) {
-  // Group 7: 4 lines, one cluster at the default threshold? Two bundles far apart instead, so
-  // the default h0 (mean) separates them: bundle A slots 0..2, bundle B slots 40..42.
+  // Two bundles far apart, so the default h0 (mean) separates them: bundle A slots 0..2,
+  // bundle B slots 40..42.
   const std::vector<int> slot{41, 0, 40, 2, 42, 1};
   auto frames = parallelStreaks(slot, 0.05f, 6);
   const std::vector<int> groups(6, 7);
@@ -257,6 +283,12 @@ TEST(BuildSurfaces, OneOrderedSurfacePerSeparatedGroupOfLines) {
   };
   EXPECT_EQ(slotsOf(surfaces[0]), (std::vector<int>{40, 41, 42}));  // first member: source 0
   EXPECT_EQ(slotsOf(surfaces[1]), (std::vector<int>{0, 1, 2}));
+  const auto reference = bruteForceSurfaces(frames, groups, -1.0);
+  ASSERT_EQ(reference.size(), surfaces.size());
+  for (std::size_t s = 0; s < surfaces.size(); ++s) {
+    EXPECT_EQ(reference[s].sources, surfaces[s].sources);
+    EXPECT_EQ(reference[s].threshold, surfaces[s].threshold);
+  }
   // A huge explicit h0 joins everything into one surface.
   EXPECT_EQ(buildSurfaces(frames, groups, 1e9)[0].sources.size(), 6u);
   // A group with one source is an error naming it.
@@ -274,21 +306,25 @@ TEST(BuildSurfaces, TwentySourcesThreeHundredFramesTiming) {
   std::vector<int> n;
   for (int t = 1; t <= frames; ++t) n.push_back(2 * t + 1);
   const auto data = randomFrames(sources, n, 3);
-  std::vector<int> ids(sources);
-  std::iota(ids.begin(), ids.end(), 0);
+  const std::vector<int> groups(std::size_t(sources), 0);
   const auto t0 = std::chrono::steady_clock::now();
-  const DistanceMatrix h = streakDistances(data, ids);
+  const StreakDistances h(StreakGroup(share(data), iota(sources)));
   const auto t1 = std::chrono::steady_clock::now();
-  const auto surfaces = buildSurfaces(data, std::vector<int>(sources, 0), -1.0);
+  const auto surfaces = buildSurfaces(data, groups, -1.0);
   const auto t2 = std::chrono::steady_clock::now();
   const ClusterSummary s = clusterSummary(h, defaultThreshold(h));
   const auto t3 = std::chrono::steady_clock::now();
+  const auto reference = bruteForceSurfaces(data, groups, -1.0);
+  const auto t4 = std::chrono::steady_clock::now();
   using ms = std::chrono::duration<double, std::milli>;
-  std::printf("[ timing ] 20 sources x 300 frames (%zu particles/frame at the end): h %.1f ms, "
-              "buildSurfaces %.1f ms (%zu surfaces), clusterSummary %.3f ms\n",
-              data.back().positions.size(), ms(t1 - t0).count(), ms(t2 - t1).count(),
-              surfaces.size(), ms(t3 - t2).count());
+  std::printf("[ timing ] 20 sources x 300 frames (%zu particles/frame at the end): distances "
+              "%.1f ms (%zu pairs held), buildSurfaces %.1f ms (%zu surfaces), clusterSummary "
+              "%.3f ms, brute force %.1f ms\n",
+              data.back().positions.size(), ms(t1 - t0).count(), h.pairCount(), ms(t2 - t1).count(),
+              surfaces.size(), ms(t3 - t2).count(), ms(t4 - t3).count());
   EXPECT_GT(s.streaklines, 0);
+  ASSERT_EQ(reference.size(), surfaces.size());
+  for (std::size_t k = 0; k < surfaces.size(); ++k) EXPECT_EQ(reference[k].sources, surfaces[k].sources);
 }
 
 // --- streak files -------------------------------------------------------------------------------
