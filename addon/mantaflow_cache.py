@@ -1,4 +1,4 @@
-"""A Blender 3.4 Mantaflow gas cache as a streak bake reads it (issue 4), no ``bpy``: which files a
+"""A Blender 3.4 Mantaflow gas cache as a streak bake reads it, no ``bpy``: which files a
 frame range needs, the per-frame config, and the world placement of the grid.
 
 Layout (cache_data_format 'OPENVDB'; 'MODULAR', 'REPLAY' and 'ALL' caches alike)::

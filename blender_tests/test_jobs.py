@@ -118,8 +118,17 @@ class JobsTest(unittest.TestCase):
     def test_6_busy_domain_refuses_a_second_job(self):
         from plume.jobs import JobRunner, registry
 
-        class Holder(JobRunner):
+        class Holder(JobRunner):  # a running job that holds the domain, doing nothing
             title = "Build Surfaces"
+
+            def prepare(self, context):
+                pass
+
+            def run(self):
+                pass
+
+            def finish(self, context):
+                return 'INFO', ""
         holder = Holder()
         registry.claim(holder, [("domain", "Domain")])
         try:

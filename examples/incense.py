@@ -47,7 +47,7 @@ def make_domain(frames, resolution=RESOLUTION, name="Incense"):
     d.density_k_u, d.density_k_v = 4, 2
     d.sheet_color = (0.9, 0.92, 1.0, 1.0)
     d.sheet_brightness = 1.4
-    d.sheet_opacity = 0.4             # one sheet face-on: p = 0.4 d e^-1, edge-on 0.4 d
+    d.sheet_opacity = 1.0             # one sheet face-on: p = d e^-1, edge-on d
     return dom
 
 

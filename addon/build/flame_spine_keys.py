@@ -1,5 +1,5 @@
-"""Bake Spines to Keyframes (structural_flames.txt §4.1, issue 7 "spines shown as curve objects the
-artist can see and key"): the cached spines of the baked frames become one plain curve object per
+"""Bake Spines to Keyframes (structural_flames.txt §4.1: spines shown as curve objects the
+artist can see and key): the cached spines of the baked frames become one plain curve object per
 flame id, its points keyed on every frame the flame lives, so they exist without the add-on and
 an artist can re-key them.
 

@@ -42,7 +42,7 @@ class JobOperator:
 
     def make_runner(self, context):
         """A new JobRunner for this call (properties of the operator passed in)."""
-        raise NotImplementedError
+        raise TypeError(f"{type(self).__name__} must define make_runner(context)")
 
     # ------------------------------------------------------------------ blocking
     def execute(self, context):

@@ -21,6 +21,7 @@ cancel() is thread-safe and may come from the main thread (Esc, file load, a del
 any time; native objects that run long register with watch() and are cancelled with it.
 """
 
+import abc
 import threading
 import time
 from dataclasses import dataclass
@@ -57,7 +58,7 @@ class JobProgress:
         return (now - self.stage_started) / self.done * (self.total - self.done)
 
 
-class JobRunner:
+class JobRunner(abc.ABC):
     """Base of every job (see the module docstring for the protocol)."""
 
     #: Name in reports and the status bar: the operator's label ("Bake", "Build Surfaces").
@@ -91,19 +92,21 @@ class JobRunner:
         self.cancelled_at = None
 
     # ------------------------------------------------------------------ the four parts
+    @abc.abstractmethod
     def prepare(self, context):
-        raise NotImplementedError
+        """Snapshot and checks on the main thread; BakeError on bad input, nothing written."""
 
+    @abc.abstractmethod
     def run(self):
-        raise NotImplementedError
+        """The computation, on the worker thread: no bpy."""
 
     def main_steps(self, context):
         """Main-thread steps after run(), each yielding a JobProgress; none by default."""
         return iter(())
 
+    @abc.abstractmethod
     def finish(self, context):
         """Commits and builds; returns (report kind, text), e.g. ('INFO', "Plume: ...")."""
-        raise NotImplementedError
 
     def stage(self, folder):
         """A Staging in the cache folder `folder` for run()'s new files (made now); its path."""

@@ -1,5 +1,5 @@
 /// \file bench_flowgraph_graph.cpp
-/// Benchmark of the flow-graph build (issue 6, graph_fire_synthesis.txt §4.3): the cost matrix
+/// Benchmark of the flow-graph build (graph_fire_synthesis.txt §4.3): the cost matrix
 /// of eq. 9-10 and the graph (block candidates, ε, pruning) for 1,000 nodes of synthetic
 /// groups at |Ω| = 3200 pathlines and L = 48 samples (the paper's campfire: 3217 pathlines per
 /// node), at 1 and 2 threads. Not a test: run build/native/plume_bench_flowgraph_graph by hand.

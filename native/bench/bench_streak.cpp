@@ -1,7 +1,7 @@
 // Benchmarks of the streak-surface pipeline (smoke_surfaces.txt §3.3–3.4).
-//  * Issue 4: 20 point sources × 300 frames; what "Build Surfaces" does in the native core (h,
+//  * Figure 1's scale: 20 point sources × 300 frames; what "Build Surfaces" does in the native core (h,
 //    clusters, order, then per frame the NURBS and density map of every surface).
-//  * Issue 14: clustering that scales. 20,000 streaklines × 60 frames (N(t) = t + 1, so 60
+//  * An artist's scale: clustering that scales. 20,000 streaklines × 60 frames (N(t) = t + 1, so 60
 //    particles at the end): 1,250 clumps of 16 point sources spread over a sphere, rising,
 //    spreading and stirred by a smooth unsteady flow. Sparse distances, clusters and greedy
 //    orders in <= 2 s and <= 1 GB peak, the same surfaces as the brute force (checked on 2,000
@@ -34,7 +34,7 @@
 namespace plume {
 namespace {
 
-// --- issue 4: a small incense plume over a long shot --------------------------------------
+// --- a small incense plume over a long shot -----------------------------------------------
 
 constexpr int kSources = 20;
 constexpr int kFrames = 300;
@@ -120,7 +120,7 @@ void BM_StreakPipeline(benchmark::State& state) {
   state.counters["surface_frames"] = double(surfaceFrames);
 }
 
-// --- issue 14: thousands of streaklines -------------------------------------------------------
+// --- thousands of streaklines ----------------------------------------------------------------
 
 constexpr int kClump = 16;       // point sources per clump (10–20 per source cell, §3.2)
 constexpr int kShotFrames = 60;  // N(t) = t + 1
