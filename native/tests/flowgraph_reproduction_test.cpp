@@ -33,6 +33,9 @@
 #include <iostream>
 #include <iterator>
 #include <memory>
+#include <string>
+
+#include <unistd.h>
 
 namespace plume {
 namespace {
@@ -57,7 +60,9 @@ Bake bakeFire(int nodesPerFrame, float lifetime, int threads, bool half, const s
   pp.lifetime = lifetime;
   pp.recordPositions = true;
   Bake bake;
-  bake.path = ::testing::TempDir() + "plume_reproduction_" + name + ".bin";
+  // The process id keeps two test runs on one machine from sharing (and renaming) a file.
+  bake.path = ::testing::TempDir() + "plume_reproduction_" + std::to_string(::getpid()) + "_" +
+              name + ".bin";
   std::unique_ptr<PathlineFileWriter> writer;
   PathlineRecorder recorder(pp, params, burner,
                             [&](const PathlineGroup& g, const std::vector<glm::vec3>& trail) {
