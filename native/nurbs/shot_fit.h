@@ -14,8 +14,7 @@ namespace plume {
 struct ShotFitParams {
   SurfaceFitParams fit;
   /// ε: largest distance allowed between a kept particle and the sheet, world units (the
-  /// add-on passes a fraction of the cell size). Half of it goes to the fit along the
-  /// streaklines, the rest to the fit across them.
+  /// add-on passes a fraction of the cell size).
   double tolerance = 0.01;
   /// δ: largest distance allowed between a control point and the sheet at its Greville
   /// abscissae (SurfaceFit::netDeviation), world units: keeps the net an artist edits on the
@@ -39,17 +38,16 @@ struct NetSize {
 };
 
 /// Counts for a shot of frames (all with the same particles and lines; the kept ones may
-/// change): along u
-/// the smallest nu in [min(order_u, P), P] (P = particles, at least 2) for which every frame's
-/// streakline curves pass within ε of their particles and have their control points within δ
-/// of the curve (curveFitQuality()), by bisection; then, with that nu, the smallest nv in
-/// [min(order_v, L), L] (L = lines, at least 2) for which every frame's surface does
-/// (fitSurface()).
-/// Where the lines are too crumpled for that (a smooth sheet through them swings beyond δ even
-/// when it interpolates them: the greedy order of many streaklines zig-zags), the order across
-/// them drops (4, 3, then 2, whose control points are the lines' own curves) before nv is
-/// chosen. Where even the largest count misses, the largest is used; NetSize says what it gives.
-/// Frames are fitted in parallel; the result does not depend on the thread count.
+/// change): along u the smallest nu in [min(order_u, P), P] (P = particles, at least 2) for
+/// which every frame's streakline curves pass within ε of their particles and have their
+/// control points within δ of the curve (curveFitQuality()), by bisection; then, with that nu,
+/// the smallest nv in [min(order_v, L), L] (L = lines, at least 2) for which every frame's
+/// surface does (fitSurface()). Where the lines are too crumpled for that (a smooth sheet
+/// through them swings beyond δ even when it interpolates them: the greedy order of many
+/// streaklines zig-zags), the order across them drops (4, 3, then 2, whose control points are
+/// the lines' own curves) before nv is chosen. Where even the largest count misses, the largest
+/// is used; NetSize says what it gives. Frames are fitted in parallel; the result does not
+/// depend on the thread count.
 NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams& params);
 
 /// fitSurface() of every frame with the net `size` (its counts and orders; the rest of the
