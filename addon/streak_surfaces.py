@@ -5,12 +5,22 @@ cluster into per-frame NURBS control points and density maps.
     frames = load_frames(native, folder, frame_start, last_frame)
     groups = group_distances(native, frames)           # {group: GroupDistances}
     plans = plan_surfaces(native, groups, h0)          # one SurfacePlan per cluster
-    anim = surface_animation(native, frames, plan)     # control points per frame
+    anim = surface_animation(native, frames, plan, cell_size)   # control points per frame
 
 The distances are sparse (native StreakDistances): each group holds every pair with h below its
 reach, exactly, and no n x n matrix. The reach starts at the group's default h0 (the mean of h)
 and grows when a build asks for a larger threshold; clusters, counts and the Figure 4 curve are
 exact up to it, the greedy order always.
+
+The surface of a cluster is a least-squares fit, not an interpolation (issue 14): a net that
+interpolates every particle slot (nu = particles per streakline, the slots of particles not yet
+emitted stacked on the youngest, the particles that left the box flying on at their exit
+velocities) swings metres away from the smoke, so an artist moving a control point moved
+something far off. The fit (native nurbs/shot_fit.h) goes through the particles of fit_mask(),
+keeps each within FIT_TOLERANCE_CELLS of the sheet and every control point within
+NET_TOLERANCE_CELLS of it, with the smallest net that does so on every frame (fixed for the
+shot, as Blender's net is). Where the streaklines leave the simulated box through an open side
+the sheet ends: no smoke is simulated past it (density 0, as the tracer gives those particles).
 """
 
 import os
@@ -24,6 +34,16 @@ from .settings import BakeError
 
 #: Orders of the surfaces (cubic, lower when there are fewer points, as Blender allows).
 ORDER_U = ORDER_V = 4
+#: ε in cells: no particle of fit_mask() is farther than this from its sheet on any frame. Half
+#: a cell is the grid's own detail: the velocity the particles follow and the density the map
+#: reads are interpolated between cell centres a cell apart, so a sheet within half a cell of a
+#: particle reads the density the particle carries, while runs of particles that wobble below
+#: that need no control point of their own.
+FIT_TOLERANCE_CELLS = 0.5
+#: δ in cells: no control point is farther than this from the sheet at its Greville abscissae
+#: (the point it pulls hardest), so the net an artist edits hugs the smoke where streaklines
+#: curl; with ε this keeps control points within about 3 cells of the particles.
+NET_TOLERANCE_CELLS = 1.5
 
 
 @dataclass
@@ -51,9 +71,11 @@ class SurfaceAnimation:
     nv: int
     order_u: int
     order_v: int
-    particles: int  # particles per streakline at the last frame (u samples of the surface)
+    particles: int  # particles per streakline at the last frame (sets the density map's width)
     control_points: np.ndarray  # float32 (frames, nv * nu, 4), Blender's flat order v*nu+u
-    surfaces: list  # per frame: the interpolate_surface dict (for the density map)
+    surfaces: list  # per frame: a surface dict (control points, orders, particle parameters)
+    max_residual: np.ndarray  # per frame: largest particle-to-sheet distance (an upper bound)
+    net_deviation: np.ndarray  # per frame: largest control point-to-sheet distance
 
 
 def streak_manifest(folder, domain_name):
@@ -182,7 +204,8 @@ def plan_surfaces(native, groups, h0) -> List[SurfacePlan]:
 
 def streakline_grid(frame, sources, particles):
     """Points (nv, particles, 3) of the ordered streaklines at one frame, oldest particle first;
-    particles not yet emitted sit at their source (where the youngest particle is born)."""
+    particles not yet emitted sit at their source, where the youngest is (fit_mask leaves them
+    out)."""
     counts = np.asarray(frame["counts"], dtype=np.int64)
     offsets = np.concatenate([[0], np.cumsum(counts)])
     pos = np.asarray(frame["positions"], dtype=np.float64)
@@ -194,20 +217,46 @@ def streakline_grid(frame, sources, particles):
     return grid
 
 
-def surface_animation(native, frames, plan) -> SurfaceAnimation:
-    """interpolate_surface (§3.3) of the cluster's streaklines at every frame."""
-    particles = int(np.max(np.asarray(frames[-1]["counts"])[plan.sources]))
-    particles = max(particles, 1)
-    cps, dicts = [], []
-    for frame in frames:
-        s = native.interpolate_surface(streakline_grid(frame, plan.sources, particles),
-                                       order_u=ORDER_U, order_v=ORDER_V)
-        cps.append(np.asarray(s["control_points"], dtype=np.float32))
-        dicts.append(s)
-    s = dicts[-1]
-    return SurfaceAnimation(nu=int(s["nu"]), nv=int(s["nv"]), order_u=int(s["order_u"]),
-                            order_v=int(s["order_v"]), particles=particles,
-                            control_points=np.stack(cps), surfaces=dicts)
+def fit_mask(frame, sources, particles):
+    """Which particles (nv, particles) bool the frame's sheet goes through: on every streakline
+    the particles emitted so far from its source up to the first one that left the simulated
+    box through an open side (those carry no smoke: the tracer gives them density 0, and each
+    flies on with its own exit velocity, so a line past them is a scatter metres long, which a
+    smooth sheet cannot follow). Older particles still inside beyond such a gap are stragglers
+    of a line that has mostly left; the sheet ends before them. The youngest particle is always
+    kept, so every streakline has a place on the sheet."""
+    counts = np.asarray(frame["counts"], dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(counts)])
+    outside = np.asarray(frame["outside"], dtype=bool)
+    keep = np.zeros((len(sources), particles), dtype=bool)
+    for row, s in enumerate(sources):
+        n = min(int(counts[s]), particles)
+        gone = np.flatnonzero(outside[offsets[s]:offsets[s] + n])
+        first = int(gone[-1]) + 1 if len(gone) else 0
+        keep[row, min(first, n - 1):n] = True
+    return keep
+
+
+def surface_animation(native, frames, plan, cell_size, tolerance_cells=FIT_TOLERANCE_CELLS,
+                      net_tolerance_cells=NET_TOLERANCE_CELLS) -> SurfaceAnimation:
+    """The least-squares surfaces (§3.3, native fit_streak_shot) of the cluster's streaklines at
+    every frame, on one control net chosen for the whole shot, through the particles of
+    fit_mask() (not those not yet emitted, nor those past the open sides)."""
+    particles = max(int(np.max(np.asarray(frames[-1]["counts"])[plan.sources])), 1)
+    grids = np.stack([streakline_grid(f, plan.sources, particles) for f in frames])
+    keep = np.stack([fit_mask(f, plan.sources, particles) for f in frames])
+    shot = native.fit_streak_shot(grids.astype(np.float32), keep.astype(np.uint8),
+                                  tolerance=tolerance_cells * cell_size,
+                                  net_tolerance=net_tolerance_cells * cell_size,
+                                  order_u=ORDER_U, order_v=ORDER_V)
+    cps = np.asarray(shot["control_points"], dtype=np.float32)
+    head = {k: int(shot[k]) for k in ("nu", "nv", "order_u", "order_v")}
+    dicts = [dict(head, control_points=cps[n], endpoint_u=True, endpoint_v=True,
+                  params_u=np.asarray(shot["params_u"][n]), params_v=np.asarray(shot["params_v"][n]),
+                  keep=keep[n]) for n in range(len(frames))]
+    return SurfaceAnimation(particles=particles, control_points=cps, surfaces=dicts,
+                            max_residual=np.asarray(shot["max_residual"]),
+                            net_deviation=np.asarray(shot["net_deviation"]), **head)
 
 
 def dense_density(native, path, resolution):
@@ -233,26 +282,19 @@ def dense_density(native, path, resolution):
     return out
 
 
-def _uniform_columns(image, nodes, domain, rate):
-    """Resamples the map's columns (at the particles' parameters plus `rate` between them) onto
-    evenly spaced parameters over the drawn domain, which is how Blender lays out a SURFACE's
-    generated UVs (u = sample index / (samples - 1))."""
-    params = np.asarray(nodes, dtype=np.float64)
-    cols = params if rate == 0 else np.concatenate(
-        [np.linspace(a, b, rate + 2)[:-1] for a, b in zip(params[:-1], params[1:])] + [params[-1:]])
-    if len(cols) != image.shape[1] or len(cols) < 2:
-        return image
-    xs = np.linspace(domain[0], domain[1], image.shape[1])
-    return np.stack([np.interp(xs, cols, row) for row in image])
+def density_image_size(particles, lines, k_u, k_v):
+    """(width, height) of a surface's §3.4 map: as many samples as the paper's k_u (k_v) between
+    consecutive particles (streaklines) would give, (n - 1)(k + 1) + 1, at least 2."""
+    return (max((particles - 1) * (k_u + 1) + 1, 2), max((lines - 1) * (k_v + 1) + 1, 2))
 
 
 def density_image(native, surface, density, origin, cell_size, k_u, k_v, interpolation, particles,
                   lines):
-    """§3.4 density map (rows = v, columns = u) on Blender's UV layout, float32."""
-    img = np.asarray(native.density_map(surface, density, origin, cell_size, k_u, k_v,
-                                        interpolation), dtype=np.float64)
-    pu = np.asarray(surface["params_u"])[:particles]
-    pv = np.asarray(surface["params_v"])[:lines]
-    img = _uniform_columns(img, pu, surface["domain_u"], k_u)
-    img = _uniform_columns(img.T, pv, surface["domain_v"], k_v).T
-    return np.clip(img, 0.0, None).astype(np.float32)
+    """§3.4 density map (rows = v, columns = u) on Blender's UV layout, float32: sampled at
+    evenly spaced parameters over the drawn domain, where Blender's generated UVs put pixel x at
+    u = x / (width - 1) (the fitted surface's particles sit at chord-length parameters, so the
+    even samples are also evenly spread along the smoke). 0 outside the simulated box."""
+    width, height = density_image_size(particles, lines, k_u, k_v)
+    img = native.density_map_on_domain(surface, density, origin, cell_size, width, height,
+                                       interpolation)
+    return np.clip(np.asarray(img, dtype=np.float32), 0.0, None)

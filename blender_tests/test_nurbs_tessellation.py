@@ -3,7 +3,9 @@
 For 2, 3, 5 and 11 streaklines of 1, 2, 3, 4 and 7 particles, with endpoint and uniform knots:
 the core interpolates the particles (plume._native.interpolate_surface), a SURFACE object is built
 from its control points by the add-on's builder (BLENDER_NOTES.md §2), and the vertices of the object's
-evaluated mesh must equal plume._native.tessellate() (<= 1e-4 of the domain size).
+evaluated mesh must equal plume._native.tessellate() (<= 1e-4 of the domain size). The same for
+least-squares nets with fewer control points than particles (plume._native.fit_surface, what
+Build Surfaces makes), orders 4, 3 and 2 across the streaklines.
 
 Uses the installed add-on's native module (CI installs the fresh build before running this).
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
@@ -107,6 +109,39 @@ class NurbsTessellationTest(unittest.TestCase):
             bpy.data.curves.remove(curve)
             bpy.context.view_layer.update()
 
+
+
+def _check_fit(self, lines, particles, nu, nv, order_v):
+    pts = particles_of(lines, particles, seed=7 * lines + particles)
+    s = self.native.fit_surface(pts, nu=nu, nv=nv, order_v=order_v)
+    self.assertEqual((s["nu"], s["nv"], s["order_v"]), (nu, nv, min(order_v, nv)))
+    ob = surface_object(f"F_{lines}_{particles}", s, RESOLUTION_U, RESOLUTION_V)
+    try:
+        got = evaluated_vertices(ob)
+        expect = self.native.tessellate(s, RESOLUTION_U, RESOLUTION_V).reshape(-1, 3)
+        err = float(np.abs(got - expect).max())
+        type(self).worst = max(type(self).worst, err)
+        self.assertLessEqual(err, 1e-4 * DOMAIN_SIZE, f"max vertex difference {err}")
+    finally:
+        curve = ob.data
+        bpy.data.objects.remove(ob, do_unlink=True)
+        bpy.data.curves.remove(curve)
+        bpy.context.view_layer.update()
+
+
+particles_of = particles
+
+
+def _add_fit_case(lines, count, nu, nv, order_v):
+    def test(self):
+        _check_fit(self, lines, count, nu, nv, order_v)
+    test.__doc__ = f"fit of {lines} streaklines x {count} particles on a {nu} x {nv} net"
+    setattr(NurbsTessellationTest, f"test_fit_{lines:02d}x{count}_net_{nu}x{nv}_o{order_v}", test)
+
+
+for _case in ((5, 7, 5, 3, 4), (11, 40, 12, 6, 4), (3, 20, 6, 3, 3), (2, 9, 4, 2, 4),
+              (11, 40, 9, 11, 2)):
+    _add_fit_case(*_case)
 
 
 def _add_case(nv, nu, endpoint_u, endpoint_v):

@@ -1,8 +1,11 @@
 """Hand edits of streak surfaces (smoke_surfaces.txt §5, Figure 13), Bake to Keyframes and the
 OpenSubdiv mesh export, on the Figure 1 setup of test_streak_surfaces.py (50³, 20 point sources).
 
-An edit made on frame 10 is stored as offsets in (u, v) control-point index space and shows,
-moved with the surface, on frame 1, the last frame and frame 200: point = cache(frame) + offset.
+An edit made on frame 10 is stored per control point (u, v index) as an offset in the sheet's
+local frame there (tangent, binormal, normal at the control point's Greville abscissae) and
+shows, moved and turned with the surface, on frame 1, the last frame and frame 200:
+point = cache(frame) + R(frame) R(10)ᵀ move. A sheet turned by 90° between two frames carries
+its edit turned by 90°; world-space edits of older files are migrated.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_surface_edits.py
@@ -17,11 +20,13 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import add_domain, compat, reset_scene, rmtree, run, select_only, temp_dir  # noqa: E402
+from helpers import (add_domain, compat, native, reset_scene, rmtree, run,  # noqa: E402
+                     select_only, temp_dir)
 from test_streak_surfaces import FRAMES, build_scene, counts, surface_objects  # noqa: E402
 
 EDIT_FRAME = 10
 MOVE = np.array([0.15, -0.05, 0.25], dtype=np.float32)
+EDITS = "plume_surface_edits_local"
 
 
 def points_of(ob, evaluated=False):
@@ -42,6 +47,38 @@ def cache_points(ob):
 def cache_at(ob, frame):
     start, cps = cache_points(ob)
     return cps[min(max(frame - start, 0), len(cps) - 1)]
+
+
+def frames_at(ob, frame):
+    """Local frames (n, 3, 3), rows tangent, binormal, normal, of the cached surface on `frame`,
+    at the control points' Greville abscissae; a control point without one there takes the
+    nearest cached frame's."""
+    start, cps = cache_points(ob)
+    sp = ob.data.splines[0]
+
+    def at(i):
+        s = {"control_points": cps[i], "nu": sp.point_count_u, "nv": sp.point_count_v,
+             "order_u": sp.order_u, "order_v": sp.order_v}
+        axes, valid = native().control_point_frames(s)
+        return np.array(axes), np.asarray(valid, bool)
+
+    i = min(max(frame - start, 0), len(cps) - 1)
+    axes, valid = at(i)
+    for step in range(1, len(cps)):
+        for j in (i - step, i + step):
+            if 0 <= j < len(cps) and not valid.all():
+                other, ok = at(j)
+                fill = ~valid & ok
+                axes[fill], valid = other[fill], valid | fill
+    return axes
+
+
+def moved_by(ob, frame, edit_frame=EDIT_FRAME):
+    """MOVE made on edit_frame, as it shows on `frame`: turned from that frame's local frames
+    into this one's, float64 (len(edited_indices), 3)."""
+    k = edited_indices(ob)
+    local = np.einsum("nkj,j->nk", frames_at(ob, edit_frame)[k], MOVE.astype(np.float64))
+    return np.einsum("nk,nkj->nj", local, frames_at(ob, frame)[k])
 
 
 def edited_indices(ob):
@@ -90,7 +127,7 @@ class SurfaceEditsTest(unittest.TestCase):
         bpy.context.scene.frame_set(frame)
         want = cache_at(ob, frame).copy()
         if moved:
-            want[edited_indices(ob), :3] += MOVE
+            want[edited_indices(ob), :3] += moved_by(ob, frame)
         np.testing.assert_allclose(points_of(ob, evaluated), want, atol=1e-5,
                                    err_msg=f"{ob.name} on frame {frame}")
 
@@ -99,23 +136,30 @@ class SurfaceEditsTest(unittest.TestCase):
         edited = self.edit_on_frame(ob)
         for f in (1, FRAMES, 200):  # captured by the handler on the first frame change
             self.assert_follows(ob, f)
-        off = np.asarray(ob["plume_surface_edits"]).reshape(-1, 3)
+        off = np.asarray(ob[EDITS]).reshape(-1, 3)
         self.assertEqual(off.shape[0], len(ob.data.splines[0].points))
-        np.testing.assert_allclose(off[edited_indices(ob)], np.tile(MOVE, (4, 1)), atol=1e-5)
+        local = np.einsum("nkj,j->nk", frames_at(ob, EDIT_FRAME)[edited_indices(ob)], MOVE)
+        np.testing.assert_allclose(off[edited_indices(ob)], local, atol=1e-5)
+        np.testing.assert_allclose(np.linalg.norm(local, axis=1), np.linalg.norm(MOVE), rtol=1e-5)
         mask = np.ones(len(off), bool)
         mask[edited_indices(ob)] = False
         self.assertEqual(np.abs(off[mask]).max(), 0.0)
         # Back on frame 10 the edited net is exactly what the artist left.
         bpy.context.scene.frame_set(EDIT_FRAME)
         np.testing.assert_allclose(points_of(ob), edited, atol=1e-5)
-        # The surface moved between frames 1 and the last, so did the edited points.
+        # The surface moved between frames 1 and the last, so did the edited points, and the
+        # sheet turned there: so did the offsets.
         self.assertGreater(np.abs(cache_at(ob, 1) - cache_at(ob, FRAMES)).max(), 0.05)
+        turned = np.abs(moved_by(ob, FRAMES) - MOVE).max()
+        print(f"  edit offset turned with the sheet by up to {turned:.3f} (|move| = "
+              f"{np.linalg.norm(MOVE):.3f}) between frames {EDIT_FRAME} and {FRAMES}")
+        self.assertGreater(turned, 1e-3)
         for o in others:  # the other sheets follow the plain cache
-            self.assertNotIn("plume_surface_edits", o)
+            self.assertNotIn(EDITS, o)
             self.assert_follows(o, FRAMES, moved=False)
         # Clear Edits (domain active: all its surfaces) puts the cache back.
         self.assertEqual(bpy.ops.plume.surface_edits_clear(), {'FINISHED'})
-        self.assertNotIn("plume_surface_edits", ob)
+        self.assertNotIn(EDITS, ob)
         np.testing.assert_allclose(points_of(ob), cache_at(ob, bpy.context.scene.frame_current),
                                    atol=0)
         for f in (1, FRAMES):
@@ -134,7 +178,7 @@ class SurfaceEditsTest(unittest.TestCase):
             self.assertEqual(bpy.ops.plume.surface_edits_store(), {'FINISHED'})
         finally:
             bpy.ops.object.mode_set(mode='OBJECT')
-        self.assertIn("plume_surface_edits", ob)
+        self.assertIn(EDITS, ob)
         for f in (1, FRAMES, 200):
             self.assert_follows(ob, f)
         select_only(ob)
@@ -146,8 +190,9 @@ class SurfaceEditsTest(unittest.TestCase):
         self.edit_on_frame(ob)
         select_only(ob)
         self.assertEqual(bpy.ops.plume.surface_edits_store(), {'FINISHED'})
-        np.testing.assert_allclose(np.asarray(ob["plume_surface_edits"]).reshape(-1, 3)[
-            edited_indices(ob)], np.tile(MOVE, (4, 1)), atol=1e-5)
+        np.testing.assert_allclose(np.asarray(ob[EDITS]).reshape(-1, 3)[edited_indices(ob)],
+                                   np.einsum("nkj,j->nk", frames_at(ob, EDIT_FRAME)[
+                                       edited_indices(ob)], MOVE), atol=1e-5)
         self.assert_follows(ob, 1)
         self.assertEqual(bpy.ops.plume.surface_edits_clear(), {'FINISHED'})
 
@@ -238,5 +283,72 @@ class SurfaceEditsTest(unittest.TestCase):
         bpy.data.objects.remove(other, do_unlink=True)
 
 
+class SheetTurnTest(unittest.TestCase):
+    """A flat sheet that turns 90° about z between frames 1 and 2 (a cache written by hand):
+    an edit made on frame 1 shows turned by 90° on frame 2; a world-space edit of an older file
+    is migrated so that the frame it was made on is unchanged and it turns from there."""
+
+    NU, NV = 6, 4
+    TURN = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90° about z
+    K = 2 * 6 + 3  # control point (u, v) = (3, 2), inside the net
+
+    def setUp(self):
+        reset_scene()
+        bpy.context.view_layer.update()  # drop the removed default objects from the view layer
+        self.tmp = temp_dir("plume_turn_")
+        from plume.build import surfaces as build
+        u, v = np.meshgrid(np.linspace(0.2, 0.7, self.NU), np.linspace(0.1, 0.4, self.NV))
+        flat = np.stack([u, np.zeros_like(u), v, np.ones_like(u)], -1).reshape(-1, 4)
+        turned = flat.copy()
+        turned[:, :3] = flat[:, :3] @ self.TURN.T
+        self.cps = np.stack([flat, turned]).astype(np.float32)
+        path = os.path.join(self.tmp, "surface_0.npz")
+        np.savez(path, control_points=self.cps, frame_start=1, nu=self.NU, nv=self.NV,
+                 order_u=4, order_v=4)
+        scn = bpy.context.scene
+        self.ob = build.surface_object("Turning", scn.collection, self.NU, self.NV,
+                                       bpy.context.view_layer)
+        sp = self.ob.data.splines[0]
+        sp.order_u = sp.order_v = 4
+        sp.use_endpoint_u = sp.use_endpoint_v = True
+        self.ob[build.CACHE_KEY] = path
+        scn.frame_set(1)
+
+    def tearDown(self):
+        rmtree(self.tmp)
+
+    def test_edit_turns_with_the_sheet(self):
+        sp = self.ob.data.splines[0]
+        np.testing.assert_allclose(points_of(self.ob), self.cps[0], atol=1e-6)
+        x, y, z, w = sp.points[self.K].co
+        sp.points[self.K].co = (x + MOVE[0], y + MOVE[1], z + MOVE[2], w)
+        bpy.context.scene.frame_set(2)
+        got = points_of(self.ob)[self.K, :3] - self.cps[1][self.K, :3]
+        np.testing.assert_allclose(got, self.TURN @ MOVE, atol=1e-5)
+        others = np.arange(self.NU * self.NV) != self.K
+        np.testing.assert_allclose(points_of(self.ob)[others], self.cps[1][others], atol=1e-6)
+        bpy.context.scene.frame_set(1)  # and back: the edit where it was made
+        np.testing.assert_allclose(points_of(self.ob)[self.K, :3] - self.cps[0][self.K, :3], MOVE,
+                                   atol=1e-5)
+
+    def test_world_space_edits_of_older_files_are_migrated(self):
+        world = np.zeros((self.NU * self.NV, 3))
+        world[self.K] = MOVE
+        # What older versions stored and wrote: world offsets, points = cache + offsets.
+        self.ob["plume_surface_edits"] = world.ravel()
+        self.ob["plume_surface_frame"] = 0
+        sp = self.ob.data.splines[0]
+        x, y, z, w = sp.points[self.K].co
+        sp.points[self.K].co = (x + MOVE[0], y + MOVE[1], z + MOVE[2], w)
+        bpy.context.scene.frame_set(2)
+        self.assertNotIn("plume_surface_edits", self.ob)
+        self.assertIn(EDITS, self.ob)
+        got = points_of(self.ob)[self.K, :3] - self.cps[1][self.K, :3]
+        np.testing.assert_allclose(got, self.TURN @ MOVE, atol=1e-5)
+        bpy.context.scene.frame_set(1)
+        np.testing.assert_allclose(points_of(self.ob)[self.K, :3] - self.cps[0][self.K, :3], MOVE,
+                                   atol=1e-5)
+
+
 if __name__ == "__main__":
-    run(SurfaceEditsTest)
+    run(SurfaceEditsTest, SheetTurnTest)

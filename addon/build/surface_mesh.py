@@ -55,6 +55,31 @@ def read_density(path):
     return np.ascontiguousarray(px.reshape(h, w, 4)[..., 0])
 
 
+def net_layout(density, sp):
+    """The sheet's density map, laid out evenly over the drawn domain as Blender's generated UVs
+    are, resampled (bilinearly) onto the layout subdivide_mesh refines as a primvar: pixel
+    (a (k + 1), b (k + 1)) at control point (a, b)'s Greville abscissae, k pixels evenly between
+    neighbours (k as fine as the map)."""
+    def coords(n, order, endpoint, size):
+        g = np.asarray(_native.greville_abscissae(n, order, endpoint), dtype=np.float64)
+        lo, hi = _native.nurbs_domain(n, order, endpoint)
+        k = max(int(round((size - 1) / (n - 1))) - 1, 0)
+        t = np.concatenate([np.linspace(a, b, k + 2)[:-1] for a, b in zip(g[:-1], g[1:])] +
+                           [g[-1:]])
+        return np.clip((t - lo) / (hi - lo), 0.0, 1.0) * (size - 1)
+
+    h, w = density.shape
+    x = coords(sp.point_count_u, sp.order_u, sp.use_endpoint_u, w)
+    y = coords(sp.point_count_v, sp.order_v, sp.use_endpoint_v, h)
+    x0 = np.minimum(np.floor(x).astype(np.int64), w - 1)
+    y0 = np.minimum(np.floor(y).astype(np.int64), h - 1)
+    x1, y1 = np.minimum(x0 + 1, w - 1), np.minimum(y0 + 1, h - 1)
+    fx, fy = (x - x0)[None, :], (y - y0)[:, None]
+    rows0 = density[y0][:, x0] * (1 - fx) + density[y0][:, x1] * fx
+    rows1 = density[y1][:, x0] * (1 - fx) + density[y1][:, x1] * fx
+    return np.ascontiguousarray(rows0 * (1 - fy) + rows1 * fy, dtype=np.float32)
+
+
 def export_mesh(ob, frame, level):
     """Creates or replaces the MESH object f"{ob.name}_mesh"; returns it. BakeError on bad input
     (the scene is unchanged then). Blocking: inputs(), refine() and mesh_object() in a row."""
@@ -65,7 +90,7 @@ def inputs(ob, frame):
     """(surface name, control points, nu, nv, density map) of the surface at `frame`: what
     refine() needs, read on the main thread. BakeError when the cache is missing."""
     sp = ob.data.splines[0]
-    density = read_density(sheet_file(ob, frame))
+    density = net_layout(read_density(sheet_file(ob, frame)), sp)
     return ob.name, surface_edits.current_points(ob), sp.point_count_u, sp.point_count_v, density
 
 

@@ -105,6 +105,7 @@ def register():
 def unregister():
     frame_handlers.remove(frame_change_pre)
     _loaded.clear()
+    surface_edits._frames.clear()
 
 
 # --------------------------------------------------------------------------- objects
@@ -163,6 +164,7 @@ def remove_surfaces(domain):
         bpy.data.collections.remove(coll)
     domain.plume.domain.surfaces_collection = ""
     _loaded.clear()
+    surface_edits._frames.clear()
 
 
 def build_surfaces(context, domain, folder, frame_start, anims, sheets, settings):

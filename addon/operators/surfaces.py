@@ -118,7 +118,7 @@ class SurfacesJob(JobRunner):
         for i, plan in enumerate(plans):
             self.set_progress(i, len(plans), "surface")
             self.check_cancel()
-            anims.append(ss.surface_animation(_native, frames, plan))
+            anims.append(ss.surface_animation(_native, frames, plan, float(m["cell_size"])))
         self.anims = anims
         self.maps = self._density_maps(folder, m, anims, self.settings)
         staged = self.stage(folder)

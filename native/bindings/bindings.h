@@ -16,6 +16,9 @@ void bindIo(pybind11::module_& m);
 /// Streak-surface NURBS: interpolation, evaluation, tessellation, density map, OpenSubdiv export
 /// (bind_nurbs.cpp).
 void bindNurbs(pybind11::module_& m);
+/// Least-squares streak surfaces: fit_surface, fit_streak_shot, control_point_frames
+/// (bind_nurbs_fit.cpp).
+void bindNurbsFit(pybind11::module_& m);
 /// Point sources, StreakTracer, streak files (bind_streak.cpp).
 void bindStreak(pybind11::module_& m);
 /// StreakFrames, sparse StreakDistances, threshold, clusters, counts, greedy order

@@ -41,6 +41,7 @@ PYBIND11_MODULE(_native, m) {
   plume::bindings::bindSolver(m);
   plume::bindings::bindIo(m);
   plume::bindings::bindNurbs(m);
+  plume::bindings::bindNurbsFit(m);
   plume::bindings::bindStreak(m);
   plume::bindings::bindStreakClusters(m);
   plume::bindings::bindMantaflow(m);

@@ -21,6 +21,13 @@ void BandedLu::set(int i, int j, double value) {
   mFactored = false;
 }
 
+void BandedLu::add(int i, int j, double value) {
+  if (i < 0 || j < 0 || i >= mN || j >= mN || i - j > mLower || j - i > mUpper)
+    throw std::invalid_argument("BandedLu::add: entry outside the band");
+  at(i, j) += value;
+  mFactored = false;
+}
+
 void BandedLu::factor() {
   // Row interchanges move entries at most `lower` rows up, so U gets lower + upper
   // super-diagonals: the extra `lower` storage rows on top of each column hold that fill-in.
@@ -32,7 +39,7 @@ void BandedLu::factor() {
     for (int i = j + 1; i <= lastRow; ++i)
       if (std::abs(at(i, j)) > std::abs(at(p, j))) p = i;
     mPivot[std::size_t(j)] = p;
-    if (at(p, j) == 0.0) throw std::runtime_error("interpolation system is singular");
+    if (at(p, j) == 0.0) throw std::runtime_error("B-spline system is singular");
     if (p != j)
       for (int c = j; c <= lastCol; ++c) std::swap(at(p, c), at(j, c));
     const double pivot = at(j, j);

@@ -1,8 +1,9 @@
 #pragma once
 /// \file banded_lu.h
 /// LU factorisation with partial pivoting of a banded matrix (LAPACK dgbtrf's storage scheme),
-/// for the B-spline collocation systems of the §3.3 surface interpolation: row i has at most
-/// `order` non-zeros near the diagonal, so factor and solve cost O(n · order²).
+/// for the B-spline systems of the §3.3 surface: the collocation matrices of the interpolation
+/// (row i has at most `order` non-zeros near the diagonal) and the normal equations of the
+/// least-squares fit (bandwidth order − 1), so factor and solve cost O(n · order²).
 
 #include <glm/glm.hpp>
 
@@ -18,6 +19,8 @@ class BandedLu {
   int size() const { return mN; }
   /// Sets A(i, j); |i - j| must be inside the band given to the constructor.
   void set(int i, int j, double value);
+  /// A(i, j) += value (normal equations are sums of outer products); same band rule as set().
+  void add(int i, int j, double value);
   /// Factorises PA = LU with partial pivoting inside the band. Throws std::runtime_error if a
   /// pivot is zero (the system has no unique solution).
   void factor();

@@ -32,9 +32,14 @@ double fractionalIndex(const std::vector<double>& p, double t) {
 }
 
 float sampleWorld(const ScalarGrid& density, const DensityMapParams& params, glm::vec3 world) {
+  // Cell coordinates: the grid's box is [0, n] on each axis.
+  const glm::vec3 c = (world - params.origin) / params.cellSize;
+  const glm::vec3 n(density.size());
+  // Outside the box no smoke is simulated (the tracer sets a particle's density to 0 once it
+  // crosses a side, tracers/domain_sides.h): the sampler would repeat the edge cells instead.
+  if (c.x < 0.f || c.y < 0.f || c.z < 0.f || c.x > n.x || c.y > n.y || c.z > n.z) return 0.f;
   // Index space of core/sampling.h: sample (i,j,k) sits at the cell centre.
-  const glm::vec3 p = (world - params.origin) / params.cellSize - glm::vec3(0.5f);
-  return sample(density, p, params.interpolation);
+  return sample(density, c - glm::vec3(0.5f), params.interpolation);
 }
 
 void checkGrid(const ScalarGrid& density) {
@@ -73,11 +78,36 @@ DensityMap densityMap(const NurbsSurface& surface, const ScalarGrid& density,
                       const DensityMapParams& params) {
   params.validate();
   surface.validate();
-  checkGrid(density);
   const SurfaceParameters particles = particleParameters(surface);
+  return densityMapAt(surface, density, params, supersampleParameters(particles.u, params.samplingU),
+                      supersampleParameters(particles.v, params.samplingV));
+}
+
+std::vector<double> evenParameters(double start, double end, int count) {
+  if (count < 2 || !std::isfinite(start) || !std::isfinite(end))
+    throw std::invalid_argument("even parameters need count >= 2 and a finite interval");
+  std::vector<double> t(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i)
+    t[std::size_t(i)] = start + (end - start) * double(i) / double(count - 1);
+  t.back() = end;
+  return t;
+}
+
+DensityMap densityMapAt(const NurbsSurface& surface, const ScalarGrid& density,
+                        const DensityMapParams& params, const std::vector<double>& us,
+                        const std::vector<double>& vs) {
+  params.validate();
+  surface.validate();
+  checkGrid(density);
+  if (us.empty() || vs.empty())
+    throw std::invalid_argument("density map needs parameters in u and v");
+  for (const std::vector<double>* t : {&us, &vs})
+    for (std::size_t i = 0; i < t->size(); ++i)
+      if (!std::isfinite((*t)[i]) || (i > 0 && (*t)[i] < (*t)[i - 1]))
+        throw std::invalid_argument("density map parameters must be finite and increasing");
   DensityMap map;
-  map.parametersU = supersampleParameters(particles.u, params.samplingU);
-  map.parametersV = supersampleParameters(particles.v, params.samplingV);
+  map.parametersU = us;
+  map.parametersV = vs;
   map.width = int(map.parametersU.size());
   map.height = int(map.parametersV.size());
   const std::vector<glm::vec3> points = surfaceGrid(surface, map.parametersU, map.parametersV);

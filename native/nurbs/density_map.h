@@ -47,10 +47,23 @@ struct DensityMap {
 std::vector<double> supersampleParameters(const std::vector<double>& nodes, int rate);
 
 /// §3.4: samples `density` (a grid of the solver, sampled with params.interpolation) at the
-/// surface points S(u, v) for the supersampled particle parameters (particleParameters()).
+/// surface points S(u, v) for the supersampled particle parameters (particleParameters() of an
+/// interpolating surface). Points outside the grid's box [origin, origin + size·Δx] read 0:
+/// no smoke is simulated there, as the tracer gives particles that left the domain density 0.
 /// Rows run in parallel; the result does not depend on the thread count.
 DensityMap densityMap(const NurbsSurface& surface, const ScalarGrid& density,
                       const DensityMapParams& params);
+
+/// The same sampling (params.samplingU/V unused) at the parameters us × vs, e.g. the evenly
+/// spaced ones of Blender's generated UVs (evenParameters()) for a fitted surface, whose
+/// particles sit at chord-length parameters.
+DensityMap densityMapAt(const NurbsSurface& surface, const ScalarGrid& density,
+                        const DensityMapParams& params, const std::vector<double>& us,
+                        const std::vector<double>& vs);
+
+/// `count` evenly spaced parameters from start to end (Blender lays a SURFACE's generated UVs
+/// out this way over the drawn domain: u = sample / (samples − 1)). count >= 2.
+std::vector<double> evenParameters(double start, double end, int count);
 
 /// Figure 8's reconstruction: the map read at surface parameters (u, v), linear between its
 /// samples in each direction (bilinear), parameters clamped to the map.

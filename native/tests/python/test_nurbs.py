@@ -90,3 +90,90 @@ def test_bad_points_raise_value_error():
         _native.interpolate_surface(np.full((2, 2, 3), np.nan))
     with pytest.raises(ValueError, match="order_u"):
         _native.interpolate_surface(sheet(2, 3), order_u=7)
+
+
+# --- the least-squares streak surface (§3.3 with an editable net) ---------------------------
+
+def rising_shot(frames=12, lines=4, steps=2):
+    """Points (frames, lines, particles, 3) float32 of a swirling rising plume and keep flags:
+    particles born so far (the unborn slots hold garbage the fit must ignore)."""
+    particles = frames * steps
+    pts = np.full((frames, lines, particles, 3), 1e6, np.float32)
+    keep = np.zeros((frames, lines, particles), np.uint8)
+    for f in range(frames):
+        born = (f + 1) * steps
+        age = (born - 1 - np.arange(born)) / (24.0 * steps)
+        for b in range(lines):
+            ph = 2 * np.pi * b / lines
+            fan = 0.02 + 0.08 * age
+            pts[f, b, :born] = np.stack([0.5 + fan * np.cos(ph + 3 * age),
+                                         0.5 + fan * np.sin(ph + 3 * age),
+                                         0.05 + 0.1 * age + 0.2 * age ** 2], -1)
+            keep[f, b, :born] = 1
+    return pts, keep
+
+
+def test_fit_surface_stays_within_its_residual():
+    pts, keep = rising_shot()
+    s = _native.fit_surface(pts[-1], keep[-1], nu=8, nv=4)
+    assert (s["nu"], s["nv"], s["order_u"], s["order_v"]) == (8, 4, 4, 4)
+    assert s["params_u"].shape == pts.shape[1:3]
+    k = keep[-1] > 0
+    u = s["params_u"][k]
+    v = np.broadcast_to(s["params_v"][:, None], k.shape)[k]
+    err = np.linalg.norm(_native.surface_point(s, u, v) - pts[-1][k], axis=-1)
+    assert err.max() <= s["max_residual"] + 1e-6
+    assert s["max_residual"] < 0.01
+    assert np.isnan(s["params_u"][~k]).all()
+    with pytest.raises(ValueError, match="keep must be flags"):
+        _native.fit_surface(pts[-1], keep[-1, :2], nu=8, nv=4)
+    with pytest.raises(ValueError, match="no particle is kept"):
+        _native.fit_surface(pts[-1], np.zeros_like(keep[-1]), nu=8, nv=4)
+
+
+def test_fit_streak_shot_chooses_one_net_for_every_frame():
+    pts, keep = rising_shot()
+    cell = 1.0 / 40
+    shot = _native.fit_streak_shot(pts, keep, tolerance=0.5 * cell, net_tolerance=1.5 * cell)
+    frames, lines, particles = keep.shape
+    assert 4 <= shot["nu"] < particles and 2 <= shot["nv"] <= lines
+    assert shot["control_points"].shape == (frames, shot["nu"] * shot["nv"], 4)
+    assert shot["max_residual"].max() <= 0.5 * cell
+    assert shot["net_deviation"].max() <= 1.5 * cell
+    assert len(shot["params_u"]) == frames
+    fixed = _native.fit_streak_shot(pts, keep, tolerance=cell, net_tolerance=cell, nu=6, nv=3,
+                                    order_v=3)
+    assert (fixed["nu"], fixed["nv"], fixed["order_v"]) == (6, 3, 3)
+    with pytest.raises(ValueError, match="tolerance"):
+        _native.fit_streak_shot(pts, keep, tolerance=0.0, net_tolerance=cell)
+    with pytest.raises(ValueError, match="keep must have shape"):
+        _native.fit_streak_shot(pts, keep[:-1], tolerance=cell, net_tolerance=cell)
+
+
+def test_control_point_frames_turn_with_the_surface():
+    pts, keep = rising_shot()
+    s = _native.fit_surface(pts[-1], keep[-1], nu=8, nv=4)
+    axes, valid = _native.control_point_frames(s)
+    assert axes.shape == (32, 3, 3) and valid.all()
+    np.testing.assert_allclose(np.einsum("nij,nkj->nik", axes, axes),
+                               np.broadcast_to(np.eye(3), axes.shape), atol=1e-12)
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90° about z
+    turned = dict(s, control_points=s["control_points"].copy())
+    turned["control_points"][:, :3] = s["control_points"][:, :3] @ turn.T
+    after, _ = _native.control_point_frames(turned)
+    np.testing.assert_allclose(after, axes @ turn.T, atol=1e-5)
+
+
+def test_density_map_on_domain_is_zero_outside_the_grid():
+    pts = sheet(3, 6)
+    s = _native.interpolate_surface(pts)
+    grid = np.ones((16, 16, 8), np.float32)
+    # The grid covers [0, 1]^2 x [0, 0.5] only: the sheet (z from 0.1 to 0.9) leaves it at the top.
+    img = _native.density_map_on_domain(s, grid, (0.0, 0.0, 0.0), 0.0625, 11, 5)
+    assert img.shape == (5, 11)
+    u = np.linspace(*s["domain_u"], 11)
+    v = np.linspace(*s["domain_v"], 5)
+    z = _native.surface_point(s, *np.meshgrid(u, v))[..., 2]
+    assert np.all(img[z > 0.5] == 0.0) and np.all(img[z < 0.49] == 1.0)
+    with pytest.raises(ValueError, match="count >= 2"):
+        _native.density_map_on_domain(s, grid, (0.0, 0.0, 0.0), 0.0625, 1, 5)

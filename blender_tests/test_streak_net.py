@@ -1,0 +1,143 @@
+"""The streak surfaces' control nets stay on the smoke (issue 14: smoke_surfaces.txt §3.3 as a
+least-squares fit instead of an interpolation of every particle slot).
+
+Two bakes: a reduced Figure 1 set-up (examples/incense.py: 50³, one tip cell with 20 point
+sources, 40 frames, the Most Surfaces threshold) and a 2 m domain at 40³ with a UV-sphere Source
+of radius 0.25 m (one point source per cell: 256 streaklines), 60 frames, default threshold
+(all of them in one sheet). For every surface on every frame: no control point is farther than
+3 cells from the nearest particle of its surface, and the sheet passes within the fit tolerance
+(streak_surfaces.FIT_TOLERANCE_CELLS) of every particle it goes through (fit_mask: emitted, not
+past an open side). The surface cache holds the fitted points and Blender's net has their size;
+on the sphere scene the net has fewer control points than particles along the streaklines and
+none outside the domain. The interpolating nets of the same particles (the surfaces before the
+fit) are printed for comparison.
+
+Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
+         --python blender_tests/test_streak_net.py
+"""
+
+import os
+import sys
+import time
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(os.path.dirname(HERE), "examples"))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (add_domain, add_sphere_source, reset_scene, rmtree, run,  # noqa: E402
+                     select_only, temp_dir)
+
+NEAR_CELLS = 3.0  # no control point farther than this from the nearest particle of its surface
+
+
+def nearest(points, cloud):
+    """Distance from each of points (n, 3) to the nearest of cloud (m, 3), float64."""
+    cloud = np.unique(np.asarray(cloud, np.float64), axis=0)
+    cc = (cloud * cloud).sum(1)
+    out = np.empty(len(points))
+    for i in range(0, len(points), 512):
+        p = np.asarray(points[i:i + 512], np.float64)
+        d = (p * p).sum(1)[:, None] + cc[None, :] - 2.0 * (p @ cloud.T)
+        out[i:i + 512] = np.sqrt(np.maximum(d.min(1), 0.0))
+    return out
+
+
+class StreakNetTest(unittest.TestCase):
+    def setUp(self):
+        reset_scene()
+        self.tmp = temp_dir("plume_streak_net_")
+        self.cache = os.path.join(self.tmp, "cache")
+
+    def tearDown(self):
+        rmtree(self.tmp)
+
+    def bake_and_build(self, dom, most_surfaces):
+        select_only(dom)
+        t0 = time.perf_counter()
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        t1 = time.perf_counter()
+        if most_surfaces:
+            self.assertEqual(bpy.ops.plume.surfaces_pick_threshold(), {'FINISHED'})
+        self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})
+        print(f"  bake {t1 - t0:.1f} s, Build Surfaces {time.perf_counter() - t1:.1f} s")
+
+    def check_nets(self, dom, label):
+        """Asserts the two bounds on every surface and frame; returns the figures."""
+        from plume import _native, cache
+        from plume import streak_surfaces as ss
+        from plume.operators.surfaces import compute_distances
+        folder, m, frames, groups = compute_distances(dom)
+        cell = float(m["cell_size"])
+        lo = np.asarray(m["origin"], np.float64)
+        hi = lo + np.asarray(m["resolution"]) * cell
+        plans = ss.plan_surfaces(_native, groups, dom.plume.domain.streak_threshold)
+        obs = [bpy.data.objects[f"{dom.name}_surface_{i}"] for i in range(len(plans))]
+        fig = dict(net=[], particles=[], cp=0.0, cp_kept=0.0, residual=0.0, old_cp=0.0,
+                   outside=0, points=0)
+        for i, (plan, ob) in enumerate(zip(plans, obs)):
+            anim = ss.surface_animation(_native, frames, plan, cell)
+            with np.load(cache.surface_path(folder, i)) as z:
+                np.testing.assert_array_equal(z["control_points"], anim.control_points)
+            sp = ob.data.splines[0]
+            self.assertEqual((sp.point_count_u, sp.point_count_v), (anim.nu, anim.nv))
+            self.assertEqual((sp.order_u, sp.order_v), (anim.order_u, anim.order_v))
+            fig["net"].append(f"{anim.nu}x{anim.nv}")
+            fig["particles"].append(anim.particles)
+            for f, frame in enumerate(frames):
+                full = ss.streakline_grid(frame, plan.sources, anim.particles)
+                counts = np.asarray(frame["counts"])[plan.sources]
+                born = np.arange(anim.particles)[None, :] < counts[:, None]
+                s = anim.surfaces[f]
+                keep = s["keep"]
+                cp = anim.control_points[f][:, :3]
+                fig["cp"] = max(fig["cp"], nearest(cp, full[born]).max() / cell)
+                fig["cp_kept"] = max(fig["cp_kept"], nearest(cp, full[keep]).max() / cell)
+                u = s["params_u"][keep]
+                v = np.broadcast_to(s["params_v"][:, None], keep.shape)[keep]
+                res = np.linalg.norm(_native.surface_point(s, u, v) - full[keep], axis=-1)
+                fig["residual"] = max(fig["residual"], res.max() / cell)
+                if f == len(frames) - 1:
+                    fig["outside"] += int(np.any((cp < lo - 1e-6) | (cp > hi + 1e-6), axis=1).sum())
+                    fig["points"] += len(cp)
+                    old = _native.interpolate_surface(full, order_u=ss.ORDER_U,
+                                                      order_v=ss.ORDER_V)["control_points"]
+                    fig["old_cp"] = max(fig["old_cp"], nearest(old[:, :3], full[born]).max() / cell)
+        print(f"  {label}: {len(plans)} surfaces, nets {', '.join(fig['net'])} (particles per "
+              f"streakline {max(fig['particles'])}); farthest control point from the nearest "
+              f"particle {fig['cp']:.2f} cells ({fig['cp_kept']:.2f} from those fitted); largest "
+              f"particle-to-sheet residual {fig['residual']:.3f} cells (tolerance "
+              f"{ss.FIT_TOLERANCE_CELLS}); last frame: {fig['outside']} of {fig['points']} control "
+              f"points outside the domain; the interpolating net of the last frame: "
+              f"{fig['old_cp']:.1f} cells")
+        self.assertLessEqual(fig["cp"], NEAR_CELLS)
+        self.assertLessEqual(fig["residual"], ss.FIT_TOLERANCE_CELLS * (1 + 1e-6))
+        return fig
+
+    def test_figure_1_incense(self):
+        import incense
+        frames = 40
+        incense.make_source(frames)
+        dom = incense.make_domain(frames)
+        dom.plume.domain.cache_directory = self.cache + "/"
+        self.bake_and_build(dom, most_surfaces=True)
+        fig = self.check_nets(dom, "incense, 40 frames")
+        self.assertGreaterEqual(len(fig["net"]), 2)
+
+    def test_sphere_source_at_40(self):
+        src = add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35))
+        src.plume.source.point_sources = 1
+        dom = add_domain(resolution=40, frame_end=60, cache_directory=self.cache + "/")
+        dom.plume.domain.streaks = True
+        self.bake_and_build(dom, most_surfaces=False)
+        fig = self.check_nets(dom, "sphere source, 40³, 60 frames")
+        nu = [int(n.split("x")[0]) for n in fig["net"]]
+        self.assertLess(max(nu), min(fig["particles"]))
+        self.assertEqual(fig["outside"], 0)
+
+
+if __name__ == "__main__":
+    run(StreakNetTest)

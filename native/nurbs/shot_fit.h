@@ -1,0 +1,58 @@
+#pragma once
+/// \file shot_fit.h
+/// The streak surface of a whole shot (smoke_surfaces.txt §3.3): Blender keeps one control-net
+/// topology per object, so the counts nu × nv are chosen once, as the smallest that fit every
+/// frame within a tolerance, and every frame is fitted with them (fitSurface()).
+
+#include "nurbs/surface_fit.h"
+
+#include <vector>
+
+namespace plume {
+
+/// Settings of the shot's fit. Field names are the Python names in snake_case.
+struct ShotFitParams {
+  SurfaceFitParams fit;
+  /// ε: largest distance allowed between a kept particle and the sheet, world units (the
+  /// add-on passes a fraction of the cell size).
+  double tolerance = 0.01;
+  /// δ: largest distance allowed between a control point and the sheet at its Greville
+  /// abscissae (SurfaceFit::netDeviation), world units: keeps the net an artist edits on the
+  /// smoke where the streaklines curl (a coarse net that fits within ε still cuts corners far
+  /// outside the curls; an interpolating one swings off).
+  double netTolerance = 0.04;
+
+  /// Throws std::invalid_argument: fit.validate(), tolerance and net_tolerance finite and > 0.
+  void validate() const;
+};
+
+/// The chosen control counts (and order across the streaklines) and the worst fit they give.
+struct NetSize {
+  int nu = 2;
+  int nv = 2;
+  int orderU = 2;  ///< the order used along the streaklines (at most fit.orderU)
+  int orderV = 2;  ///< the order used across the streaklines (at most fit.orderV)
+  double maxResidual = 0.0;     ///< max over frames of SurfaceFit::maxResidual
+  double netDeviation = 0.0;    ///< max over frames of SurfaceFit::netDeviation
+  double netToParticles = 0.0;  ///< max over frames of SurfaceFit::netToParticles
+};
+
+/// Counts for a shot of frames (all with the same particles and lines; the kept ones may
+/// change): along u the smallest nu in [min(order_u, P), P] (P = particles, at least 2) for
+/// which every frame's streakline curves pass within ε of their particles and have their
+/// control points within δ of the curve (curveFitQuality()), by bisection; then, with that nu,
+/// the smallest nv in [min(order_v, L), L] (L = lines, at least 2) for which every frame's
+/// surface does (fitSurface()). Where the lines are too crumpled for that (a smooth sheet
+/// through them swings beyond δ even when it interpolates them: the greedy order of many
+/// streaklines zig-zags), the order across them drops (4, 3, then 2, whose control points are
+/// the lines' own curves) before nv is chosen. Where even the largest count misses, the largest
+/// is used; NetSize says what it gives. Frames are fitted in parallel; the result does not
+/// depend on the thread count.
+NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams& params);
+
+/// fitSurface() of every frame with the net `size` (its counts and orders; the rest of the
+/// settings from `params`), with netToParticles() filled in; in parallel, deterministic.
+std::vector<SurfaceFit> fitShot(const std::vector<StreakGrid>& frames, const NetSize& size,
+                                const SurfaceFitParams& params);
+
+}  // namespace plume

@@ -1,0 +1,225 @@
+#include "nurbs/surface_fit.h"
+
+#include "core/parallel.h"
+#include "nurbs/chord_parameters.h"
+#include "nurbs/evaluation.h"
+#include "nurbs/interpolation.h"
+#include "nurbs/knots.h"
+#include "nurbs/least_squares.h"
+#include "nurbs/near_particles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace plume {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+void checkNet(const char* name, int n) {
+  if (n < 2) {
+    std::ostringstream s;
+    s << name << " must be at least 2 control points (got " << n << ")";
+    throw std::invalid_argument(s.str());
+  }
+}
+
+KnotDomain drawnDomain(int count, int order) {
+  return blenderDomain(blenderKnots(count, order, true), count, order);
+}
+
+/// The u step: every line with kept particles as a curve of nu control points.
+struct LineCurves {
+  int nu = 0, order = 0;
+  std::vector<int> lines;                     ///< the lines that have kept particles, in order
+  std::vector<glm::dvec3> controlPoints;      ///< lines.size() × nu, row-major
+  std::vector<double> paramsU;                ///< [b * particles + a], NaN where not kept
+  std::vector<CurveFitQuality> quality;       ///< per entry of `lines`
+};
+
+LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
+  LineCurves c;
+  c.nu = nu;
+  c.order = std::min(params.orderU, nu);
+  for (int b = 0; b < g.lines; ++b)
+    for (int a = 0; a < g.particles; ++a)
+      if (g.kept(b, a)) {
+        c.lines.push_back(b);
+        break;
+      }
+  c.controlPoints.resize(c.lines.size() * std::size_t(nu));
+  c.paramsU.assign(std::size_t(g.lines) * std::size_t(g.particles), kNaN);
+  c.quality.resize(c.lines.size());
+  const KnotDomain dom = drawnDomain(nu, c.order);
+  parallelFor(0, int(c.lines.size()), [&](int r) {
+    const int b = c.lines[std::size_t(r)];
+    std::vector<int> kept;
+    std::vector<glm::vec3> pts;
+    std::vector<glm::dvec3> data;
+    for (int a = 0; a < g.particles; ++a)
+      if (g.kept(b, a)) {
+        kept.push_back(a);
+        pts.push_back(g.at(b, a));
+        data.emplace_back(g.at(b, a));
+      }
+    const std::vector<double> t = mapParameters(
+        averagedChordParameters({pts.data(), int(pts.size()), 1, 1, 0}, params.exponentU), dom.start,
+        dom.end);
+    const CurveFitter fit(t, nu, c.order, true, params.smoothing);
+    glm::dvec3* row = c.controlPoints.data() + std::size_t(r) * std::size_t(nu);
+    fit.fit(data.data(), 1, row, 1);
+    CurveFitQuality& q = c.quality[std::size_t(r)];
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      c.paramsU[g.index(b, kept[i])] = t[i];
+      q.maxResidual = std::max(q.maxResidual, glm::length(fit.point(i, row, 1) - data[i]));
+    }
+    q.netDeviation = fit.netDeviation(row, 1);
+  });
+  return c;
+}
+
+/// The kept particles of the frame, bucketed for nearest-particle distances.
+NearParticles keptParticles(const StreakGrid& g) {
+  std::vector<glm::vec3> pts;
+  glm::vec3 lo(0.f), hi(0.f);
+  for (int b = 0; b < g.lines; ++b)
+    for (int a = 0; a < g.particles; ++a)
+      if (g.kept(b, a)) {
+        lo = pts.empty() ? g.at(b, a) : glm::min(lo, g.at(b, a));
+        hi = pts.empty() ? g.at(b, a) : glm::max(hi, g.at(b, a));
+        pts.push_back(g.at(b, a));
+      }
+  // About 32 buckets across the particles' box: a handful of particles per bucket.
+  const double extent = std::max(double(glm::length(hi - lo)), 1e-6);
+  return NearParticles(pts, extent / 32.0);
+}
+
+}  // namespace
+
+void SurfaceFitParams::validate() const {
+  for (int order : {orderU, orderV})
+    if (order < kMinBlenderOrder || order > kMaxBlenderOrder) {
+      std::ostringstream s;
+      s << "order_u and order_v must be in [" << kMinBlenderOrder << ", " << kMaxBlenderOrder
+        << "] (got " << orderU << ", " << orderV << ")";
+      throw std::invalid_argument(s.str());
+    }
+  for (double x : {smoothing, exponentU, exponentV})
+    if (!(x >= 0.0 && x <= 1.0)) {
+      std::ostringstream s;
+      s << "smoothing, exponent_u and exponent_v must be in [0, 1] (got " << smoothing << ", "
+        << exponentU << ", " << exponentV << ")";
+      throw std::invalid_argument(s.str());
+    }
+}
+
+void StreakGrid::validate() const {
+  if (points == nullptr || keep == nullptr || lines < 1 || particles < 1) {
+    std::ostringstream s;
+    s << "streak grid: need points, keep flags and lines, particles >= 1 (got lines = " << lines
+      << ", particles = " << particles << ")";
+    throw std::invalid_argument(s.str());
+  }
+  bool any = false;
+  for (int b = 0; b < lines; ++b)
+    for (int a = 0; a < particles; ++a) {
+      if (!kept(b, a)) continue;
+      any = true;
+      const glm::vec3& q = at(b, a);
+      if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z))
+        throw std::invalid_argument("streak grid: particle positions must be finite");
+    }
+  if (!any) throw std::invalid_argument("streak grid: no particle is kept for the fit");
+}
+
+SurfaceFit fitSurface(const StreakGrid& g, int nu, int nv, const SurfaceFitParams& params) {
+  params.validate();
+  g.validate();
+  checkNet("nu", nu);
+  checkNet("nv", nv);
+  const LineCurves curves = fitLines(g, nu, params);
+  SurfaceFit fit;
+  NurbsSurface& s = fit.surface;
+  s.nu = nu;
+  s.nv = nv;
+  s.orderU = curves.order;
+  s.orderV = std::min(params.orderV, nv);
+  s.endpointU = s.endpointV = true;
+  fit.paramsU = curves.paramsU;
+
+  // v: as many lines as control points -> interpolation at interpolationParameters() (they
+  // satisfy Schoenberg-Whitney on Blender's knots, which chord lengths of unevenly spaced lines
+  // may not); fewer control points -> the lines' control polygons at averaged chord length
+  // (coincident lines merged), penalised least squares.
+  const int rows = int(curves.lines.size());
+  const bool interpolate = rows == nv;
+  std::vector<double> tv;
+  if (interpolate) {
+    tv = interpolationParameters(nv, s.orderV, true);
+  } else {
+    std::vector<glm::vec3> polygons(curves.controlPoints.size());
+    for (std::size_t n = 0; n < polygons.size(); ++n)
+      polygons[n] = glm::vec3(curves.controlPoints[n]);
+    const KnotDomain dom = drawnDomain(nv, s.orderV);
+    tv = mapParameters(averagedChordParameters({polygons.data(), rows, nu, nu, 1}, params.exponentV),
+                       dom.start, dom.end);
+  }
+  fit.paramsV.assign(std::size_t(g.lines), kNaN);
+  for (int r = 0; r < rows; ++r)
+    fit.paramsV[std::size_t(curves.lines[std::size_t(r)])] = tv[std::size_t(r)];
+
+  // Step 2: one fit across the lines per column u of their control points.
+  const CurveFitter fv(tv, nv, s.orderV, true, interpolate ? 0.0 : params.smoothing);
+  std::vector<glm::dvec3> net(std::size_t(nu) * std::size_t(nv));
+  parallelFor(0, nu, [&](int u) { fv.fit(curves.controlPoints.data() + u, nu, net.data() + u, nu); });
+  s.controlPoints.resize(net.size());
+  for (std::size_t n = 0; n < net.size(); ++n) s.controlPoints[n] = glm::vec4(glm::vec3(net[n]), 1.f);
+
+  // Residuals at the particles' own parameters, on the float control points Blender gets.
+  const SurfaceKnots k = surfaceKnots(s);
+  std::vector<double> worst(std::size_t(rows), 0.0);
+  parallelFor(0, rows, [&](int r) {
+    const int b = curves.lines[std::size_t(r)];
+    for (int a = 0; a < g.particles; ++a) {
+      if (!g.kept(b, a)) continue;
+      const glm::vec3 p = surfacePoint(s, k, fit.paramsU[g.index(b, a)], fit.paramsV[std::size_t(b)]);
+      const double d = glm::length(glm::dvec3(p) - glm::dvec3(g.at(b, a)));
+      worst[std::size_t(r)] = std::max(worst[std::size_t(r)], d);
+    }
+  });
+  fit.maxResidual = *std::max_element(worst.begin(), worst.end());
+  const std::vector<glm::vec3> at = surfaceGrid(s, grevilleAbscissae(k.u, nu, s.orderU),
+                                                grevilleAbscissae(k.v, nv, s.orderV));
+  for (std::size_t n = 0; n < at.size(); ++n)
+    fit.netDeviation =
+        std::max(fit.netDeviation, double(glm::length(glm::vec3(s.controlPoints[n]) - at[n])));
+  return fit;
+}
+
+CurveFitQuality curveFitQuality(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
+  params.validate();
+  g.validate();
+  checkNet("nu", nu);
+  const LineCurves curves = fitLines(g, nu, params);
+  CurveFitQuality worst;
+  for (const CurveFitQuality& q : curves.quality) {
+    worst.maxResidual = std::max(worst.maxResidual, q.maxResidual);
+    worst.netDeviation = std::max(worst.netDeviation, q.netDeviation);
+  }
+  return worst;
+}
+
+double netToParticles(const NurbsSurface& surface, const StreakGrid& g) {
+  g.validate();
+  const NearParticles near = keptParticles(g);
+  std::vector<double> d(surface.controlPoints.size(), 0.0);
+  parallelFor(0, int(d.size()), [&](int n) {
+    d[std::size_t(n)] = near.nearest(glm::vec3(surface.controlPoints[std::size_t(n)]));
+  });
+  return d.empty() ? 0.0 : *std::max_element(d.begin(), d.end());
+}
+
+}  // namespace plume
