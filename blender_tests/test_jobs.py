@@ -205,6 +205,41 @@ class JobsTest(unittest.TestCase):
         self.assertEqual(tree_listing(folder), ["b.bin", "sub", os.path.join("sub", "c.bin")])
         rmtree(folder)
 
+    # ------------------------------------------------------------------ a long job says so
+    def test_9_long_build_says_how_long_first(self):
+        """Headless, a job forecast above LONG_JOB_S prints "<title>: <what>, about N s" before
+        it starts (reports only appear when an operator ends); a short one prints nothing. The
+        forecast counts the bake's streaklines (what the panel said the bake would trace) and
+        frames."""
+        import contextlib
+        import io
+        from plume import _native, streak_count
+        from plume import surfaces_forecast as sf
+        from plume.jobs import operator as job_operator
+        from plume.snapshot import cache_folder_of
+        from plume import cache
+        folder = cache_folder_of(self.dom)
+        lines, particles, frames = sf.shot_size(_native, folder, cache.read_manifest(folder))
+        self.assertEqual(lines, streak_count.count(_native, bpy.context.scene, self.dom)[0])
+        self.assertEqual(frames, FRAMES)
+        seconds = sf.seconds(lines, particles, frames)
+        self.assertLess(seconds, job_operator.LONG_JOB_S)  # a small scene: no word
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})
+        self.assertNotIn("about", out.getvalue())
+        long_job_s, job_operator.LONG_JOB_S = job_operator.LONG_JOB_S, 0.0
+        out = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(out):
+                self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})
+        finally:
+            job_operator.LONG_JOB_S = long_job_s
+        first = out.getvalue().splitlines()[0]
+        self.assertEqual(first, f"Plume: Build Surfaces: {lines:,} streaklines x {frames} "
+                                f"frames, about {seconds:.0f} s")
+        print(f"  forecast {seconds:.2f} s for {lines} streaklines x {frames} frames")
+
 
 if __name__ == "__main__":
     run(JobsTest)

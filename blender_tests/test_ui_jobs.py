@@ -1,6 +1,7 @@
 """The UI path of Plume's jobs: invoked from a button they run modal on a worker thread with
 status-bar progress, Esc cancels them, and deleting the domain, loading another file or quitting
-Blender stops them cleanly.
+Blender stops them cleanly. A job forecast to be long asks first: a dialog, whose OK starts it
+in the background and whose Esc starts nothing.
 
 Modal operators, timers and events never run under ``blender -b``, so this test (itself run with
 ``blender -b`` like the others) starts one real windowed Blender under Xvfb with
@@ -27,7 +28,8 @@ import bpy  # noqa: E402
 from helpers import run, tree_listing  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-CASES = ["bake:esc", "surfaces:esc", "toon:esc", "surfaces:delete", "toon:load", "toon:quit"]
+CASES = ["bake:esc", "surfaces:esc", "toon:esc", "surfaces:delete", "surfaces:decline",
+         "surfaces:ask", "toon:load", "toon:quit"]
 #: Esc, a deleted object or a file load stops a job within one unit of work (a frame, a
 #: density map) plus a poll of the modal timer: well under a second on these small scenes.
 STOP_S = 1.0
@@ -122,6 +124,24 @@ class UiJobsTest(unittest.TestCase):
         self.assert_ran_modal_with_progress(c)
         self.assert_left_nothing(c)
         self.assertLess(c["seconds_to_stop"], STOP_S)
+
+    # ------------------------------------------------------------------ a long job asks first
+    def test_long_job_declined_starts_nothing(self):
+        c = self.case("surfaces", "decline")
+        self.assertEqual(c["invoke"], ["RUNNING_MODAL"])  # the dialog is open
+        self.assertFalse(c["job_before_answer"])
+        self.assertIsNone(c["job_title"])
+        self.assert_left_nothing(c)
+
+    def test_long_job_confirmed_runs_in_the_background(self):
+        c = self.case("surfaces", "ask")
+        self.assertEqual(c["invoke"], ["RUNNING_MODAL"])
+        self.assertFalse(c["job_before_answer"])  # nothing ran before the answer
+        self.assertEqual(c["job_title"], "Build Surfaces")
+        self.assertFalse(c["worker_is_main_thread"])
+        self.assertTrue(any(s[4] for s in c["seen"]), c["seen"])
+        new = sorted(set(c["objects_after"]) - set(c["objects_before"]))
+        self.assertTrue(new and all("_surface_" in n for n in new), new)
 
     # ------------------------------------------------------------------ from outside
     def test_deleting_the_domain_cancels(self):

@@ -1,7 +1,7 @@
 """Jobs: every long Plume operation (bake, flames bake, Build Surfaces, toon build, graph build,
 fire synthesis, mesh export) as one runner protocol and one operator mixin.
 
-- runner.py   JobRunner: prepare() (main thread, snapshot + validation), run() (worker thread, no
+- runner.py   JobRunner: forecast() (how long, before it starts), prepare() (main thread, snapshot + validation), run() (worker thread, no
               bpy), main_steps() and finish() (main thread, Blender data); cancel(), progress()
 - operator.py JobOperator: execute() blocking, invoke() worker thread + modal timer + status bar
               + Esc; cancel() when Blender drops the handler
@@ -13,12 +13,12 @@ fire synthesis, mesh export) as one runner protocol and one operator mixin.
 
 from . import handlers, registry
 from .operator import JobOperator
-from .runner import JobCancelled, JobProgress, JobRunner
+from .runner import Forecast, JobCancelled, JobProgress, JobRunner
 from .staging import Staging
 from .worker import Worker
 
-__all__ = ("JobOperator", "JobRunner", "JobProgress", "JobCancelled", "Staging", "Worker",
-           "registry", "register", "unregister")
+__all__ = ("JobOperator", "JobRunner", "Forecast", "JobProgress", "JobCancelled", "Staging",
+           "Worker", "registry", "register", "unregister")
 
 
 def register():

@@ -9,7 +9,9 @@ execute() runs the job blocking (``blender -b``, scripts, tests: bad input raise
 invoke() (a button) runs prepare() at once, then run() on a worker thread while a modal timer
 shows "<label> i of N, ~s left (Esc cancels)" in the status bar and the progress cursor; Esc
 cancels within one unit of work; deleting an object the job works on cancels it; the result is
-built on the main thread when the worker is done. Blender calls cancel() when it removes the
+built on the main thread when the worker is done. A job whose runner forecasts more than
+LONG_JOB_S asks first (a dialog saying how long, OK starts it); headless, the forecast is printed
+when the job starts and repeated in its report. Blender calls cancel() when it removes the
 modal handler (quit, window closed, file load): the job is aborted and nothing is built."""
 
 import time
@@ -27,6 +29,9 @@ POLL_S = 0.1
 #: responsive while main_steps() take most of the time.
 STEP_BUDGET_S = 0.05
 STEP_POLL_S = 0.01
+#: Seconds above which a button asks before starting a job (runner.forecast()), and a headless
+#: run prints the forecast: the issue's budget for an ordinary Build Surfaces.
+LONG_JOB_S = 30.0
 
 
 def status_text(title, p, seconds_left):
@@ -35,6 +40,11 @@ def status_text(title, p, seconds_left):
         return f"Plume {title}: {p.label}... (Esc cancels)"
     left = f", ~{seconds_left:.0f} s left" if seconds_left is not None else ""
     return f"Plume {title}: {p.label} {p.done} of {p.total}{left} (Esc cancels)"
+
+
+def _headless(context):
+    """No event loop (``blender -b``, a bpy module, a script without a window)."""
+    return bpy.app.background or context.window is None
 
 
 class JobOperator:
@@ -46,9 +56,15 @@ class JobOperator:
 
     # ------------------------------------------------------------------ blocking
     def execute(self, context):
+        if getattr(self, "_asked", None) is not None and not _headless(context):
+            return self._start(context)  # OK in invoke()'s dialog: in the background
+        forecast, title = self._long_forecast(context)
+        if forecast is not None:  # reports appear when the operator ends: say it now too
+            print(f"Plume: {forecast.text(title)}", flush=True)
         runner = self._prepare(context)
         if runner is None:
             return {'CANCELLED'}
+        runner.forecast_said = forecast
         error = Worker(runner).run_here().error
         if error is None and not runner.cancelled:
             try:
@@ -61,11 +77,31 @@ class JobOperator:
 
     # ------------------------------------------------------------------ in the background
     def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
+        if _headless(context):
             return self.execute(context)  # no event loop: modal handlers would never run
+        self._forecast, title = self._long_forecast(context)
+        self._asked = self._forecast.text(title) if self._forecast is not None else None
+        if self._asked is not None:  # OK calls execute() on this same operator
+            return context.window_manager.invoke_props_dialog(self, width=420)
+        return self._start(context)
+
+    def draw(self, context):
+        """The dialog of a long job: how long, and how to make it shorter."""
+        if getattr(self, "_asked", None) is None:
+            return
+        col = self.layout.column()
+        col.label(text=self._asked, icon='TIME')
+        col.label(text="It runs in the background: Esc cancels it.")
+        for line in self.make_runner(context).shorter_hint():
+            col.label(text=line)
+
+    def _start(self, context):
+        """prepare(), then run() on a worker thread with a modal timer (the button's path)."""
+        self._asked = None
         runner = self._prepare(context)
         if runner is None:
             return {'CANCELLED'}
+        runner.forecast_said = getattr(self, "_forecast", None)
         self._runner, self._steps, self._error, self._gone = runner, None, None, None
         wm = context.window_manager
         self._timer = wm.event_timer_add(POLL_S, window=context.window)
@@ -111,6 +147,21 @@ class JobOperator:
             pass
 
     # ------------------------------------------------------------------ parts
+    def _long_forecast(self, context):
+        """(Forecast, the job's title) when the runner forecasts more than LONG_JOB_S, else
+        (None, title) (also when it cannot tell: prepare() reports bad input)."""
+        probe = self.make_runner(context)
+        try:
+            forecast = probe.forecast(context)
+        except BakeError:  # bad input: prepare() says so
+            forecast = None
+        except Exception:  # a forecast never stops a job
+            traceback.print_exc()
+            forecast = None
+        if forecast is None or not forecast.seconds > LONG_JOB_S:
+            return None, probe.title
+        return forecast, probe.title
+
     def _prepare(self, context):
         """runner.prepare(); None (the error reported, nothing held) on bad input."""
         runner = self.make_runner(context)
@@ -202,6 +253,8 @@ class JobOperator:
                 runner.discard()
                 self.report({'ERROR'}, runner.error_text(e))
                 return {'CANCELLED'}
+            if runner.forecast_said is not None:
+                text += f" (forecast: {runner.forecast_said.about()})"
             self.report({kind}, text)
             return {'FINISHED'}
         finally:

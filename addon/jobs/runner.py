@@ -58,6 +58,25 @@ class JobProgress:
         return (now - self.stage_started) / self.done * (self.total - self.done)
 
 
+@dataclass(frozen=True)
+class Forecast:
+    """How long a job is expected to take, said before it starts: `seconds` and `what` the
+    figure is made of ("1,024 streaklines x 60 frames")."""
+
+    seconds: float
+    what: str
+
+    def about(self):
+        """ "about 2 min" """
+        s = self.seconds
+        return "about " + (f"{s:.0f} s" if s < 90 else (f"{s / 60:.0f} min" if s < 5400 else
+                                                        f"{s / 3600:.1f} h"))
+
+    def text(self, title):
+        """ "Build Surfaces: 1,024 streaklines x 60 frames, about 2 min" """
+        return f"{title}: {self.what}, {self.about()}"
+
+
 class JobRunner(abc.ABC):
     """Base of every job (see the module docstring for the protocol)."""
 
@@ -88,10 +107,22 @@ class JobRunner(abc.ABC):
         self.worker = None
         #: The status bar's last line (operator.py), for scripts and tests.
         self.status_text = ""
+        #: The Forecast said before a long job started (operator.py), for its report.
+        self.forecast_said = None
         #: time.perf_counter() of the first cancel() (None while not cancelled).
         self.cancelled_at = None
 
     # ------------------------------------------------------------------ the four parts
+    def forecast(self, context):
+        """A Forecast of how long the job will take, from the settings and what is on disk,
+        before prepare() (cheap: the operator asks it when the button is pressed); None when it
+        cannot tell or the job is short. Must not raise for bad input: prepare() reports that."""
+        return None
+
+    def shorter_hint(self):
+        """Lines the long-job dialog adds: which settings make the job shorter."""
+        return ()
+
     @abc.abstractmethod
     def prepare(self, context):
         """Snapshot and checks on the main thread; BakeError on bad input, nothing written."""

@@ -13,8 +13,9 @@ import numpy as np
 
 from .. import _native, cache
 from .. import streak_surfaces as ss
+from .. import surfaces_forecast
 from ..build import surfaces as build
-from ..jobs import JobOperator, JobRunner
+from ..jobs import Forecast, JobOperator, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
 from .bake import domain_key
@@ -84,6 +85,23 @@ class SurfacesJob(JobRunner):
 
     title = "Build Surfaces"
     prepare_errors = (BakeError, ValueError, RuntimeError)
+
+    def forecast(self, context):
+        domain = active_domain(context)
+        folder = cache_folder_of(domain)
+        m = cache.read_manifest(folder)
+        if m is None or not m.get("streaks"):
+            return None
+        size = surfaces_forecast.shot_size(_native, folder, m)
+        if size is None:
+            return None
+        lines, particles, frames = size
+        return Forecast(surfaces_forecast.seconds(lines, particles, frames),
+                        f"{lines:,} streaklines x {frames} frames")
+
+    def shorter_hint(self):
+        return ("Fewer streaklines (Max Streaklines, then bake again) or a lower",
+                "Threshold (h0) make it shorter.")
 
     def prepare(self, context):
         self.t0 = time.perf_counter()

@@ -11,6 +11,9 @@ Each CASE is <operator>:<action>, run in order:
               delete  delete the domain while the job runs
               load    open another .blend file while the job runs
               quit    quit Blender while the job runs (the last case)
+              ask     the job is made "long" (LONG_JOB_S = 0): the button opens a dialog
+                      saying how long; Return starts the job, which then runs to its end
+              decline the same dialog answered with Esc: nothing starts
 
 A case sets its scene up, invokes the operator from the Properties editor's context
 ('INVOKE_DEFAULT': worker thread + modal timer), polls the job (its progress and status-bar line)
@@ -104,8 +107,15 @@ def start_case():
         bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
         rec["other_file"] = path
     win, area = window_and_area()
-    with bpy.context.temp_override(window=win, area=area, screen=win.screen):
-        rec["invoke"] = sorted(getattr(bpy.ops.plume, OPERATORS[operator])('INVOKE_DEFAULT'))
+    from plume.jobs import operator as job_operator
+    long_job_s = job_operator.LONG_JOB_S
+    if action in ("ask", "decline"):
+        job_operator.LONG_JOB_S = 0.0  # every forecast is "long": the dialog opens
+    try:
+        with bpy.context.temp_override(window=win, area=area, screen=win.screen):
+            rec["invoke"] = sorted(getattr(bpy.ops.plume, OPERATORS[operator])('INVOKE_DEFAULT'))
+    finally:
+        job_operator.LONG_JOB_S = long_job_s
     j = job()
     rec["job_title"] = j.title if j else None
     state["job"] = j
@@ -131,13 +141,24 @@ def act(rec, j):
         bpy.ops.wm.quit_blender()
 
 
+def answer_dialog(rec):
+    """ask/decline: the dialog is open and no job runs yet; Return (OK) or Esc answers it."""
+    rec["job_before_answer"] = job() is not None
+    key = 'RET' if rec["action"] == "ask" else 'ESC'
+    win = bpy.context.window_manager.windows[0]
+    win.event_simulate(type=key, value='PRESS')
+    win.event_simulate(type=key, value='RELEASE')
+    state["acted_at"] = time.perf_counter()
+
+
 def end_case(rec):
     """The job has ended: what it left behind."""
     j = state["job"]
     rec["seconds_to_stop"] = time.perf_counter() - state["acted_at"]
-    rec["seconds_to_cancel"] = (j.cancelled_at - state["acted_at"]) if j.cancelled_at else None
-    rec["seconds_worker_ran_on"] = (j.worker.ended_at - state["acted_at"]
-                                    if j.worker.ended_at else None)
+    if j is not None:
+        rec["seconds_to_cancel"] = (j.cancelled_at - state["acted_at"]) if j.cancelled_at else None
+        rec["seconds_worker_ran_on"] = (j.worker.ended_at - state["acted_at"]
+                                        if j.worker.ended_at else None)
     rec["objects_after"] = sorted(o.name for o in bpy.data.objects)
     rec["files_after"] = tree_listing(rec["cache"])
     if rec["operator"] == "bake":
@@ -179,6 +200,17 @@ def step():
         bpy.ops.wm.quit_blender()
         return None
     j = job()
+    if rec["action"] in ("ask", "decline"):
+        if state["acted_at"] is None:
+            answer_dialog(rec)
+            return POLL_S
+        if j is not None:
+            state["job"] = j
+            rec["job_title"] = j.title
+            rec["worker_is_main_thread"] = j.worker.thread_id == threading.main_thread().ident
+        elif state["job"] is None and rec["action"] == "ask" and \
+                time.perf_counter() - state["acted_at"] < 5.0:
+            return POLL_S  # Return not handled yet
     if j is not None:
         p = j.progress()
         rec["seen"].append([round(time.perf_counter() - state["case_t0"], 3), p.done, p.total,

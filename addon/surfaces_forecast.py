@@ -1,0 +1,48 @@
+"""How long Build Surfaces will take, said before it starts (a long build asks first in the UI and
+prints the forecast headless: jobs/operator.py). A cost model of the build's two stages, read
+off the bake's last streak file (lines L, particles per line P) and its frame count F:
+
+    h(α,β) of every pair closer than h0 (§3.3, sparse):  H_PAIR_S × pairs × F × P̄
+    least-squares nets and density maps (§3.3, §3.4):    FIT_S × L × P × F
+
+with P̄ = P/2 (a streakline grows by one particle per frame) and pairs = PAIR_SHARE × L²/2 (the
+default h0, the mean of h, keeps about half the pairs of a source covering a sphere; a smaller
+h0 keeps fewer, so the figure is an upper one there). The rates were measured on the 2-core
+machine the README's tables come from (bench: examples/surfaces_forecast.py)."""
+
+import numpy as np
+
+from . import cache
+
+#: Seconds per (pair of streaklines × particle-frame) of the sparse h.
+H_PAIR_S = 2.2e-9
+#: Seconds per particle-frame of the nets and density maps.
+FIT_S = 1.0e-5
+#: Share of the pairs within the default h0.
+PAIR_SHARE = 0.5
+
+
+def work(lines, particles, frames):
+    """(pairs × particle-frames of h, particle-frames of the fit) of a shot."""
+    pairs = PAIR_SHARE * lines * (lines - 1) / 2.0
+    return pairs * frames * particles / 2.0, float(lines) * particles * frames
+
+
+def seconds(lines, particles, frames):
+    """The forecast in seconds for L lines of P particles over F frames."""
+    h_work, fit_work = work(lines, particles, frames)
+    return H_PAIR_S * h_work + FIT_S * fit_work
+
+
+def shot_size(native, folder, manifest):
+    """(lines, particles per line, frames) of a streak bake, from its last streak file; None
+    when the file is missing or unreadable (Build Surfaces reports that itself)."""
+    first, last = int(manifest["frame_start"]), int(manifest["last_complete_frame"])
+    try:
+        frame = native.read_streak_file(cache.streak_path(folder, last))
+    except (OSError, RuntimeError, ValueError):
+        return None
+    counts = np.asarray(frame["counts"])
+    if counts.size == 0:
+        return None
+    return int(counts.size), int(counts.max()), last - first + 1
