@@ -8,7 +8,11 @@ Set-up: a 4 x 4 NURBS net (one cubic Bézier patch) with evenly spaced control p
 x in [-0.5, 0.5] (u) and z in [0, 1] (v), so u and v are linear in x and z; it is turned by θ
 about z and seen by an orthographic camera along +y, so n·v = cos θ on every pixel and screen x
 = (u − 0.5)·cos θ. Emission colour white, brightness 1, opacity 1, black world: the pixel's
-linear value is p itself (Transparent lets the black through, Emission adds p).
+linear value is p itself (Transparent lets the black through, Emission adds p). The scene uses
+the add-on's Fast Sheet Render set-up (8 samples, no light bounces: plume.surfaces_fast_render),
+so the equation is checked on the picture that set-up gives; three sheets stacked in front of one
+another must composite as layers do, 1 − (1 − p)³, which they only do when every layer is reached
+(transparent bounces) and nothing but emission and transparency shades them.
 
 Run: blender_tests/run.py --blender {3.4,4.5,5.0} test_sheet_shading.py
 """
@@ -68,9 +72,7 @@ class SheetShadingTest(unittest.TestCase):
         cam.data.ortho_scale = ORTHO
         cam.location, cam.rotation_euler = (0.0, -5.0, 0.5), (math.pi / 2, 0.0, 0.0)
         scene.camera = cam
-        scene.render.engine = 'CYCLES'
-        scene.cycles.samples = 4
-        scene.cycles.use_denoising = False
+        assert bpy.ops.plume.surfaces_fast_render() == {'FINISHED'}
         scene.cycles.filter_width = 0.1
         scene.render.resolution_x = scene.render.resolution_y = SIZE
         scene.render.resolution_percentage = 100
@@ -86,7 +88,7 @@ class SheetShadingTest(unittest.TestCase):
     def tearDownClass(cls):
         rmtree(cls.tmp)
 
-    def render(self, falloff, theta_deg, frame):
+    def render(self, falloff, theta_deg, frame, layers=1):
         """The rendered red channel (rows bottom-up) of the sheet turned by theta, with the
         material of `falloff` ('EXPONENTIAL' or 'LINEAR') showing density map `frame`."""
         mat = self.build.sheet_material(
@@ -98,11 +100,22 @@ class SheetShadingTest(unittest.TestCase):
         cu.materials.append(mat)
         self.sheet.rotation_euler = (0.0, 0.0, math.radians(theta_deg))
         scene = bpy.context.scene
+        copies = []
+        for k in range(1, layers):  # the same sheet 5 cm nearer the camera per layer
+            ob = self.sheet.copy()
+            ob.location.y = -0.05 * k
+            self.sheet.users_collection[0].objects.link(ob)
+            copies.append(ob)
         scene.frame_set(frame)
-        path = os.path.join(OUT_DIR, "sheet_shading", f"{falloff}_{theta_deg}_{frame}.exr")
+        path = os.path.join(OUT_DIR, "sheet_shading",
+                            f"{falloff}_{theta_deg}_{frame}_{layers}.exr")
         os.makedirs(os.path.dirname(path), exist_ok=True)
         scene.render.filepath = path
-        bpy.ops.render.render(write_still=True)
+        try:
+            bpy.ops.render.render(write_still=True)
+        finally:
+            for ob in copies:
+                bpy.data.objects.remove(ob, do_unlink=True)
         return image_pixels(path)[..., 0].astype(np.float64)
 
     @staticmethod
@@ -124,12 +137,13 @@ class SheetShadingTest(unittest.TestCase):
         term = math.exp(-c) if falloff == 'EXPONENTIAL' else 1.0 - c
         return np.clip(self.density(theta_deg, frame) * term, 0.0, 1.0)
 
-    def check(self, falloff, theta_deg, frame):
-        got = self.render(falloff, theta_deg, frame)
-        want = self.expected(falloff, theta_deg, frame)
+    def check(self, falloff, theta_deg, frame, layers=1):
+        got = self.render(falloff, theta_deg, frame, layers)
+        want = 1.0 - (1.0 - self.expected(falloff, theta_deg, frame)) ** layers
         inside = np.isfinite(want)
         err = np.abs(got[inside] - want[inside])
-        print(f"  {falloff} θ={theta_deg}° map {'u' if frame == 1 else 'v'}: {inside.sum()} "
+        print(f"  {falloff} θ={theta_deg}° map {'u' if frame == 1 else 'v'}, {layers} layer(s): "
+              f"{inside.sum()} "
               f"pixels, p {want[inside].min():.3f}..{want[inside].max():.3f}, max error "
               f"{err.max():.2e}")
         self.assertGreater(int(inside.sum()), 200)
@@ -155,6 +169,9 @@ class SheetShadingTest(unittest.TestCase):
 
     def test_map_rows_run_along_v(self):
         self.check('EXPONENTIAL', 30, 2)
+
+    def test_stacked_sheets_composite_as_layers(self):
+        self.check('EXPONENTIAL', 0, 1, layers=3)
 
     def test_linear_contour(self):
         self.check('LINEAR', 60, 1)

@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import _native, cache
 from .. import streak_surfaces as ss
-from .. import surfaces_forecast
+from .. import sheet_render, surfaces_forecast
 from ..build import surfaces as build
 from ..jobs import Forecast, JobOperator, JobRunner
 from ..settings import BakeError
@@ -236,4 +236,20 @@ class PLUME_OT_surfaces_pick_threshold(bpy.types.Operator):
         return {'FINISHED'}
 
 
-classes = (PLUME_OT_surfaces_build, PLUME_OT_surfaces_pick_threshold)
+class PLUME_OT_surfaces_fast_render(bpy.types.Operator):
+    """Set the scene to a fast Cycles set-up for streak sheets: their material shades itself
+    (emission and transparency by p, §3.4), so 8 samples and no light bounces, only transparent
+    ones, give the same picture (other objects lose indirect light)"""
+
+    bl_idname = "plume.surfaces_fast_render"
+    bl_label = "Fast Sheet Render"
+    bl_options = {'REGISTER', 'UNDO'}  # render settings only
+
+    def execute(self, context):
+        sheet_render.apply_fast_cycles(context.scene)
+        self.report({'INFO'}, "Plume: " + sheet_render.describe(context.scene))
+        return {'FINISHED'}
+
+
+classes = (PLUME_OT_surfaces_build, PLUME_OT_surfaces_pick_threshold,
+           PLUME_OT_surfaces_fast_render)

@@ -230,6 +230,8 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         row = col.row()
         row.enabled = not is_busy(ob)
         row.operator("plume.surfaces_build", icon='SURFACE_NSURFACE')
+        if d.surfaces_collection:
+            col.operator("plume.surfaces_fast_render", icon='RENDER_STILL')
         # On the built surfaces (all of this domain's; §5 hand edits, keyframes, mesh export).
         if d.surfaces_collection:
             sub = col.column(align=True)
