@@ -75,6 +75,7 @@ def main():
     scene_kit.camera(scene, (0.0, -1.7, 0.5), (90.0, 0.0, 0.0), lens=50.0)
     scene_kit.dark_studio(scene, world_color=(0.004, 0.004, 0.006))
     scene_kit.cycles(scene, 240, 320, 64, os.path.join(out_dir, "figure3_"))
+    assert bpy.ops.plume.surfaces_fast_render() == {'FINISHED'}  # sheets shade themselves
     scene.frame_start, scene.frame_end = 1, frames
     scene_kit.save_blend(out_dir, "figure3")
     shown = max(1, round(0.7 * frames))

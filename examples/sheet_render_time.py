@@ -89,9 +89,9 @@ def main():
     ref = pixels(paths[0])
     for (name, seconds), p in zip(rows, paths):
         d = np.abs(pixels(p) - ref) * 255.0
-        print(f"  {name}: {seconds:.2f} s per frame ({rows[0][1] / seconds:.1f}x faster than "
-              f"the first), difference {d.mean():.2f} mean, {np.percentile(d, 99.9):.1f} at the "
-              f"99.9th percentile (8-bit levels)", flush=True)
+        print(f"  {name}: {seconds:.2f} s per frame ({rows[0][1] / seconds:.1f}x the speed of "
+              f"the first), difference from it {d.mean():.2f} mean, {np.percentile(d, 99.9):.1f} "
+              f"at the 99.9th percentile (8-bit levels)", flush=True)
     strip = scene_kit.strip(paths, os.path.join(out_dir, "sheet_render_strip.png"))
     print(f"sheet_render_time: bake {bake_s:.1f} s, Build Surfaces {build_s:.1f} s -> {strip}",
           flush=True)
