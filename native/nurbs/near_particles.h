@@ -11,7 +11,8 @@
 
 namespace plume {
 
-/// The particles sorted into cubic buckets of side `bucketSize` (world units).
+/// The particles sorted into cubic buckets of side `bucketSize` (world units; doubled until the
+/// particles' box has at most 4 M buckets), with a dense table of each bucket's particles.
 class NearParticles {
  public:
   /// Throws std::invalid_argument unless bucketSize is finite and > 0 and the points finite.
@@ -24,12 +25,12 @@ class NearParticles {
 
  private:
   glm::ivec3 bucketOf(glm::vec3 p) const;
-  static std::uint64_t key(glm::ivec3 b);
+  std::size_t linear(glm::ivec3 b) const;  ///< index of bucket b in mStart (b within mLo..mHi)
 
   double mSize;
-  std::vector<glm::vec3> mPoints;       ///< sorted by bucket key
-  std::vector<std::uint64_t> mKeys;     ///< bucket key of each point, ascending
-  glm::ivec3 mLo{0}, mHi{0};            ///< bucket range holding points
+  std::vector<glm::vec3> mPoints;       ///< sorted by bucket
+  std::vector<std::uint32_t> mStart;    ///< bucket b's points: mStart[b] .. mStart[b + 1]
+  glm::ivec3 mLo{0}, mHi{0}, mDims{0};  ///< bucket range holding points, and its size
 };
 
 }  // namespace plume

@@ -72,11 +72,18 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
       return q.maxResidual <= params.tolerance && q.netDeviation <= params.netTolerance;
     });
   });
+  // The lines' curves do not depend on nv or the order across: fitted once per frame.
+  std::vector<LineCurves> curves(frames.size());
+  parallelFor(0, int(frames.size()), [&](int n) {
+    curves[std::size_t(n)] = fitLines(frames[std::size_t(n)], size.nu, fit);
+  });
   auto good = [&](int nv) {
-    return everyFrame(frames, [&](const StreakGrid& g) {
-      const SurfaceFit f = fitSurface(g, size.nu, nv, fit);
-      return f.maxResidual <= params.tolerance && f.netDeviation <= params.netTolerance;
+    std::vector<char> ok(frames.size(), 0);
+    parallelFor(0, int(frames.size()), [&](int n) {
+      const SurfaceFit f = fitAcross(frames[std::size_t(n)], curves[std::size_t(n)], nv, fit);
+      ok[std::size_t(n)] = f.maxResidual <= params.tolerance && f.netDeviation <= params.netTolerance;
     });
+    return std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
   };
   // Across the streaklines: the highest order whose interpolating sheet keeps to the
   // tolerances, then the fewest control points with it.

@@ -31,16 +31,12 @@ KnotDomain drawnDomain(int count, int order) {
   return blenderDomain(blenderKnots(count, order, true), count, order);
 }
 
-/// The u step: every line with kept particles as a curve of nu control points.
-struct LineCurves {
-  int nu = 0, order = 0;
-  std::vector<int> lines;                     ///< the lines that have kept particles, in order
-  std::vector<glm::dvec3> controlPoints;      ///< lines.size() × nu, row-major
-  std::vector<double> paramsU;                ///< [b * particles + a], NaN where not kept
-  std::vector<CurveFitQuality> quality;       ///< per entry of `lines`
-};
+}  // namespace
 
 LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
+  params.validate();
+  g.validate();
+  checkNet("nu", nu);
   LineCurves c;
   c.nu = nu;
   c.order = std::min(params.orderU, nu);
@@ -81,6 +77,8 @@ LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params)
   return c;
 }
 
+namespace {
+
 /// The kept particles of the frame, bucketed for nearest-particle distances.
 NearParticles keptParticles(const StreakGrid& g) {
   std::vector<glm::vec3> pts;
@@ -92,9 +90,12 @@ NearParticles keptParticles(const StreakGrid& g) {
         hi = pts.empty() ? g.at(b, a) : glm::max(hi, g.at(b, a));
         pts.push_back(g.at(b, a));
       }
-  // About 32 buckets across the particles' box: a handful of particles per bucket.
-  const double extent = std::max(double(glm::length(hi - lo)), 1e-6);
-  return NearParticles(pts, extent / 32.0);
+  // Buckets of about four particles were the particles to fill their box (they fill less of
+  // it, sheets and lines, so more sit in the buckets they occupy), and no more than 256 across.
+  const glm::dvec3 box = glm::max(glm::dvec3(hi - lo), glm::dvec3(1e-6));
+  const double extent = std::max({box.x, box.y, box.z});
+  const double filled = std::cbrt(box.x * box.y * box.z * 4.0 / double(pts.size()));
+  return NearParticles(pts, std::max(filled, extent / 256.0));
 }
 
 }  // namespace
@@ -136,11 +137,17 @@ void StreakGrid::validate() const {
 }
 
 SurfaceFit fitSurface(const StreakGrid& g, int nu, int nv, const SurfaceFitParams& params) {
+  return fitAcross(g, fitLines(g, nu, params), nv, params);
+}
+
+SurfaceFit fitAcross(const StreakGrid& g, const LineCurves& curves, int nv,
+                     const SurfaceFitParams& params) {
   params.validate();
   g.validate();
-  checkNet("nu", nu);
   checkNet("nv", nv);
-  const LineCurves curves = fitLines(g, nu, params);
+  if (curves.lines.empty() || curves.paramsU.size() != g.index(g.lines, 0))
+    throw std::invalid_argument("fitAcross: the line curves are not of this streak grid");
+  const int nu = curves.nu;
   SurfaceFit fit;
   NurbsSurface& s = fit.surface;
   s.nu = nu;
@@ -200,9 +207,6 @@ SurfaceFit fitSurface(const StreakGrid& g, int nu, int nv, const SurfaceFitParam
 }
 
 CurveFitQuality curveFitQuality(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
-  params.validate();
-  g.validate();
-  checkNet("nu", nu);
   const LineCurves curves = fitLines(g, nu, params);
   CurveFitQuality worst;
   for (const CurveFitQuality& q : curves.quality) {

@@ -89,6 +89,24 @@ struct CurveFitQuality {
 };
 CurveFitQuality curveFitQuality(const StreakGrid& grid, int nu, const SurfaceFitParams& params);
 
+/// The u step of fitSurface() on its own: every line with kept particles as a curve of nu
+/// control points (order min(params.orderU, nu)). It does not depend on nv or orderV, so a
+/// search over those (chooseNetSize()) fits the lines once per frame and reuses them.
+struct LineCurves {
+  int nu = 0, order = 0;
+  std::vector<int> lines;                 ///< the lines that have kept particles, in order
+  std::vector<glm::dvec3> controlPoints;  ///< lines.size() × nu, row-major
+  std::vector<double> paramsU;            ///< [b * particles + a], NaN where not kept
+  std::vector<CurveFitQuality> quality;   ///< per entry of `lines`
+};
+LineCurves fitLines(const StreakGrid& grid, int nu, const SurfaceFitParams& params);
+
+/// The v step: the surface of nv control points across `curves` (fitLines() of the same grid
+/// and nu; params.orderU is not read again). fitSurface(g, nu, nv, p) is
+/// fitAcross(g, fitLines(g, nu, p), nv, p), bit for bit.
+SurfaceFit fitAcross(const StreakGrid& grid, const LineCurves& curves, int nv,
+                     const SurfaceFitParams& params);
+
 /// max over the surface's control points of the distance to the nearest kept particle of grid.
 double netToParticles(const NurbsSurface& surface, const StreakGrid& grid);
 
