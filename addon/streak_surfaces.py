@@ -282,10 +282,19 @@ def dense_density(native, path, resolution):
     return out
 
 
+#: Largest side of a density map, pixels. The paper's supersampling is for particles far apart
+#: (§3.4); a surface of thousands of streaklines has them closer than the grid resolves, and a
+#: map of (lines - 1)(k_v + 1) + 1 rows would only cost memory, EXR writing time (about 0.1 µs a
+#: pixel) and, past 16,384, GPU textures that EEVEE cannot load.
+MAX_MAP_SIDE = 2048
+
+
 def density_image_size(particles, lines, k_u, k_v):
     """(width, height) of a surface's §3.4 map: as many samples as the paper's k_u (k_v) between
-    consecutive particles (streaklines) would give, (n - 1)(k + 1) + 1, at least 2."""
-    return (max((particles - 1) * (k_u + 1) + 1, 2), max((lines - 1) * (k_v + 1) + 1, 2))
+    consecutive particles (streaklines) would give, (n - 1)(k + 1) + 1, at least 2 and at most
+    MAX_MAP_SIDE (the samples stay evenly spread over the surface's parameters)."""
+    return tuple(min(max((n - 1) * (k + 1) + 1, 2), MAX_MAP_SIDE)
+                 for n, k in ((particles, k_u), (lines, k_v)))
 
 
 def density_image(native, surface, density, origin, cell_size, k_u, k_v, interpolation, particles,

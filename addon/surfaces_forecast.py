@@ -1,23 +1,28 @@
 """How long Build Surfaces will take, said before it starts (a long build asks first in the UI and
-prints the forecast headless: jobs/operator.py). A cost model of the build's two stages, read
+prints the forecast headless: jobs/operator.py). A cost model of the build's stages, read
 off the bake's last streak file (lines L, particles per line P) and its frame count F:
 
     h(α,β) of every pair closer than h0 (§3.3, sparse):  H_PAIR_S × pairs × F × P̄
     least-squares nets and density maps (§3.3, §3.4):    FIT_S × L × P × F
+    reading the files, building the objects:            OVERHEAD_S
 
 with P̄ = P/2 (a streakline grows by one particle per frame) and pairs = PAIR_SHARE × L²/2 (the
 default h0, the mean of h, keeps about half the pairs of a source covering a sphere; a smaller
-h0 keeps fewer, so the figure is an upper one there). The rates were measured on the 2-core
-machine the README's tables come from (bench: examples/surfaces_forecast.py)."""
+h0 keeps fewer, so the figure is an upper one there). The rates were fitted to Build Surfaces of
+the 40³ sphere scene (60 frames, 113 particles per line) on the 2-core machine the README's
+tables come from: 256, 1,024 and 4,096 streaklines took 6.5, 25-31 and 134 s (forecast 7.8, 28
+and 134 s); a faster machine finishes sooner."""
 
 import numpy as np
 
 from . import cache
 
 #: Seconds per (pair of streaklines × particle-frame) of the sparse h.
-H_PAIR_S = 2.2e-9
+H_PAIR_S = 2.5e-9
 #: Seconds per particle-frame of the nets and density maps.
-FIT_S = 1.0e-5
+FIT_S = 3.5e-6
+#: Seconds of reading the files and building the objects.
+OVERHEAD_S = 1.5
 #: Share of the pairs within the default h0.
 PAIR_SHARE = 0.5
 
@@ -31,7 +36,7 @@ def work(lines, particles, frames):
 def seconds(lines, particles, frames):
     """The forecast in seconds for L lines of P particles over F frames."""
     h_work, fit_work = work(lines, particles, frames)
-    return H_PAIR_S * h_work + FIT_S * fit_work
+    return OVERHEAD_S + H_PAIR_S * h_work + FIT_S * fit_work
 
 
 def shot_size(native, folder, manifest):
