@@ -79,8 +79,8 @@ class StreakNetTest(unittest.TestCase):
         hi = lo + np.asarray(m["resolution"]) * cell
         plans = ss.plan_surfaces(_native, groups, dom.plume.domain.streak_threshold)
         obs = [bpy.data.objects[f"{dom.name}_surface_{i}"] for i in range(len(plans))]
-        fig = dict(net=[], orders=[], particles=[], cp=0.0, cp_kept=0.0, residual=0.0, old_cp=0.0,
-                   outside=0, points=0)
+        fig = dict(net=[], orders=[], particles=[], cp=0.0, cp_kept=0.0, residual=0.0,
+                   old_cp=0.0, outside=0, points=0)
         for i, (plan, ob) in enumerate(zip(plans, obs)):
             anim = ss.surface_animation(_native, frames, plan, cell)
             with np.load(cache.surface_path(folder, i)) as z:

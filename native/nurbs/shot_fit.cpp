@@ -86,7 +86,8 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
   auto countU = [&]() {
     const bool last = fit.orderU <= kMinBlenderOrder;
     if (fit.orderU < firstU && !last && !fitsU(maxU, true)) return 0;
-    const int nu = smallestCount(std::max(fit.orderU, 2), maxU, [&](int n) { return fitsU(n, false); });
+    const int nu =
+        smallestCount(std::max(fit.orderU, 2), maxU, [&](int n) { return fitsU(n, false); });
     if (fitsU(nu, true)) return nu;
     if (nu < maxU && fitsU(maxU, true)) return maxU;
     return last ? maxU : 0;
