@@ -18,9 +18,10 @@ emitted stacked on the youngest, the particles that left the box flying on at th
 velocities) swings metres away from the smoke, so an artist moving a control point moved
 something far off. The fit (native nurbs/shot_fit.h) goes through the particles of fit_mask(),
 keeps each within FIT_TOLERANCE_CELLS of the sheet and every control point within
-NET_TOLERANCE_CELLS of it, with the smallest net that does so on every frame (fixed for the
-shot, as Blender's net is). Where the streaklines leave the simulated box through an open side
-the sheet ends: no smoke is simulated past it (density 0, as the tracer gives those particles).
+NET_TOLERANCE_CELLS of it and NEAR_TOLERANCE_CELLS of a particle, with the smallest net that
+does so on every frame (fixed for the shot, as Blender's net is). Where the streaklines leave
+the simulated box through an open side the sheet ends: no smoke is simulated past it (density 0,
+as the tracer gives those particles).
 """
 
 import os
@@ -44,6 +45,12 @@ FIT_TOLERANCE_CELLS = 0.5
 #: (the point it pulls hardest), so the net an artist edits hugs the smoke where streaklines
 #: curl; with ε this keeps control points within about 3 cells of the particles.
 NET_TOLERANCE_CELLS = 1.5
+#: ν in cells: no control point is farther than this from the nearest particle the frame's sheet
+#: goes through (issue 14: a control point an artist grabs sits among the particles it shapes).
+#: Where a cubic net of at most one control point per particle cannot (a plume's top scattering
+#: late in its shot), the net drops to order 2 along the streaklines, whose control points are
+#: the particles.
+NEAR_TOLERANCE_CELLS = 3.0
 
 
 @dataclass
@@ -238,7 +245,8 @@ def fit_mask(frame, sources, particles):
 
 
 def surface_animation(native, frames, plan, cell_size, tolerance_cells=FIT_TOLERANCE_CELLS,
-                      net_tolerance_cells=NET_TOLERANCE_CELLS) -> SurfaceAnimation:
+                      net_tolerance_cells=NET_TOLERANCE_CELLS,
+                      near_tolerance_cells=NEAR_TOLERANCE_CELLS) -> SurfaceAnimation:
     """The least-squares surfaces (§3.3, native fit_streak_shot) of the cluster's streaklines at
     every frame, on one control net chosen for the whole shot, through the particles of
     fit_mask() (not those not yet emitted, nor those past the open sides)."""
@@ -248,6 +256,7 @@ def surface_animation(native, frames, plan, cell_size, tolerance_cells=FIT_TOLER
     shot = native.fit_streak_shot(grids.astype(np.float32), keep.astype(np.uint8),
                                   tolerance=tolerance_cells * cell_size,
                                   net_tolerance=net_tolerance_cells * cell_size,
+                                  particle_tolerance=near_tolerance_cells * cell_size,
                                   order_u=ORDER_U, order_v=ORDER_V)
     cps = np.asarray(shot["control_points"], dtype=np.float32)
     head = {k: int(shot[k]) for k in ("nu", "nv", "order_u", "order_v")}

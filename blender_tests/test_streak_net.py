@@ -1,16 +1,19 @@
 """The streak surfaces' control nets stay on the smoke (issue 14: smoke_surfaces.txt §3.3 as a
 least-squares fit instead of an interpolation of every particle slot).
 
-Two bakes: a reduced Figure 1 set-up (examples/incense.py: 50³, one tip cell with 20 point
-sources, 40 frames, the Most Surfaces threshold) and a 2 m domain at 40³ with a UV-sphere Source
-of radius 0.25 m (one point source per cell: 256 streaklines), 60 frames, default threshold
-(all of them in one sheet). For every surface on every frame: no control point is farther than
-3 cells from the nearest particle of its surface, and the sheet passes within the fit tolerance
+Three bakes: the Figure 1 example itself (examples/incense.py's make_source and make_domain:
+50³, one tip cell with 20 point sources, its 120 frames, the Most Surfaces threshold), where the
+top of the plume scatters late in the shot and the nets drop to order 2 along the streaklines;
+the same set-up reduced to 40 frames; and a 2 m domain at 40³ with a UV-sphere Source of radius
+0.25 m (one point source per cell: 256 streaklines), 60 frames, default threshold (all of them
+in one sheet). For every surface on every frame: no control point is farther than 3 cells from
+the nearest particle of its surface, and the sheet passes within the fit tolerance
 (streak_surfaces.FIT_TOLERANCE_CELLS) of every particle it goes through (fit_mask: emitted, not
-past an open side). The surface cache holds the fitted points and Blender's net has their size;
-on the sphere scene the net has fewer control points than particles along the streaklines and
-none outside the domain. The interpolating nets of the same particles (the surfaces before the
-fit) are printed for comparison.
+past an open side). The surface cache holds the fitted points and Blender's net has their size
+and orders (an order-2 net drawn with one sample per control point); on the reduced incense and
+the sphere scene the nets stay cubic along the streaklines, with fewer control points than
+particles, and on the sphere scene none is outside the domain. The interpolating nets of the
+same particles (the surfaces before the fit) are printed for comparison.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_streak_net.py
@@ -76,8 +79,8 @@ class StreakNetTest(unittest.TestCase):
         hi = lo + np.asarray(m["resolution"]) * cell
         plans = ss.plan_surfaces(_native, groups, dom.plume.domain.streak_threshold)
         obs = [bpy.data.objects[f"{dom.name}_surface_{i}"] for i in range(len(plans))]
-        fig = dict(net=[], particles=[], cp=0.0, cp_kept=0.0, residual=0.0, old_cp=0.0,
-                   outside=0, points=0)
+        fig = dict(net=[], orders=[], particles=[], cp=0.0, cp_kept=0.0, residual=0.0,
+                   old_cp=0.0, outside=0, points=0)
         for i, (plan, ob) in enumerate(zip(plans, obs)):
             anim = ss.surface_animation(_native, frames, plan, cell)
             with np.load(cache.surface_path(folder, i)) as z:
@@ -85,7 +88,10 @@ class StreakNetTest(unittest.TestCase):
             sp = ob.data.splines[0]
             self.assertEqual((sp.point_count_u, sp.point_count_v), (anim.nu, anim.nv))
             self.assertEqual((sp.order_u, sp.order_v), (anim.order_u, anim.order_v))
+            # An order-2 net is drawn with its samples on its control points (the particles).
+            self.assertEqual(sp.resolution_u, 1 if anim.order_u == 2 else 2)
             fig["net"].append(f"{anim.nu}x{anim.nv}")
+            fig["orders"].append((anim.order_u, anim.order_v))
             fig["particles"].append(anim.particles)
             for f, frame in enumerate(frames):
                 full = ss.streakline_grid(frame, plan.sources, anim.particles)
@@ -106,7 +112,9 @@ class StreakNetTest(unittest.TestCase):
                     old = _native.interpolate_surface(full, order_u=ss.ORDER_U,
                                                       order_v=ss.ORDER_V)["control_points"]
                     fig["old_cp"] = max(fig["old_cp"], nearest(old[:, :3], full[born]).max() / cell)
-        print(f"  {label}: {len(plans)} surfaces, nets {', '.join(fig['net'])} (particles per "
+        orders = ", ".join(f"{u}x{v}" for u, v in fig["orders"])
+        print(f"  {label}: {len(plans)} surfaces, nets {', '.join(fig['net'])} (orders {orders}; "
+              f"particles per "
               f"streakline {max(fig['particles'])}); farthest control point from the nearest "
               f"particle {fig['cp']:.2f} cells ({fig['cp_kept']:.2f} from those fitted); largest "
               f"particle-to-sheet residual {fig['residual']:.3f} cells (tolerance "
@@ -117,15 +125,28 @@ class StreakNetTest(unittest.TestCase):
         self.assertLessEqual(fig["residual"], ss.FIT_TOLERANCE_CELLS * (1 + 1e-6))
         return fig
 
-    def test_figure_1_incense(self):
+    def incense(self, frames):
+        """The set-up of examples/incense.py (its own functions) over `frames` frames."""
         import incense
-        frames = 40
         incense.make_source(frames)
         dom = incense.make_domain(frames)
         dom.plume.domain.cache_directory = self.cache + "/"
         self.bake_and_build(dom, most_surfaces=True)
-        fig = self.check_nets(dom, "incense, 40 frames")
+        fig = self.check_nets(dom, f"incense, {frames} frames")
         self.assertGreaterEqual(len(fig["net"]), 2)
+        return fig
+
+    def test_figure_1_example(self):
+        import incense
+        fig = self.incense(incense.DEFAULT_FRAMES)
+        # The scatter at the top is met by one control point per particle, on the particles.
+        self.assertIn(2, [u for u, _ in fig["orders"]])
+
+    def test_figure_1_incense(self):
+        fig = self.incense(40)
+        # Smooth streaklines keep cubic nets, with fewer control points than particles.
+        self.assertEqual({u for u, _ in fig["orders"]}, {4})
+        self.assertLess(max(int(n.split("x")[0]) for n in fig["net"]), max(fig["particles"]))
 
     def test_sphere_source_at_40(self):
         src = add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35))
@@ -136,6 +157,7 @@ class StreakNetTest(unittest.TestCase):
         fig = self.check_nets(dom, "sphere source, 40³, 60 frames")
         nu = [int(n.split("x")[0]) for n in fig["net"]]
         self.assertLess(max(nu), min(fig["particles"]))
+        self.assertEqual({u for u, _ in fig["orders"]}, {4})
         self.assertEqual(fig["outside"], 0)
 
 

@@ -19,6 +19,16 @@ DOMAIN_KEY = "plume_surface_domain"
 MATERIAL = "Plume Smoke Sheet"
 RESOLUTION_U, RESOLUTION_V = 2, 4
 
+
+def resolution_u(order_u):
+    """Blender's samples per control point along the streaklines. An order-2 net (one control
+    point per particle where the streaklines scatter: streak_surfaces.NEAR_TOLERANCE_CELLS) is
+    straight between its control points, and with 1 sample per point Blender samples exactly at
+    them (step (n - 1) / (n - 1)): the drawn sheet is the fitted one, through every particle. With
+    2, the samples fall between the particles and cut the corners of every zig-zag, and the
+    sheet renders as bright creased outlines instead of smoke."""
+    return 1 if order_u <= 2 else RESOLUTION_U
+
 # path -> (mtime, frame_start, control points (frames, n, 4) float32)
 _loaded = {}
 #: Seconds the last handler call spent per surface (measured by tests).
@@ -188,7 +198,7 @@ def build_surfaces(context, domain, folder, frame_start, anims, sheets, settings
             ob[surface_edits.FRAME_KEY] = frame
             sp.order_u, sp.order_v = anim.order_u, anim.order_v
             sp.use_endpoint_u = sp.use_endpoint_v = True
-            sp.resolution_u, sp.resolution_v = RESOLUTION_U, RESOLUTION_V
+            sp.resolution_u, sp.resolution_v = resolution_u(anim.order_u), RESOLUTION_V
             ob[CACHE_KEY] = _file_path(cache.surface_path(folder, i))
             _control_points(cache.surface_path(folder, i))  # loaded now, not on the first frame
             ob[DOMAIN_KEY] = domain.name

@@ -113,8 +113,8 @@ void bindNurbsFit(py::module_& m) {
   m.def(
       "fit_streak_shot",
       [](const FArray& points, const KeepArray& keep, double tolerance, double netTolerance,
-         int orderU, int orderV, double smoothing, double exponentU, double exponentV, int nu,
-         int nv) {
+         double particleTolerance, int orderU, int orderV, double smoothing, double exponentU,
+         double exponentV, int nu, int nv) {
         const std::vector<StreakGrid> frames = shotFrom(points, keep);
         ShotFitParams p;
         p.fit.orderU = orderU;
@@ -124,6 +124,7 @@ void bindNurbsFit(py::module_& m) {
         p.fit.exponentV = exponentV;
         p.tolerance = tolerance;
         p.netTolerance = netTolerance;
+        p.particleTolerance = particleTolerance;
         NetSize size;
         std::vector<SurfaceFit> fits;
         {
@@ -168,16 +169,18 @@ void bindNurbsFit(py::module_& m) {
         return d;
       },
       py::arg("points"), py::arg("keep"), py::arg("tolerance"), py::arg("net_tolerance"),
-      py::arg("order_u") = 4,
+      py::arg("particle_tolerance") = ShotFitParams{}.particleTolerance, py::arg("order_u") = 4,
       py::arg("order_v") = 4, py::arg("smoothing") = SurfaceFitParams{}.smoothing,
       py::arg("exponent_u") = SurfaceFitParams{}.exponentU,
       py::arg("exponent_v") = SurfaceFitParams{}.exponentV, py::arg("nu") = 0, py::arg("nv") = 0,
       "§3.3 for a whole shot: points (frames, lines, particles, 3) float32 and keep (frames, "
       "lines, particles), the particles each frame's sheet goes through (as fit_surface). Chooses "
       "the smallest control net nu x nv (fixed for the shot, as Blender's net is; the order "
-      "across the lines may drop to 2 for crumpled clusters) that keeps every kept particle "
-      "within `tolerance` (world units) of every frame's sheet and every control point within "
-      "`net_tolerance` of the sheet at its Greville abscissae — or uses nu, nv, order_u, order_v "
+      "across the lines may drop to 2 for crumpled clusters, and along them for scattered "
+      "lines, then one control point per particle) that keeps every kept particle "
+      "within `tolerance` (world units) of every frame's sheet, every control point within "
+      "`net_tolerance` of the sheet at its Greville abscissae and within `particle_tolerance` "
+      "of the nearest kept particle — or uses nu, nv, order_u, order_v "
       "when nu and nv are > 0 — and fits every frame with it. Returns dict(nu, nv, order_u, "
       "order_v, control_points float32 (frames, nv*nu, 4) in Blender's flat order, params_u / "
       "params_v: per frame the particles' parameters (NaN where not kept), max_residual, "

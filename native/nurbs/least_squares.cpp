@@ -32,7 +32,7 @@ int distinctCount(std::vector<double> t) {
 
 CurveFitter::CurveFitter(const std::vector<double>& params, int count, int order, bool endpoint,
                          double smoothing)
-    : mCount(count), mOrder(order), mLu(1, 0, 0) {
+    : mCount(count), mOrder(order), mParams(params), mLu(1, 0, 0) {
   checkInputs(params, count, order, smoothing);
   mKnots = blenderKnots(count, order, endpoint);
   mGreville = grevilleAbscissae(mKnots, count, order);

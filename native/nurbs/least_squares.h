@@ -33,6 +33,8 @@ class CurveFitter {
   int count() const { return mCount; }
   int order() const { return mOrder; }
   std::size_t dataCount() const { return mRows.size(); }
+  /// t_i, the parameter of datum i < dataCount().
+  double parameter(std::size_t i) const { return mParams.at(i); }
 
   /// Control points (count of them, at out[j * outStride]) of the fit to the data
   /// q_i = data[i * stride], i < dataCount().
@@ -51,6 +53,7 @@ class CurveFitter {
   bool mConstant = false;
   std::vector<float> mKnots;
   std::vector<double> mGreville;
+  std::vector<double> mParams;
   std::vector<BasisValues> mRows;
   BandedLu mLu;
 };

@@ -21,11 +21,11 @@ void checkFrames(const std::vector<StreakGrid>& frames) {
   }
 }
 
-/// True when f holds on every frame (each frame on its own task; the answer is order-free).
-bool everyFrame(const std::vector<StreakGrid>& frames,
-                const std::function<bool(const StreakGrid&)>& f) {
-  std::vector<char> ok(frames.size(), 0);
-  parallelFor(0, int(frames.size()), [&](int n) { ok[std::size_t(n)] = f(frames[std::size_t(n)]); });
+/// True when f(n) holds for every frame n < count (each frame on its own task; the answer is
+/// order-free).
+bool everyFrame(std::size_t count, const std::function<bool(std::size_t)>& f) {
+  std::vector<char> ok(count, 0);
+  parallelFor(0, int(count), [&](int n) { ok[std::size_t(n)] = f(std::size_t(n)); });
   return std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
 }
 
@@ -48,10 +48,10 @@ int smallestCount(int lo, int hi, const std::function<bool(int)>& good) {
 void ShotFitParams::validate() const {
   fit.validate();
   if (!std::isfinite(tolerance) || !(tolerance > 0.0) || !std::isfinite(netTolerance) ||
-      !(netTolerance > 0.0)) {
+      !(netTolerance > 0.0) || !std::isfinite(particleTolerance) || !(particleTolerance > 0.0)) {
     std::ostringstream s;
-    s << "tolerance and net_tolerance must be finite and > 0 (got " << tolerance << ", "
-      << netTolerance << ")";
+    s << "tolerance, net_tolerance and particle_tolerance must be finite and > 0 (got "
+      << tolerance << ", " << netTolerance << ", " << particleTolerance << ")";
     throw std::invalid_argument(s.str());
   }
 }
@@ -63,34 +63,58 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
   const int maxV = std::max(frames.front().lines, 2);
   NetSize size;
   SurfaceFitParams fit = params.fit;
+  // Each frame's kept particles, bucketed once for ν.
+  std::vector<NearParticles> near;
+  near.reserve(frames.size());
+  for (const StreakGrid& g : frames) near.push_back(keptParticles(g));
+  // The counts are bisected on ε and δ, which tighten as the count grows; ν need not (more
+  // control points on sparse particles may sit farther from them), so it is checked at the
+  // count found, and the largest count is the fallback.
   // Along the streaklines first: the curves the v step then blends. Interpolating them across
   // adds no error at the streaklines, so they may use the whole tolerances.
-  size.orderU = fit.orderU = std::min(params.fit.orderU, maxU);
-  size.nu = smallestCount(std::max(fit.orderU, 2), maxU, [&](int nu) {
-    return everyFrame(frames, [&](const StreakGrid& g) {
-      const CurveFitQuality q = curveFitQuality(g, nu, fit);
-      return q.maxResidual <= params.tolerance && q.netDeviation <= params.netTolerance;
+  auto fitsU = [&](int nu, bool checkNear) {
+    return everyFrame(frames.size(), [&](std::size_t n) {
+      const CurveFitQuality q = curveFitQuality(frames[n], nu, fit, checkNear ? &near[n] : nullptr);
+      return q.maxResidual <= params.tolerance && q.netDeviation <= params.netTolerance &&
+             (!checkNear || q.netToParticles <= params.particleTolerance);
     });
-  });
+  };
+  // The count at the current order along u, 0 when no count meets the three tolerances. Orders
+  // below the first are tried only where the largest count meets them; order 2 with one control
+  // point per particle always does (its control points are the particles), so it is the last.
+  const int firstU = std::min(params.fit.orderU, maxU);
+  auto countU = [&]() {
+    const bool last = fit.orderU <= kMinBlenderOrder;
+    if (fit.orderU < firstU && !last && !fitsU(maxU, true)) return 0;
+    const int nu =
+        smallestCount(std::max(fit.orderU, 2), maxU, [&](int n) { return fitsU(n, false); });
+    if (fitsU(nu, true)) return nu;
+    if (nu < maxU && fitsU(maxU, true)) return maxU;
+    return last ? maxU : 0;
+  };
+  for (fit.orderU = firstU;; --fit.orderU)
+    if ((size.nu = countU()) > 0) break;
+  size.orderU = fit.orderU;
   // The lines' curves do not depend on nv or the order across: fitted once per frame.
   std::vector<LineCurves> curves(frames.size());
   parallelFor(0, int(frames.size()), [&](int n) {
     curves[std::size_t(n)] = fitLines(frames[std::size_t(n)], size.nu, fit);
   });
-  auto good = [&](int nv) {
-    std::vector<char> ok(frames.size(), 0);
-    parallelFor(0, int(frames.size()), [&](int n) {
-      const SurfaceFit f = fitAcross(frames[std::size_t(n)], curves[std::size_t(n)], nv, fit);
-      ok[std::size_t(n)] = f.maxResidual <= params.tolerance && f.netDeviation <= params.netTolerance;
+  auto fitsV = [&](int nv, bool checkNear) {
+    return everyFrame(frames.size(), [&](std::size_t n) {
+      const SurfaceFit f = fitAcross(frames[n], curves[n], nv, fit);
+      return f.maxResidual <= params.tolerance && f.netDeviation <= params.netTolerance &&
+             (!checkNear || netToParticles(f.surface, near[n]) <= params.particleTolerance);
     });
-    return std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
   };
   // Across the streaklines: the highest order whose interpolating sheet keeps to the
   // tolerances, then the fewest control points with it.
   for (fit.orderV = std::min(params.fit.orderV, maxV); fit.orderV > kMinBlenderOrder; --fit.orderV)
-    if (good(maxV)) break;
+    if (fitsV(maxV, true)) break;
   size.orderV = fit.orderV;
-  size.nv = smallestCount(std::max(std::min(fit.orderV, maxV), 2), maxV, good);
+  size.nv = smallestCount(std::max(std::min(fit.orderV, maxV), 2), maxV,
+                          [&](int n) { return fitsV(n, false); });
+  if (size.nv < maxV && !fitsV(size.nv, true)) size.nv = maxV;
   const std::vector<SurfaceFit> fits = fitShot(frames, size, params.fit);
   for (const SurfaceFit& f : fits) {
     size.maxResidual = std::max(size.maxResidual, f.maxResidual);

@@ -21,8 +21,12 @@ struct ShotFitParams {
   /// smoke where the streaklines curl (a coarse net that fits within ε still cuts corners far
   /// outside the curls; an interpolating one swings off).
   double netTolerance = 0.04;
+  /// ν: largest distance allowed between a control point and the nearest kept particle of its
+  /// frame, world units (the add-on passes 3 cells): the control point an artist grabs sits among
+  /// the particles it shapes, even where they are too sparse for δ to say so.
+  double particleTolerance = 0.06;
 
-  /// Throws std::invalid_argument: fit.validate(), tolerance and net_tolerance finite and > 0.
+  /// Throws std::invalid_argument: fit.validate(), the three tolerances finite and > 0.
   void validate() const;
 };
 
@@ -40,14 +44,18 @@ struct NetSize {
 /// Counts for a shot of frames (all with the same particles and lines; the kept ones may
 /// change): along u the smallest nu in [min(order_u, P), P] (P = particles, at least 2) for
 /// which every frame's streakline curves pass within ε of their particles and have their
-/// control points within δ of the curve (curveFitQuality()), by bisection; then, with that nu,
-/// the smallest nv in [min(order_v, L), L] (L = lines, at least 2) for which every frame's
-/// surface does (fitSurface()). Where the lines are too crumpled for that (a smooth sheet
-/// through them swings beyond δ even when it interpolates them: the greedy order of many
-/// streaklines zig-zags), the order across them drops (4, 3, then 2, whose control points are
-/// the lines' own curves) before nv is chosen. Where even the largest count misses, the largest
-/// is used; NetSize says what it gives. Frames are fitted in parallel; the result does not
-/// depend on the thread count.
+/// control points within δ of the curve and within ν of a particle (curveFitQuality()), by
+/// bisection; then, with that nu, the smallest nv in [min(order_v, L), L] (L = lines, at least
+/// 2) for which every frame's surface does (fitSurface(), netToParticles()). Where the lines
+/// scatter along u (the top of a plume late in its shot: consecutive particles many cells apart,
+/// zig-zagging) even P control points at order_u miss, and the order along them drops (3, then
+/// 2): at nu = P those interpolate every particle at its slot's Greville abscissa
+/// (slotsInterpolated()), and at order 2 every control point is a particle. Where the lines are
+/// too crumpled across (a smooth sheet through them swings beyond δ even when it interpolates
+/// them: the greedy order of many streaklines zig-zags), the order across them drops likewise
+/// (4, 3, then 2, whose control points are the lines' own curves) before nv is chosen. Where
+/// even the largest count misses, the largest is used; NetSize says what it gives. Frames are
+/// fitted in parallel; the result does not depend on the thread count.
 NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams& params);
 
 /// fitSurface() of every frame with the net `size` (its counts and orders; the rest of the

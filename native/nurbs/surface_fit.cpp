@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -33,6 +34,25 @@ KnotDomain drawnDomain(int count, int order) {
 
 }  // namespace
 
+/// The slot each slot's control point interpolates in slotsInterpolated() mode: the slot itself
+/// when its particle is kept, else the nearest kept slot of the line (the older one on a tie):
+/// particles not yet emitted take the youngest kept, those past an open side the oldest kept.
+static std::vector<int> nearestKeptSlots(const StreakGrid& g, int b) {
+  std::vector<int> slot(std::size_t(g.particles), -1);
+  int last = -1;
+  for (int a = 0; a < g.particles; ++a) {  // forward: the nearest kept at or before a
+    if (g.kept(b, a)) last = a;
+    slot[std::size_t(a)] = last;
+  }
+  last = -1;
+  for (int a = g.particles - 1; a >= 0; --a) {  // backward: a nearer kept one after a wins
+    if (g.kept(b, a)) last = a;
+    const int before = slot[std::size_t(a)];
+    if (last >= 0 && (before < 0 || last - a < a - before)) slot[std::size_t(a)] = last;
+  }
+  return slot;
+}
+
 LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
   params.validate();
   g.validate();
@@ -50,36 +70,59 @@ LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params)
   c.paramsU.assign(std::size_t(g.lines) * std::size_t(g.particles), kNaN);
   c.quality.resize(c.lines.size());
   const KnotDomain dom = drawnDomain(nu, c.order);
+  // One control point per slot at a low order: every line interpolated at the same Greville
+  // abscissae (Schoenberg-Whitney holds there, so no penalty is needed), one factorisation.
+  const bool slots = slotsInterpolated(g, nu, params);
+  std::unique_ptr<CurveFitter> slotFit;
+  if (slots) slotFit = std::make_unique<CurveFitter>(interpolationParameters(nu, c.order, true),
+                                                     nu, c.order, true, /*smoothing=*/0.0);
   parallelFor(0, int(c.lines.size()), [&](int r) {
     const int b = c.lines[std::size_t(r)];
-    std::vector<int> kept;
-    std::vector<glm::vec3> pts;
+    std::vector<int> kept;     // the kept particles, in slot order
+    std::vector<int> rowOf;    // the fitter's data row of each of them
     std::vector<glm::dvec3> data;
-    for (int a = 0; a < g.particles; ++a)
-      if (g.kept(b, a)) {
-        kept.push_back(a);
-        pts.push_back(g.at(b, a));
-        data.emplace_back(g.at(b, a));
+    std::unique_ptr<CurveFitter> own;
+    if (slots) {
+      const std::vector<int> from = nearestKeptSlots(g, b);
+      for (int a = 0; a < g.particles; ++a) {
+        data.emplace_back(g.at(b, from[std::size_t(a)]));
+        if (from[std::size_t(a)] == a) {
+          kept.push_back(a);
+          rowOf.push_back(a);
+        }
       }
-    const std::vector<double> t = mapParameters(
-        averagedChordParameters({pts.data(), int(pts.size()), 1, 1, 0}, params.exponentU), dom.start,
-        dom.end);
-    const CurveFitter fit(t, nu, c.order, true, params.smoothing);
+    } else {
+      std::vector<glm::vec3> pts;
+      for (int a = 0; a < g.particles; ++a)
+        if (g.kept(b, a)) {
+          kept.push_back(a);
+          rowOf.push_back(int(pts.size()));
+          pts.push_back(g.at(b, a));
+          data.emplace_back(g.at(b, a));
+        }
+      const std::vector<double> t = mapParameters(
+          averagedChordParameters({pts.data(), int(pts.size()), 1, 1, 0}, params.exponentU),
+          dom.start, dom.end);
+      own = std::make_unique<CurveFitter>(t, nu, c.order, true, params.smoothing);
+    }
+    const CurveFitter& fit = slots ? *slotFit : *own;
     glm::dvec3* row = c.controlPoints.data() + std::size_t(r) * std::size_t(nu);
     fit.fit(data.data(), 1, row, 1);
     CurveFitQuality& q = c.quality[std::size_t(r)];
     for (std::size_t i = 0; i < kept.size(); ++i) {
-      c.paramsU[g.index(b, kept[i])] = t[i];
-      q.maxResidual = std::max(q.maxResidual, glm::length(fit.point(i, row, 1) - data[i]));
+      const std::size_t k = std::size_t(rowOf[i]);
+      c.paramsU[g.index(b, kept[i])] = fit.parameter(k);
+      q.maxResidual = std::max(q.maxResidual, glm::length(fit.point(k, row, 1) - data[k]));
     }
     q.netDeviation = fit.netDeviation(row, 1);
   });
   return c;
 }
 
-namespace {
+bool slotsInterpolated(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
+  return nu == g.particles && nu >= 2 && std::min(params.orderU, nu) <= 3;
+}
 
-/// The kept particles of the frame, bucketed for nearest-particle distances.
 NearParticles keptParticles(const StreakGrid& g) {
   std::vector<glm::vec3> pts;
   glm::vec3 lo(0.f), hi(0.f);
@@ -97,8 +140,6 @@ NearParticles keptParticles(const StreakGrid& g) {
   const double filled = std::cbrt(box.x * box.y * box.z * 4.0 / double(pts.size()));
   return NearParticles(pts, std::max(filled, extent / 256.0));
 }
-
-}  // namespace
 
 void SurfaceFitParams::validate() const {
   for (int order : {orderU, orderV})
@@ -206,19 +247,26 @@ SurfaceFit fitAcross(const StreakGrid& g, const LineCurves& curves, int nv,
   return fit;
 }
 
-CurveFitQuality curveFitQuality(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
+CurveFitQuality curveFitQuality(const StreakGrid& g, int nu, const SurfaceFitParams& params,
+                                const NearParticles* near) {
   const LineCurves curves = fitLines(g, nu, params);
   CurveFitQuality worst;
   for (const CurveFitQuality& q : curves.quality) {
     worst.maxResidual = std::max(worst.maxResidual, q.maxResidual);
     worst.netDeviation = std::max(worst.netDeviation, q.netDeviation);
   }
+  if (near != nullptr)
+    for (const glm::dvec3& p : curves.controlPoints)
+      worst.netToParticles = std::max(worst.netToParticles, near->nearest(glm::vec3(p)));
   return worst;
 }
 
 double netToParticles(const NurbsSurface& surface, const StreakGrid& g) {
   g.validate();
-  const NearParticles near = keptParticles(g);
+  return netToParticles(surface, keptParticles(g));
+}
+
+double netToParticles(const NurbsSurface& surface, const NearParticles& near) {
   std::vector<double> d(surface.controlPoints.size(), 0.0);
   parallelFor(0, int(d.size()), [&](int n) {
     d[std::size_t(n)] = near.nearest(glm::vec3(surface.controlPoints[std::size_t(n)]));

@@ -6,6 +6,7 @@
 /// while its control points stay on the smoke (an interpolating net through hundreds of
 /// unevenly spaced particles swings metres away from them).
 
+#include "nurbs/near_particles.h"
 #include "nurbs/surface.h"
 
 #include <glm/glm.hpp>
@@ -54,7 +55,8 @@ struct StreakGrid {
 struct SurfaceFit {
   NurbsSurface surface;
   /// u of every kept particle, [b * particles + a] (NaN for the others): the streakline's own
-  /// chord length, mapped onto the drawn domain (oldest kept particle at its start).
+  /// chord length, mapped onto the drawn domain (oldest kept particle at its start), or with
+  /// slotsInterpolated() the Greville abscissa of the particle's slot.
   std::vector<double> paramsU;
   /// v of every streakline (NaN for a line with no kept particle): its interpolation parameter,
   /// or averaged chord length across the lines' fitted curves when nv is smaller.
@@ -73,7 +75,11 @@ struct SurfaceFit {
 /// §3.3 as a fit, tensor product in two steps (Piegl & Tiller §9.4.3): each streakline, its kept
 /// particles at centripetal chord-length parameters (coincident particles merged), becomes a
 /// penalised least-squares curve (CurveFitter) with nu control points on Blender's endpoint
-/// knots; then every column of those control points becomes a curve across v with nv control
+/// knots — except with one control point per particle slot (nu = particles) at order 2 or 3
+/// (slotsInterpolated()): there particle a sits at the Greville abscissa ḡ_a of control point a
+/// and the line is interpolated (§3.3's "each particle ... serves as a knot"), the slots of
+/// particles not kept holding the nearest kept particle of the line (by slot), so at order 2
+/// every control point is a particle; then every column of those control points becomes a curve across v with nv control
 /// points: interpolated at interpolationParameters() when there are nv lines with kept particles
 /// (§3.3's interpolation across the streaklines), else a penalised least-squares fit with the
 /// lines at averaged chord-length parameters. Weights are 1. A direction with one distinct point
@@ -81,13 +87,26 @@ struct SurfaceFit {
 /// nu, nv >= 2. Throws std::invalid_argument on bad input.
 SurfaceFit fitSurface(const StreakGrid& grid, int nu, int nv, const SurfaceFitParams& params);
 
+/// True when fitSurface() interpolates each streakline with one control point per particle slot
+/// at the slots' Greville abscissae (order along u of 2 or 3, nu = particles >= 2) instead of
+/// fitting chord-length parameters: the low orders chooseNetSize() falls back to where the
+/// lines scatter, at whose Greville abscissae the interpolation is exact and non-singular.
+bool slotsInterpolated(const StreakGrid& grid, int nu, const SurfaceFitParams& params);
+
 /// How well the streakline curves of the u step of fitSurface() alone fit: what the count along
 /// u controls.
 struct CurveFitQuality {
   double maxResidual = 0.0;   ///< max over kept particles of |C_b(u_ab) − q_ab|
   double netDeviation = 0.0;  ///< max over the curves' control points of |c_bj − C_b(ḡ_j)|
+  /// max over the curves' control points of the distance to the nearest particle of `near`
+  /// (0 when curveFitQuality() is given none).
+  double netToParticles = 0.0;
 };
-CurveFitQuality curveFitQuality(const StreakGrid& grid, int nu, const SurfaceFitParams& params);
+CurveFitQuality curveFitQuality(const StreakGrid& grid, int nu, const SurfaceFitParams& params,
+                                const NearParticles* near = nullptr);
+
+/// The kept particles of grid, bucketed for netToParticles() (build once per frame).
+NearParticles keptParticles(const StreakGrid& grid);
 
 /// The u step of fitSurface() on its own: every line with kept particles as a curve of nu
 /// control points (order min(params.orderU, nu)). It does not depend on nv or orderV, so a
@@ -109,5 +128,7 @@ SurfaceFit fitAcross(const StreakGrid& grid, const LineCurves& curves, int nv,
 
 /// max over the surface's control points of the distance to the nearest kept particle of grid.
 double netToParticles(const NurbsSurface& surface, const StreakGrid& grid);
+/// The same, to the particles of `near` (keptParticles() of the frame).
+double netToParticles(const NurbsSurface& surface, const NearParticles& near);
 
 }  // namespace plume
