@@ -245,8 +245,13 @@ class PLUME_OT_surfaces_fast_render(bpy.types.Operator):
     bl_label = "Fast Sheet Render"
     bl_options = {'REGISTER', 'UNDO'}  # render settings only
 
+    samples: bpy.props.IntProperty(
+        name="Samples", default=sheet_render.FAST_SAMPLES, min=1, soft_max=256,
+        description="Samples per pixel: the sheets need a few for their edges; lit objects seen "
+                    "through them (a collider) need more against light-sampling noise")
+
     def execute(self, context):
-        sheet_render.apply_fast_cycles(context.scene)
+        sheet_render.apply_fast_cycles(context.scene, samples=self.samples)
         self.report({'INFO'}, "Plume: " + sheet_render.describe(context.scene))
         return {'FINISHED'}
 
