@@ -89,8 +89,8 @@ class JobOperator:
         """The dialog of a long job: how long, and how to make it shorter."""
         if getattr(self, "_asked", None) is None:
             return
-        col = self.layout.column()
-        col.label(text=self._asked, icon='TIME')
+        col = self.layout.column()  # the dialog's title is the operator's label already
+        col.label(text=f"{self._forecast.what}, {self._forecast.about()}", icon='TIME')
         col.label(text="It runs in the background: Esc cancels it.")
         for line in self.make_runner(context).shorter_hint():
             col.label(text=line)
