@@ -22,8 +22,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
 
-from helpers import (incense_streak_scene, reset_scene, rmtree, run, run_cancelled,  # noqa: E402
-                     select_only, temp_dir, tree_listing)
+from helpers import (assert_reports_error, incense_streak_scene, reset_scene, rmtree, run,  # noqa: E402
+                     run_cancelled, select_only, temp_dir, tree_listing)
 
 RESOLUTION = 24
 FRAMES = 20
@@ -239,6 +239,27 @@ class JobsTest(unittest.TestCase):
         self.assertEqual(first, f"Plume: Build Surfaces: {lines:,} streaklines x {frames} "
                                 f"frames, about {seconds:.0f} s")
         print(f"  forecast {seconds:.2f} s for {lines} streaklines x {frames} frames")
+
+    def test_10_build_beyond_free_memory_is_refused(self):
+        """A build that would not fit in free memory is refused before anything is computed or
+        written, naming the streaklines and the memory they need (free memory is faked small:
+        the check reads it when the button is pressed)."""
+        from plume import _native, cache, point_sources
+        from plume import surfaces_forecast as sf
+        from plume.snapshot import cache_folder_of
+        folder = cache_folder_of(self.dom)
+        lines, particles, frames = sf.shot_size(_native, folder, cache.read_manifest(folder))
+        need = sf.memory_bytes(lines, particles, frames)
+        available = point_sources.available_bytes
+        point_sources.available_bytes = lambda: int(need) - 1
+        try:
+            assert_reports_error(self, bpy.ops.plume.surfaces_build,
+                                 rf"{lines:,} streaklines over {frames} frames need about "
+                                 r"[0-9.]+ GB .* than the [0-9.]+ GB of memory free",
+                                 self.state)
+        finally:
+            point_sources.available_bytes = available
+        self.assertEqual(bpy.ops.plume.surfaces_build(), {'FINISHED'})  # enough again
 
 
 if __name__ == "__main__":

@@ -115,6 +115,9 @@ class SurfacesJob(JobRunner):
         self.objects = (domain.name,)
         self.claim(domain_key(domain.name))
         self.manifest = ss.streak_manifest(self.folder, domain.name)
+        size = surfaces_forecast.shot_size(_native, self.folder, self.manifest)
+        if size is not None:
+            surfaces_forecast.check_memory(domain.name, *size)
 
     def run(self):
         folder, m = self.folder, self.manifest
