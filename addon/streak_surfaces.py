@@ -12,7 +12,8 @@ reach, exactly, and no n x n matrix. The reach starts at the group's default h0 
 and grows when a build asks for a larger threshold; clusters, counts and the Figure 4 curve are
 exact up to it, the greedy order always.
 
-The surface of a cluster is a least-squares fit, not an interpolation (issue 14): a net that
+The surface of a cluster is a least-squares fit, not an interpolation, so that an artist can
+edit its control net by hand (the paper's §5): a net that
 interpolates every particle slot (nu = particles per streakline, the slots of particles not yet
 emitted stacked on the youngest, the particles that left the box flying on at their exit
 velocities) swings metres away from the smoke, so an artist moving a control point moved
@@ -46,7 +47,7 @@ FIT_TOLERANCE_CELLS = 0.5
 #: curl; with ε this keeps control points within about 3 cells of the particles.
 NET_TOLERANCE_CELLS = 1.5
 #: ν in cells: no control point is farther than this from the nearest particle the frame's sheet
-#: goes through (issue 14: a control point an artist grabs sits among the particles it shapes).
+#: goes through (a control point an artist grabs sits among the particles it shapes).
 #: Where a cubic net of at most one control point per particle cannot (a plume's top scattering
 #: late in its shot), the net drops to order 2 along the streaklines, whose control points are
 #: the particles.

@@ -1,5 +1,5 @@
 // Unit tests of the order along the streaklines of the least-squares streak surface
-// (smoke_surfaces.txt §3.3 with a control net an artist can edit, issue 14): where the lines
+// (smoke_surfaces.txt §3.3 with a control net an artist can edit): where the lines
 // scatter (consecutive particles many cells apart, zig-zagging, as at the top of the Figure-1
 // plume late in its shot) the net drops to order 2 with one control point per particle, whose
 // control points are the particles; smooth lines keep the cubic net with fewer control points.
