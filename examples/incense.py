@@ -98,8 +98,8 @@ def main():
     scene_kit.save_blend(out_dir, "incense")
 
     bake_s, build_s, h0, surfaces = scene_kit.bake_surfaces(dom, "incense")
-    # The sheets shade themselves (§3.4): 8 samples and no light bounces give the same picture
-    # as 64 samples with bounces, 7-10x faster (examples/sheet_render_time.py).
+    # The sheets shade themselves (§3.4): 16 samples and no light bounces give the same picture
+    # as 64 samples with bounces, several times faster (examples/sheet_render_time.py).
     assert bpy.ops.plume.surfaces_fast_render() == {'FINISHED'}
     shown = sorted({max(1, min(frames, round(f * frames))) for f in SHOW})
     render_s, strip = scene_kit.render_strip(scene, shown, out_dir, "incense")

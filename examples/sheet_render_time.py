@@ -6,7 +6,7 @@ its 120 frames) at 640 x 480, frame 84, in three set-ups, with the difference fr
 
 - Cycles as the example rendered before: 64 samples, Blender's default light bounces, 64
   transparent bounces;
-- Cycles with the add-on's Fast Sheet Render (plume.surfaces_fast_render: 8 samples, no light
+- Cycles with the add-on's Fast Sheet Render (plume.surfaces_fast_render: 16 samples, no light
   bounces; the sheets shade themselves, §3.4);
 - EEVEE, 16 samples, where this Blender can run it (3.4.1 under ``blender -b`` has no GPU
   context: run it in a window, e.g. under ``xvfb-run``, to measure it).

@@ -109,7 +109,7 @@ def main():
 
     bake_s, build_s, h0, surfaces = scene_kit.bake_surfaces(dom, "sphere_collision")
     # Sheets shade themselves (§3.4); the lit sphere seen through them needs more than the
-    # sheets' 8 samples against light-sampling noise.
+    # sheets' 16 samples against light-sampling noise.
     assert bpy.ops.plume.surfaces_fast_render(samples=48) == {'FINISHED'}
     shown = sorted({min(f, frames) for f in SHOW})
     render_s, strip = scene_kit.render_strip(scene, shown, out_dir, "sphere")

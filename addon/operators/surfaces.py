@@ -241,7 +241,7 @@ class PLUME_OT_surfaces_pick_threshold(bpy.types.Operator):
 
 class PLUME_OT_surfaces_fast_render(bpy.types.Operator):
     """Set the scene to a fast Cycles set-up for streak sheets: their material shades itself
-    (emission and transparency by p, §3.4), so 8 samples and no light bounces, only transparent
+    (emission and transparency by p, §3.4), so 16 samples and no light bounces, only transparent
     ones, give the same picture (other objects lose indirect light)"""
 
     bl_idname = "plume.surfaces_fast_render"
