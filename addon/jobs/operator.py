@@ -86,14 +86,18 @@ class JobOperator:
         return self._start(context)
 
     def draw(self, context):
-        """The dialog of a long job: how long, and how to make it shorter."""
-        if getattr(self, "_asked", None) is None:
-            return
+        """The operator's settings (as Blender draws them by default, in the Adjust Last
+        Operation panel), under how long the job will take and how to make it shorter while
+        the long-job dialog is open."""
         col = self.layout.column()  # the dialog's title is the operator's label already
-        col.label(text=f"{self._forecast.what}, {self._forecast.about()}", icon='TIME')
-        col.label(text="It runs in the background: Esc cancels it.")
-        for line in self.make_runner(context).shorter_hint():
-            col.label(text=line)
+        if getattr(self, "_asked", None) is not None:
+            col.label(text=f"{self._forecast.what}, {self._forecast.about()}", icon='TIME')
+            col.label(text="It runs in the background: Esc cancels it.")
+            for line in self.make_runner(context).shorter_hint():
+                col.label(text=line)
+        for prop in self.properties.bl_rna.properties:
+            if prop.identifier != "rna_type" and not prop.is_hidden:
+                col.prop(self, prop.identifier)
 
     def _start(self, context):
         """prepare(), then run() on a worker thread with a modal timer (the button's path)."""
