@@ -1,6 +1,6 @@
 #pragma once
 /// \file block_mask.h
-/// Sparse work for advection (issue 3: "skip advection in blocks with no smoke"): blocks of
+/// Sparse work for advection (skip advection in blocks with no smoke): blocks of
 /// 8³ samples that may hold something other than a field's background value, and the loop over
 /// the x-runs of a grid that lie in them.
 

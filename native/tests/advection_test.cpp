@@ -1,4 +1,4 @@
-// Tests of the advection machinery behind issue 3's speed-ups: Euler back-traces (first order,
+// Tests of the advection machinery behind the solver's speed-ups: Euler back-traces (first order,
 // Mantaflow's), the schemes against a reference built from the position-based samplers, fields
 // carried together against fields carried one by one, and determinism of the new option.
 #include "core/parallel.h"

@@ -1,5 +1,5 @@
 /// \file flowgraph_reproduction_test.cpp
-/// The proof that synthesis integrates the pathlines correctly (issue 6): a real fire bake
+/// The proof that synthesis integrates the pathlines correctly: a real fire bake
 /// records its pathline groups to a file, together with the positions its RK4 integration
 /// reached; a walk restricted to temporal edges (nodes 0, 1, 2, ... of the state) synthesized
 /// from the file with u_ext = 0 must put every particle where the bake's integration put it.

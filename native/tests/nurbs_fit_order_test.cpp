@@ -8,6 +8,8 @@
 #include "nurbs/knots.h"
 #include "nurbs/shot_fit.h"
 
+#include "streak_shot.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,17 +28,7 @@ constexpr double kCell = 1.0 / 50.0;  // the Figure-1 grid: 50³ over a 1 m doma
 /// the second half of the shot the particles older than 20 emissions zig-zag ±12 cells across
 /// (consecutive ones 24 cells apart, the incense top's scatter), and the 4 oldest have left
 /// through an open side (keep = 0, positions far off).
-struct ZigZagShot {
-  int lines = 0, particles = 0;
-  std::vector<std::vector<glm::vec3>> points;
-  std::vector<std::vector<std::uint8_t>> keep;
-  std::vector<StreakGrid> grids() const {
-    std::vector<StreakGrid> g;
-    for (std::size_t f = 0; f < points.size(); ++f)
-      g.push_back({points[f].data(), keep[f].data(), particles, lines});
-    return g;
-  }
-};
+using ZigZagShot = StreakShot;
 
 ZigZagShot zigZagShot(int lines, int frames, bool scatter) {
   ZigZagShot s;

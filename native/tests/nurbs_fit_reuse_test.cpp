@@ -1,4 +1,4 @@
-// The speed-ups of Build Surfaces' fit (issue 14) change no result: the v step on line curves
+// The speed-ups of Build Surfaces' fit change no result: the v step on line curves
 // fitted once (fitLines + fitAcross, as chooseNetSize searches nv) is fitSurface bit for bit,
 // and the nearest-particle search stays exact when its bucket table is coarsened to fit.
 

@@ -14,6 +14,8 @@
 #include "nurbs/near_particles.h"
 #include "nurbs/shot_fit.h"
 
+#include "streak_shot.h"
+
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -125,17 +127,7 @@ constexpr float kCell = 1.f / 40.f;  // a 40³ grid over the unit domain
 /// particles not yet emitted stacked on the youngest (keep = 0). Particles speed up as they
 /// rise (young ones crowd near the source), the oldest are held together at the top (exactly
 /// coincident, like a line piling up against a closed side), and the lines fan out with age.
-struct Shot {
-  int lines = 0, particles = 0;
-  std::vector<std::vector<glm::vec3>> points;
-  std::vector<std::vector<std::uint8_t>> keep;
-  std::vector<StreakGrid> grids() const {
-    std::vector<StreakGrid> g;
-    for (std::size_t f = 0; f < points.size(); ++f)
-      g.push_back({points[f].data(), keep[f].data(), particles, lines});
-    return g;
-  }
-};
+using Shot = StreakShot;
 
 Shot plumeShot(int lines, int frames, int steps) {
   Shot s;

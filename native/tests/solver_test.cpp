@@ -1,4 +1,4 @@
-// Tests of the smoke solver: the properties issue 2 names (divergence after projection, mass
+// Tests of the smoke solver: the properties a grid solver must keep (divergence after projection, mass
 // conservation, no new extrema, symmetry, determinism across thread counts).
 #include "core/parallel.h"
 #include "core/rng.h"

@@ -1,8 +1,8 @@
 #pragma once
 /// \file mantaflow_driver.h
 /// Streaklines driven by a baked Blender Mantaflow cache instead of the Plume solver
-/// (smoke_surfaces.txt §3.2: the particles are "advected by the velocity field"; issue 4: "the
-/// tracers can also be driven by an existing Blender Mantaflow cache").
+/// (smoke_surfaces.txt §3.2: the particles are "advected by the velocity field"; any velocity
+/// field will do, so an artist's existing Mantaflow bake can drive them).
 ///
 /// Time. The cache holds the fields at frame ends only. Over one frame of length T from frame
 /// f's fields (A) to frame f+1's (B) the velocity is taken as linear in time,

@@ -1,4 +1,4 @@
-"""Streaklines driven by a Blender Mantaflow cache, from Python (issue 4, smoke_surfaces §3.2):
+"""Streaklines driven by a Blender Mantaflow cache, from Python (smoke_surfaces §3.2):
 the grid's world placement, reading a fluid_data VDB (written here with pyopenvdb as Blender 3.4
 lays it out, when pyopenvdb is installed), volume frames, the tracer and its errors."""
 import numpy as np
