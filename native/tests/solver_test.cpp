@@ -1,5 +1,5 @@
-// Tests of the smoke solver: the properties a grid solver must keep (divergence after projection, mass
-// conservation, no new extrema, symmetry, determinism across thread counts).
+// Tests of the smoke solver: the properties a grid solver must keep (divergence after
+// projection, mass conservation, no new extrema, symmetry, determinism across thread counts).
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "solver/advection.h"
