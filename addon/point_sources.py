@@ -1,21 +1,23 @@
 """Tracer point sources of a traced bake (smoke_surfaces.txt §3.2-3.3), no ``bpy``: where each
 Source's point sources are and which candidate group each belongs to.
 
-    points, velocities = source_point_sources(native, params, domain_name, seed, emitter, index)
-    groups = split_groups(points, first_group, emitter.candidate_split, emitter.name)
+    points, groups, velocities, emitting = domain_point_sources(native, params, snapshot)
 
-A source's point sources are `point_sources` random points in each of its cells (§3.2: "10-20
-point sources are placed randomly in a source cell"), thinned at random to the domain's
-max_streaklines over all Sources (a 0.25 m sphere at 40³ has ~500 cells, 8,000 streaklines at 16
-per cell, where the paper's sheets use 11-20), or the vertices of the mesh the artist picked
-(point_source_mesh), one streakline per vertex. A source split in k candidate groups
-(candidate_split) is cut into k groups of equal count along the axis of largest extent, so the
-streaklines of different parts are never clustered into one surface (§3.3). Emission pauses on
-the frames where none of the Sources with point sources has emit_particles on (Figure 10's gap).
+A source's point sources are, by its point_placement: a ring around its outline across the flow
+(RIM, the default; point_rim.py), cut into arcs that are candidate groups of their own; or
+`point_sources` random points in each of its cells (CELLS, §3.2: "10-20 point sources are placed
+randomly in a source cell"; a 0.25 m sphere at 40³ has ~670 cells, 10,000 streaklines at 16 per
+cell, where the paper's sheets use 11-20); or the vertices of the mesh the artist picked
+(point_source_mesh), one streakline per vertex. Placed points are cut down to the domain's
+max_streaklines over all Sources. A source split in k candidate groups (candidate_split) is cut
+into k groups of equal count along the axis of largest extent, so the streaklines of different
+parts are never clustered into one surface (§3.3). Emission pauses on the frames where none of
+the Sources with point sources has emit_particles on (Figure 10's gap).
 """
 
 import numpy as np
 
+from . import point_rim
 from .settings import BakeError, candidate_groups
 
 
@@ -55,30 +57,48 @@ def vertex_point_sources(params, domain_name, emitter):
     return points
 
 
-def source_point_sources(native, params, domain_name, seed, emitter, index):
+def _cells(native, params, emitter):
+    """(cells int (N, 3), motion float32 (N, 3)) of a Source at the domain's first frame."""
+    e = emitter
+    try:
+        return native.source_cells(e.vertices, e.triangles, e.matrix_at(0), e.matrix_at(1),
+                                   params, e.name)
+    except ValueError as err:
+        raise BakeError(f"Plume: source '{e.name}': {err}") from None
+
+
+def source_point_sources(native, params, domain_name, seed, emitter, index, gravity, count=None):
     """(positions, velocities), float32 (N, 3) each, of one Source's point sources (§3.2), or None
-    when a source without point_source_mesh has no cell in the domain. Random points are seeded by
-    the domain seed and the source's index among the Sources; their velocity is the source's
-    velocity plus its own motion (motion_factor), as the solver writes into its cells. Vertex
-    point sources leave with the source's velocity. BakeError names the source."""
+    when a source without point_source_mesh has no cell in the domain: its point_source_mesh's
+    vertices; else for point_placement RIM a ring around its outline across the flow
+    (point_rim.py; `count` points, or one per cell of its length when None); else (CELLS)
+    point_sources random points per cell, seeded by the domain seed and the source's index
+    among the Sources. Their velocity is the source's velocity plus its own motion
+    (motion_factor) in their cell, as the solver writes into its cells; vertex point sources
+    leave with the source's velocity. BakeError names the source."""
     e = emitter
     velocity = np.asarray(e.source.velocity, np.float32)
     if e.point_source_vertices is not None:
         points = vertex_point_sources(params, domain_name, e)
         return points, np.repeat(velocity[None, :], len(points), axis=0)
+    cells, motion = _cells(native, params, e)
+    if len(cells) == 0:
+        return None
+    motion = np.asarray(motion, np.float32).reshape(-1, 3) * np.float32(e.source.motion_factor)
+    if e.point_placement == "RIM":
+        axis = point_rim.flow_axis(e.source.velocity, gravity)
+        grid = (params.resolution, params.cell_size, params.origin)
+        if count is None:
+            count = point_rim.natural_count(cells, grid, axis)
+        points, rows = point_rim.rim_points(cells, grid, axis, count)
+        return points, motion[rows] + velocity
     try:
-        cells, motion = native.source_cells(e.vertices, e.triangles, e.matrix_at(0),
-                                            e.matrix_at(1), params, e.name)
-        if len(cells) == 0:
-            return None
         points = native.random_points_in_cells(
             cells, params.resolution, params.cell_size, params.origin, e.point_sources,
             seed=seed, stream=index)
     except ValueError as err:
         raise BakeError(f"Plume: source '{e.name}': {err}") from None
-    vel = (np.repeat(np.asarray(motion, np.float32), e.point_sources, axis=0)
-           * np.float32(e.source.motion_factor) + velocity)
-    return points, vel
+    return points, np.repeat(motion, e.point_sources, axis=0) + velocity
 
 
 def split_groups(points, first_group, split, source_name=""):
@@ -125,10 +145,10 @@ def hand_groups(emitter, first_group):
 
 
 def thinning_quotas(counts, cap):
-    """How many of each Source's random point sources to keep so that about `cap` remain in all
-    (`counts`: random point sources per Source): all when cap is 0 or not exceeded, else shares
-    in proportion to the counts (largest remainders), each at least the 2 a surface needs (or
-    all, when a Source has fewer); so at most max(cap, 2 per Source)."""
+    """How many of each Source's placed point sources to keep so that about `cap` remain in all
+    (`counts`: point sources per Source, Point Source Meshes left out): all when cap is 0 or not
+    exceeded, else shares in proportion to the counts (largest remainders), each at least the 2
+    a surface needs (or all, when a Source has fewer); so at most max(cap, 2 per Source)."""
     counts = np.asarray(counts, dtype=np.int64)
     total = int(counts.sum())
     if cap <= 0 or total <= cap:
@@ -150,39 +170,68 @@ def thin(points, velocities, keep, seed, index):
     return points[rows], velocities[rows]
 
 
+def group_counts(sources, placed):
+    """Candidate groups each Source's point sources fall in (§3.3): a rim's arcs (point_rim.py),
+    else its hand-made groups or candidate_split (settings.candidate_groups); `placed` maps a
+    Source's index to its point sources."""
+    counts = []
+    for index, e in enumerate(sources):
+        rim = e.point_placement == "RIM" and e.point_source_vertices is None
+        if rim and index in placed:
+            counts.append(point_rim.arc_count(len(placed[index][0]), e.candidate_split))
+        else:
+            counts.append(e.hand_groups or e.candidate_split)
+    return counts
+
+
+def source_groups(e, points, first_group):
+    """Candidate group of each of a placed Source's point sources (§3.3)."""
+    if e.hand_groups:
+        return hand_groups(e, first_group)
+    if e.point_placement == "RIM" and e.point_source_vertices is None:
+        return point_rim.arc_groups(len(points), e.candidate_split, first_group)
+    return split_groups(points, first_group, e.candidate_split, e.name)
+
+
 def domain_point_sources(native, params, snapshot):
     """The point sources of every Source of a traced bake on the grid of SmokeParams `params`
     (§3.2-3.3), Sources in order: world positions float32 (N, 3), candidate groups int64 (N,),
     velocities float32 (N, 3) and the Sources that have point sources (emitter snapshots, for
-    emits_during). The random point sources (per source cell) are thinned to the domain's
-    max_streaklines (thinning_quotas); a Point Source Mesh's vertices are kept as picked.
-    BakeError when no Source has a point source in the domain."""
+    emits_during). Placed point sources (a rim, or random per source cell) are cut down to the
+    domain's max_streaklines (thinning_quotas: a rim placed again with fewer points, random
+    ones thinned at random); a Point Source Mesh's vertices are kept as picked. BakeError when
+    no Source has a point source in the domain."""
     snap = snapshot
     sources = [e for e in snap.emitters if e.role == "SOURCE"]
-    placed = []
-    for index, (e, group) in enumerate(zip(sources, candidate_groups(snap.emitters))):
-        p = source_point_sources(native, params, snap.domain_name, snap.solver.seed, e, index)
+    gravity = snap.solver.gravity
+    placed = {}
+    for index, e in enumerate(sources):
+        p = source_point_sources(native, params, snap.domain_name, snap.solver.seed, e, index,
+                                 gravity)
         if p is not None:
-            placed.append((index, e, group, *p))
-    random = [k for k, (_i, e, *_rest) in enumerate(placed) if e.point_source_vertices is None]
-    quotas = thinning_quotas([len(placed[k][3]) for k in random], snap.streaks.max_streaklines)
-    for k, keep in zip(random, quotas):
-        index, e, group, points, vel = placed[k]
-        placed[k] = (index, e, group, *thin(points, vel, keep, snap.solver.seed, index))
-    emitting, all_points, all_groups, all_vel = [], [], [], []
-    for _index, e, group, points, vel in placed:
-        emitting.append(e)
-        all_points.append(points)
-        all_vel.append(vel)
-        all_groups.append(hand_groups(e, group) if e.hand_groups else
-                          split_groups(points, group, e.candidate_split, e.name))
-    if not all_points:
+            placed[index] = p
+    cut = [i for i in placed if sources[i].point_source_vertices is None]
+    quotas = thinning_quotas([len(placed[i][0]) for i in cut], snap.streaks.max_streaklines)
+    for index, keep in zip(cut, quotas):
+        e = sources[index]
+        if keep >= len(placed[index][0]):
+            continue
+        if e.point_placement == "RIM":
+            placed[index] = source_point_sources(native, params, snap.domain_name,
+                                                 snap.solver.seed, e, index, gravity, keep)
+        else:
+            placed[index] = thin(*placed[index], keep, snap.solver.seed, index)
+    if not placed:
         raise BakeError(f"Plume: domain '{snap.domain_name}': streak surfaces need point "
                         "sources, but no Source object has a cell inside the domain")
-    check_memory(snap.domain_name, sum(len(p) for p in all_points), snap.frame_count,
+    firsts = candidate_groups(snap.emitters, group_counts(sources, placed))
+    emitting = [sources[i] for i in placed]
+    points = [placed[i][0] for i in placed]
+    groups = [source_groups(sources[i], placed[i][0], firsts[i]) for i in placed]
+    check_memory(snap.domain_name, sum(len(p) for p in points), snap.frame_count,
                  max(1, snap.solver.substeps) / max(1, snap.streaks.emission_period))
-    return (np.concatenate(all_points), np.concatenate(all_groups), np.concatenate(all_vel),
-            emitting)
+    return (np.concatenate(points), np.concatenate(groups),
+            np.concatenate([placed[i][1] for i in placed]), emitting)
 
 
 #: Bytes per stored particle (position float32 x 3 + density float32) in the streak files, each

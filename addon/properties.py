@@ -259,9 +259,24 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
         description="Velocity given to the air in the source's cells, m/s (smoke_surfaces.txt §3.2)")
     motion_factor: FloatProperty(name="Motion Factor", default=1.0, soft_min=0.0, soft_max=2.0,
                                  description="Share of the source object's own motion added to its velocity")
+    point_placement: EnumProperty(
+        name="Placement", default='RIM',
+        items=(('RIM', "Rim",
+                "A ring of point sources around the source's outline, across the direction the "
+                "smoke leaves it (its Initial Velocity, else against gravity), one a cell apart, "
+                "cut into arcs of about 8 (each its own candidate group, §3.3): sheets that wrap "
+                "the smoke, a few per source"),
+               ('CELLS', "Cells",
+                "Point Sources random points in every source cell (smoke_surfaces.txt §3.2: "
+                "\"10-20 point sources are placed randomly in a source cell\"): the paper's set-up "
+                "for a source one to four cells wide; a wide source fills the smoke's volume "
+                "with streaklines and its sheets fold many times over")),
+        description="Where this source's point sources are, when it has no Point Source Mesh "
+                    "(smoke_surfaces.txt §3.2)")
     point_sources: IntProperty(
         name="Point Sources", default=16, soft_min=1, soft_max=64,
-        description="Tracer point sources per source cell (10-20 in smoke_surfaces.txt §3.2)")
+        description="Tracer point sources per source cell when Placement is Cells (10-20 in "
+                    "smoke_surfaces.txt §3.2)")
     candidate_group: IntProperty(
         name="Candidate Group", default=-1, soft_min=-1, soft_max=64,
         description="Streaklines are clustered only inside a candidate group (-1: the source's own group)")
@@ -282,10 +297,12 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
                     "if its Density is keyframed to 0 too). The first particle is always emitted")
     candidate_split: IntProperty(
         name="Split Into Groups", default=1, soft_min=1, soft_max=64,
-        description="Splits this source's point sources into this many candidate groups of equal "
-                    "count along their longest extent, so that streaklines of different parts "
-                    "never share a surface (smoke_surfaces.txt §3.3); 1 = no split, more replaces "
-                    "Candidate Group; validated at bake time to [1, 64]")
+        description="Splits this source's point sources into this many candidate groups so that "
+                    "streaklines of different parts never share a surface (smoke_surfaces.txt "
+                    "§3.3): a Rim into this many arcs (1: arcs of about 8 point sources), other "
+                    "point sources into groups of equal count along their longest extent (1: no "
+                    "split); more than 1 replaces Candidate Group; validated at bake time to "
+                    "[1, 64]")
 
 
 class PlumeObstacleSettings(bpy.types.PropertyGroup):

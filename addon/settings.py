@@ -96,6 +96,9 @@ class EmitterSnapshot:
     #: holds the first); empty when they are constant.
     source_frames: List[SourceParams] = field(default_factory=list)
     slip: str = "NO_SLIP"
+    #: streak surfaces: where the point sources are (§3.2): "RIM", a ring around the outline
+    #: (point_rim.py), or "CELLS", point_sources random points per source cell
+    point_placement: str = "RIM"
     point_sources: int = 16  # streak surfaces: tracer point sources per source cell (§3.2)
     candidate_group: int = -1  # §3.3 candidate group, -1: the source's own group
     candidate_split: int = 1  # §3.3: the source's point sources split into this many groups
@@ -157,6 +160,8 @@ class EmitterSnapshot:
         newer settings only when not default, so older caches still resume."""
         data = [self.name, self.point_sources, self.candidate_group]
         extra = {}
+        if self.point_placement != "CELLS":  # caches from before the rim were per cell
+            extra["point_placement"] = self.point_placement
         if self.candidate_split != 1:
             extra["candidate_split"] = self.candidate_split
         if self.point_source_vertices is not None:
@@ -395,7 +400,8 @@ def validate_streaks(domain_name, streaks, emitters):
     split_lo, split_hi = CANDIDATE_SPLIT_RANGE
     for e in sources:
         # Unused (and not checked) when a point source mesh gives the points.
-        if e.point_source_vertices is None and not (lo <= e.point_sources <= hi):
+        if (e.point_source_vertices is None and e.point_placement == "CELLS"
+                and not (lo <= e.point_sources <= hi)):
             raise BakeError(f"Plume: source '{e.name}': point_sources must be in [{lo}, {hi}] "
                             f"(got {e.point_sources})")
         if not (split_lo <= e.candidate_split <= split_hi):
@@ -406,13 +412,18 @@ def validate_streaks(domain_name, streaks, emitters):
                             f"(-1 = its own group; got {e.candidate_group})")
 
 
-def candidate_groups(emitters):
+def candidate_groups(emitters, counts=None):
     """Candidate group of each Source (§3.3), in source order: the explicit group, or for -1 a
     number of its own that no explicit group uses. A source split in k > 1 groups
-    (candidate_split, or k hand-made groups: the vertex groups of its point source mesh) gets the
-    first of k consecutive numbers, all after every other source's group (its candidate_group is
-    then unused)."""
+    (candidate_split, k hand-made groups: the vertex groups of its point source mesh, or `counts`
+    [i] for the i-th Source when given: a rim's arcs) gets the first of k consecutive numbers,
+    all after every other source's group (its candidate_group is then unused)."""
     sources = [e for e in emitters if e.role == "SOURCE"]
+    split = dict(zip(map(id, sources), counts)) if counts is not None else {}
+
+    def _group_count(e):
+        return split.get(id(e)) or e.hand_groups or e.candidate_split
+
     whole = [e for e in sources if _group_count(e) <= 1]
     used = {e.candidate_group for e in whole if e.candidate_group >= 0}
     groups, next_free = [], 0
@@ -432,12 +443,6 @@ def candidate_groups(emitters):
             groups[n] = next_split
             next_split += _group_count(e)
     return groups
-
-
-def _group_count(emitter):
-    """Candidate groups a Source's point sources fall in: its hand-made groups (vertex groups of
-    its point source mesh), else candidate_split."""
-    return emitter.hand_groups or emitter.candidate_split
 
 
 def to_native_params(solver, native):

@@ -154,7 +154,8 @@ def emitter_snapshots(context, domain, frame_start, frame_end):
             matrices=[np.array(o.matrix_world, dtype=np.float64)],
             source=source_params(s) if o.plume.role == 'SOURCE' else None,
             slip=o.plume.obstacle.slip,
-            point_sources=int(s.point_sources), candidate_group=int(s.candidate_group),
+            point_placement=s.point_placement, point_sources=int(s.point_sources),
+            candidate_group=int(s.candidate_group),
             candidate_split=int(s.candidate_split)))
     animated = [i for i, o in enumerate(objs) if _is_animated(o)]
     keyed = [i for i, o in enumerate(objs) if o.plume.role == 'SOURCE' and _source_is_keyed(o)]

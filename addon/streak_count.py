@@ -1,13 +1,13 @@
 """How many streaklines a domain's next bake will trace (smoke_surfaces.txt §3.2), for the Streak
-Surfaces panel: every Source's point sources (point_sources per source cell, or its Point Source
-Mesh's vertices) and what max_streaklines keeps of them. Computed from the objects' own mesh data
+Surfaces panel: every Source's point sources (a rim one per cell of its length, point_sources per
+source cell, or its Point Source Mesh's vertices) and what max_streaklines keeps of them. Computed from the objects' own mesh data
 (no depsgraph evaluation: this runs while the panel draws) and cached until a setting, a Source
 or the domain changes; nothing is read from or written to disk."""
 
 import numpy as np
 from mathutils import Vector
 
-from . import point_sources
+from . import point_rim, point_sources
 from .settings import domain_grid, to_native_params
 from .snapshot import solver_settings
 
@@ -40,13 +40,14 @@ def _sources(scene, domain):
 
 def _key(scene, domain, sources):
     d = domain.plume.domain
-    parts = [domain.name, int(d.resolution), int(d.max_streaklines),
+    parts = [domain.name, int(d.resolution), int(d.max_streaklines), tuple(d.gravity),
              tuple(tuple(r) for r in domain.matrix_world), tuple(domain.dimensions)]
     for o in sources:
         s = o.plume.source
         mesh = s.point_source_mesh
         parts.append((o.name, tuple(tuple(r) for r in o.matrix_world), len(o.data.vertices),
-                      len(o.data.polygons), int(s.point_sources),
+                      len(o.data.polygons), int(s.point_sources), s.point_placement,
+                      tuple(s.velocity),
                       (mesh.name, len(mesh.data.vertices)) if mesh is not None else None))
     return tuple(parts)
 
@@ -72,9 +73,15 @@ def count(native, scene, domain):
             continue
         verts, tris = _triangles(o.data)
         m = np.array(o.matrix_world, dtype=np.float64)
-        in_domain = len(native.source_cells(verts, tris, m, m, params, o.name)[0]) if len(tris) \
-            else 0
-        random.append(in_domain * int(s.point_sources))
+        inside = native.source_cells(verts, tris, m, m, params, o.name)[0] if len(tris) else ()
+        if len(inside) == 0:
+            random.append(0)
+        elif s.point_placement == 'RIM':
+            axis = point_rim.flow_axis(s.velocity, domain.plume.domain.gravity)
+            random.append(point_rim.natural_count(
+                inside, (params.resolution, params.cell_size, params.origin), axis))
+        else:
+            random.append(len(inside) * int(s.point_sources))
     kept = int(point_sources.thinning_quotas(random, domain.plume.domain.max_streaklines).sum())
     result = (kept + fixed, sum(random) + fixed)
     _cache[domain.name] = (key, result)

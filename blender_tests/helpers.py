@@ -101,6 +101,7 @@ def incense_streak_scene(cache_dir, resolution, frames):
     src.name = "Incense"
     bpy.ops.plume.role_set(role='SOURCE')
     s = src.plume.source
+    s.point_placement = 'CELLS'  # the paper's set-up: random points in the source cells
     s.point_sources, s.velocity, s.density, s.temperature = 10, (0.0, 0.0, 1.0), 1.0, 2.0
     dom = add_domain(resolution=resolution, frame_end=frames, cache_directory=cache_dir + "/")
     dom.plume.domain.streaks = True

@@ -72,6 +72,7 @@ def plume_domain(name, cache_dir, mantaflow_domain):
         source = bpy.context.active_object
         source.name = "TraceSource"
         bpy.ops.plume.role_set(role='SOURCE')
+        source.plume.source.point_placement = 'CELLS'
         source.plume.source.point_sources = 4
     dom = add_domain(size=2.0, location=(0.0, 0.0, 1.0), resolution=16, frame_end=FRAMES,
                      cache_directory=cache_dir + "/", name=name)

@@ -1,9 +1,10 @@
 """Streak surfaces at an artist's scale (smoke_surfaces.txt §3.2): the scene a new user makes - a
 2 m domain at 40³, a UV sphere of radius 0.25 m as the Source, Streak Surfaces on, every other
-setting at its default - traces a bounded number of streaklines (Max Streaklines thins the 16
-point sources per source cell); the Streak Surfaces panel shows that number before baking, and it
-is what the bake traces; thinning is seeded; a count whose particles would not fit in memory is
-refused before anything is written.
+setting at its default - traces a few dozen streaklines (a rim of point sources, point_rim.py;
+with Placement Cells, Max Streaklines thins the 16 point sources per source cell); the Streak
+Surfaces panel shows that number before baking, and it is what the bake traces; placement and
+thinning are seeded; a count whose particles would not fit in memory is refused before anything
+is written.
 
 Run: blender_tests/run.py --blender {3.4,4.5,5.0} test_streak_defaults.py
 """
@@ -47,22 +48,49 @@ class StreakDefaultsTest(unittest.TestCase):
         rmtree(self.tmp)
 
     def test_default_scene_traces_what_the_panel_says(self):
+        """Every default: a rim of point sources (point_rim.py), one per cell of its length:
+        a few dozen streaklines, the count the panel shows before the bake."""
         dom = artist_scene(self.tmp)
         d = dom.plume.domain
         self.assertEqual(d.max_streaklines, 256)
+        self.assertEqual(bpy.data.objects["Source"].plume.source.point_placement, 'RIM')
+        kept, placed = self.count(dom)
+        print(f"  panel: {kept} streaklines of {placed} point sources")
+        # A ring 4/5 of the way out on a 0.25 m sphere at 20 cells/m: 2π 0.2 m = 25 cells long.
+        self.assertEqual(kept, placed)
+        self.assertTrue(20 <= kept <= 32, kept)
+        from plume import streak_count
+        self.assertEqual(streak_count.label(native(), bpy.context.scene, dom),
+                         f"{kept:,} streaklines")
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        first = traced(self.tmp)
+        self.assertEqual(len(first["counts"]), kept)
+        # Seeded: a second bake from scratch places the same point sources.
+        bpy.ops.plume.cache_free()
+        select_only(dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        np.testing.assert_array_equal(traced(self.tmp)["positions"], first["positions"])
+        # A cap below the rim's count places the rim again with fewer points.
+        d.max_streaklines = 12
+        self.assertEqual(self.count(dom), (12, placed))
+
+    def test_cells_placement_thinned_to_the_cap(self):
+        """Placement Cells (the paper's 16 random points per source cell) on the same sphere:
+        thousands of point sources, thinned at random to Max Streaklines; what the panel says."""
+        dom = artist_scene(self.tmp)
+        d = dom.plume.domain
+        bpy.data.objects["Source"].plume.source.point_placement = 'CELLS'
         self.assertEqual(bpy.data.objects["Source"].plume.source.point_sources, 16)
         kept, placed = self.count(dom)
         print(f"  panel: {kept} streaklines of {placed} point sources")
         # 16 per cell of a 0.25 m sphere at 20 cells/m: hundreds of cells, thousands of points.
         self.assertGreater(placed, 2000)
         self.assertEqual(kept, 256)
-        from plume.ui.panels import PHYSICS_PT_plume_streaks  # noqa: F401  (the panel's line)
         from plume import streak_count
         self.assertIn("256 streaklines (of", streak_count.label(native(), bpy.context.scene, dom))
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
         first = traced(self.tmp)
         self.assertEqual(len(first["counts"]), kept)
-        # Seeded: a second bake from scratch places the same point sources.
         bpy.ops.plume.cache_free()
         select_only(dom)
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
@@ -73,7 +101,9 @@ class StreakDefaultsTest(unittest.TestCase):
 
     def test_thinning_keeps_each_source_in_proportion(self):
         dom = artist_scene(self.tmp)
+        bpy.data.objects["Source"].plume.source.point_placement = 'CELLS'
         small = add_sphere_source(radius=0.12, location=(0.5, 0.0, 0.35), name="Small")
+        small.plume.source.point_placement = 'CELLS'
         small.plume.source.point_sources = 4
         select_only(dom)
         dom.plume.domain.max_streaklines = 100
@@ -92,6 +122,7 @@ class StreakDefaultsTest(unittest.TestCase):
         dom = artist_scene(self.tmp, frame_end=5000)
         d = dom.plume.domain
         d.max_streaklines = 0
+        bpy.data.objects["Source"].plume.source.point_placement = 'CELLS'
         bpy.data.objects["Source"].plume.source.point_sources = 10000
         select_only(dom)
         folder = os.path.join(self.tmp, "Domain")

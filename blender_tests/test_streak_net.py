@@ -6,7 +6,7 @@ Three bakes: the Figure 1 example itself (examples/incense.py's make_source and 
 top of the plume scatters late in the shot and the nets drop to order 2 along the streaklines;
 the same set-up reduced to 40 frames; and a 2 m domain at 40³ with a UV-sphere Source of radius
 0.25 m (one point source per cell: 256 streaklines), 60 frames, default threshold (all of them
-in one sheet). For every surface on every frame: no control point is farther than 3 cells from
+in one sheet); and that scene with every default (a rim of point sources: a few sheets). For every surface on every frame: no control point is farther than 3 cells from
 the nearest particle of its surface, and the sheet passes within the fit tolerance
 (streak_surfaces.FIT_TOLERANCE_CELLS) of every particle it goes through (fit_mask: emitted, not
 past an open side). The surface cache holds the fitted points and Blender's net has their size
@@ -150,6 +150,7 @@ class StreakNetTest(unittest.TestCase):
 
     def test_sphere_source_at_40(self):
         src = add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35))
+        src.plume.source.point_placement = 'CELLS'
         src.plume.source.point_sources = 1
         dom = add_domain(resolution=40, frame_end=60, cache_directory=self.cache + "/")
         dom.plume.domain.streaks = True
@@ -158,6 +159,19 @@ class StreakNetTest(unittest.TestCase):
         nu = [int(n.split("x")[0]) for n in fig["net"]]
         self.assertLess(max(nu), min(fig["particles"]))
         self.assertEqual({u for u, _ in fig["orders"]}, {4})
+        self.assertEqual(fig["outside"], 0)
+
+    def test_sphere_source_at_40_every_default(self):
+        """The same scene with every default (a rim of point sources, the mean of h as h0): a
+        few sheets, each of the paper's size, on the smoke."""
+        add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35))
+        dom = add_domain(resolution=40, frame_end=60, cache_directory=self.cache + "/")
+        dom.plume.domain.streaks = True
+        self.bake_and_build(dom, most_surfaces=False)
+        fig = self.check_nets(dom, "sphere source, every default, 40³, 60 frames")
+        widths = [int(n.split("x")[1]) for n in fig["net"]]
+        self.assertTrue(2 <= len(widths) <= 8, widths)
+        self.assertLessEqual(max(widths), 12)  # an arc of about 8 point sources (point_rim.py)
         self.assertEqual(fig["outside"], 0)
 
 

@@ -32,6 +32,7 @@ def build_scene(cache_dir, frame_end=3, point_sources=4, split=1):
     """A 2-unit cube domain over z in [0, 2] with a small sphere source low in it, streaks on."""
     src = add_sphere_source(radius=0.2, location=(0.0, 0.0, 0.35))
     s = src.plume.source
+    s.point_placement = 'CELLS'
     s.point_sources = point_sources
     s.candidate_split = split
     s.velocity = (0.0, 0.0, 0.5)
@@ -245,6 +246,7 @@ class StreakSourcesTest(unittest.TestCase):
             self.assert_bake_error(r"source 'Source': candidate_split must be in \[1, 64\] "
                                    rf"candidate groups \(got {value}\)")
         src.plume.source.candidate_split = 64
+        src.plume.source.point_placement = 'CELLS'
         src.plume.source.point_sources = 1
         self.assert_bake_error(r"candidate_split 64 needs at least 128 point sources")
 

@@ -36,6 +36,7 @@ def build_scene(cache_dir, frame_end=FRAMES, point_sources=POINT_SOURCES, streak
     src.name = "Incense"
     bpy.ops.plume.role_set(role='SOURCE')
     s = src.plume.source
+    s.point_placement = 'CELLS'
     s.point_sources = point_sources
     s.velocity = (0.0, 0.0, 1.0)
     s.density = 1.0

@@ -65,6 +65,7 @@ def make_source(frames, point_sources=POINT_SOURCES, vertex_sources=0):
     s = src.plume.source
     s.density, s.temperature = 1.0, 1.0
     s.velocity = (0.0, 0.0, 0.15)
+    s.point_placement = 'CELLS'  # §3.2: random point sources in the one source cell
     s.point_sources = point_sources
     if vertex_sources > 0:
         rng = random.Random(7)

@@ -27,6 +27,7 @@ def scene(out_dir, count):
     scene_kit.new_scene()
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.25, location=(0.0, 0.0, 0.35))
     bpy.ops.plume.role_set(role='SOURCE')
+    bpy.context.active_object.plume.source.point_placement = 'CELLS'  # count set by the cap
     dom = scene_kit.domain_cube("Domain", 2.0, (0.0, 0.0, 1.0), 40, FRAMES)
     d = dom.plume.domain
     d.cache_directory = os.path.join(out_dir, f"cache_{count}") + "/"

@@ -353,8 +353,11 @@ class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
         col.prop(s, "emit_particles")
         col.prop(s, "point_source_mesh")
         sub = col.column()
-        sub.active = s.point_source_mesh is None  # the mesh's vertices replace the random points
-        sub.prop(s, "point_sources")
+        sub.active = s.point_source_mesh is None  # the mesh's vertices replace placed points
+        sub.prop(s, "point_placement")
+        row = sub.row()
+        row.active = s.point_placement == 'CELLS'
+        row.prop(s, "point_sources")
         sub = col.column()
         sub.active = s.candidate_split <= 1  # split groups are numbered after all the others
         sub.prop(s, "candidate_group")
