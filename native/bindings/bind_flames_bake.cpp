@@ -3,12 +3,10 @@
 /// into a signed-distance grid (structural_flames.txt §6.1) for GridSdf.
 
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
 
 #include "flames/mesh_sdf.h"
 
-#include <pybind11/numpy.h>
-
-#include <cstring>
 #include <string>
 
 namespace py = pybind11;
@@ -18,15 +16,12 @@ namespace plume::bindings {
 void bindFlamesBake(py::module_& m) {
   m.def(
       "mesh_signed_distance",
-      [](const py::array_t<float, py::array::c_style | py::array::forcecast>& vertices,
-         const py::array_t<long long, py::array::c_style | py::array::forcecast>& triangles,
-         double voxelSize, double padding, const std::string& name) {
+      [](const FloatArrayC& vertices, const Int64ArrayC& triangles, double voxelSize, double padding, const std::string& name) {
         if (vertices.ndim() != 2 || vertices.shape(1) != 3)
           throw py::value_error("vertices of obstacle '" + name + "' must have shape (N, 3)");
         if (triangles.ndim() != 2 || triangles.shape(1) != 3)
           throw py::value_error("triangles of obstacle '" + name + "' must have shape (M, 3)");
-        std::vector<glm::vec3> v(std::size_t(vertices.shape(0)));
-        std::memcpy(v.data(), vertices.data(), v.size() * sizeof(glm::vec3));
+        const std::vector<glm::vec3> v = pointsArg(vertices, "vertices");
         std::vector<glm::ivec3> t(std::size_t(triangles.shape(0)));
         const long long* tp = triangles.data();
         for (std::size_t n = 0; n < t.size() * 3; ++n) t[n / 3][int(n % 3)] = int(tp[n]);
@@ -35,13 +30,10 @@ void bindFlamesBake(py::module_& m) {
           py::gil_scoped_release release;
           g = meshSignedDistance(v, t, voxelSize, padding, name);
         }
-        const glm::ivec3 n = g.values.size();
-        py::array_t<float, py::array::f_style> a({py::ssize_t(n.x), py::ssize_t(n.y), py::ssize_t(n.z)});
-        std::memcpy(a.mutable_data(), g.values.data(), sizeof(float) * g.values.count());
         py::dict d;
-        d["values"] = a;
+        d["values"] = gridArray(g.values);
         d["cell_size"] = g.cellSize;
-        d["origin"] = py::make_tuple(g.origin.x, g.origin.y, g.origin.z);
+        d["origin"] = vec3Tuple(g.origin);
         return d;
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("voxel_size"), py::arg("padding") = 0.0,

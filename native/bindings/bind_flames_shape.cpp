@@ -6,11 +6,11 @@
 /// shaping and rasterization release the GIL.
 
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
 
 #include "flames/flame_raster.h"
 #include "flames/flame_shape.h"
 
-#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <cstring>
@@ -20,12 +20,9 @@ namespace py = pybind11;
 namespace plume::bindings {
 namespace {
 
-using DoubleC = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using FloatC = py::array_t<float, py::array::c_style | py::array::forcecast>;
-
 /// An (N, k) array (ValueError naming `what` otherwise).
-DoubleC rowsArg(const py::handle& o, py::ssize_t k, const char* what) {
-  const DoubleC a = DoubleC::ensure(o);
+DoubleArrayC rowsArg(const py::handle& o, py::ssize_t k, const char* what) {
+  const DoubleArrayC a = DoubleArrayC::ensure(o);
   if (!a || a.ndim() != 2 || a.shape(1) != k)
     throw py::value_error(std::string(what) + " must be an array of shape (N, " + std::to_string(k) + ")");
   return a;
@@ -35,18 +32,18 @@ Flame flameArg(const py::handle& h, std::size_t index) {
   const py::dict d = py::reinterpret_borrow<py::dict>(h);
   const std::string name = "flames[" + std::to_string(index) + "]";
   if (!d.contains("points")) throw py::value_error(name + " needs 'points'");
-  const DoubleC x = rowsArg(d["points"], 3, (name + ".points").c_str());
+  const DoubleArrayC x = rowsArg(d["points"], 3, (name + ".points").c_str());
   const py::ssize_t n = x.shape(0);
   Flame f;
   f.points.resize(std::size_t(n));
   for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].x = {x.at(k, 0), x.at(k, 1), x.at(k, 2)};
   if (d.contains("velocities")) {
-    const DoubleC v = rowsArg(d["velocities"], 3, (name + ".velocities").c_str());
+    const DoubleArrayC v = rowsArg(d["velocities"], 3, (name + ".velocities").c_str());
     if (v.shape(0) != n) throw py::value_error(name + ".velocities must have one row per point");
     for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].v = {v.at(k, 0), v.at(k, 1), v.at(k, 2)};
   }
   if (d.contains("ages")) {
-    const DoubleC a = DoubleC::ensure(d["ages"]);
+    const DoubleArrayC a = DoubleArrayC::ensure(d["ages"]);
     if (!a || a.ndim() != 1 || a.shape(0) != n) throw py::value_error(name + ".ages must have shape (N,)");
     for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].age = a.at(k);
   }
@@ -59,28 +56,8 @@ Flame flameArg(const py::handle& h, std::size_t index) {
   return f;
 }
 
-template <typename T>
-py::array_t<float> floatRows(const std::vector<T>& v, py::ssize_t k) {
-  py::array_t<float> a({py::ssize_t(v.size()), k});
-  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
-  return a;
-}
-
-template <typename T>
-py::array_t<T> flat(const std::vector<T>& v) {
-  py::array_t<T> a(py::ssize_t(v.size()));
-  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
-  return a;
-}
-
-glm::dvec3 vec3Arg(const py::object& o, const char* name) {
-  const auto v = o.cast<std::vector<double>>();
-  if (v.size() != 3) throw py::value_error(std::string(name) + " must hold 3 numbers");
-  return {v[0], v[1], v[2]};
-}
-
 ColorImage imageArg(const py::handle& o) {
-  const FloatC a = FloatC::ensure(o);
+  const FloatArrayC a = FloatArrayC::ensure(o);
   if (!a || a.ndim() != 3 || a.shape(2) != 3)
     throw py::value_error("color images must be float arrays of shape (height, width, 3), row 0 at the bottom");
   ColorImage image;
@@ -94,13 +71,12 @@ ColorImage imageArg(const py::handle& o) {
 FlameParticles particlesArg(const py::dict& d) {
   FlameParticles p;
   auto vec3s = [&](const char* key, std::vector<glm::vec3>& out) {
-    const FloatC a = FloatC::ensure(d[key]);
+    const FloatArrayC a = FloatArrayC::ensure(d[key]);
     if (!a || a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string(key) + " must have shape (N, 3)");
-    out.resize(std::size_t(a.shape(0)));
-    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
+    out = pointsArg(a, key);
   };
   auto floats = [&](const char* key, std::vector<float>& out) {
-    const FloatC a = FloatC::ensure(d[key]);
+    const FloatArrayC a = FloatArrayC::ensure(d[key]);
     if (!a || a.ndim() != 1) throw py::value_error(std::string(key) + " must have shape (N,)");
     out.assign(a.data(), a.data() + a.size());
   };
@@ -125,7 +101,7 @@ void bindFlamesShape(py::module_& m) {
   profile.def_static(
       "from_curve",
       [](const py::object& points) {
-        const DoubleC a = rowsArg(points, 2, "points");
+        const DoubleArrayC a = rowsArg(points, 2, "points");
         std::vector<glm::dvec2> p;
         for (py::ssize_t k = 0; k < a.shape(0); ++k) p.push_back({a.at(k, 0), a.at(k, 1)});
         return FlameProfile::fromCurve(p);
@@ -137,7 +113,7 @@ void bindFlamesShape(py::module_& m) {
   py::class_<FlameCamera> camera(m, "FlameCamera", "Camera for sample counts (§5.3) and eq. 6's distance.");
   camera.def(py::init([](const py::object& position, double focal, double sensor, int width, int height) {
                FlameCamera c;
-               c.position = vec3Arg(position, "position");
+               c.position = dvec3Arg(position, "position");
                c.focalLength = focal;
                c.sensorWidth = sensor;
                c.width = width;
@@ -168,7 +144,7 @@ void bindFlamesShape(py::module_& m) {
         p.flowNoise = {flowAmplitude, flowScale, flowFrequency, flowRotation};
         p.kolmogorov.amplitude = kAmplitude;
         p.kolmogorov.scale = kScale;
-        p.kolmogorov.drift = vec3Arg(kDrift, "kolmogorov_drift");
+        p.kolmogorov.drift = dvec3Arg(kDrift, "kolmogorov_drift");
         p.kolmogorov.frequency = kFrequency;
         p.kolmogorov.resolution = kResolution;
         p.incandescence = {energyScale, heat, fuelArea};
@@ -213,13 +189,13 @@ void bindFlamesShape(py::module_& m) {
         }
         const FlameParticles& p = frame.particles;
         py::dict d;
-        d["positions"] = floatRows(p.positions, 3);
-        d["velocities"] = floatRows(p.velocities, 3);
-        d["colors"] = floatRows(p.colors, 3);
-        d["density"] = flat(p.density);
-        d["incandescence"] = flat(p.incandescence);
-        d["mass"] = flat(p.mass);
-        d["flame"] = flat(p.flame);
+        d["positions"] = rowsArray(p.positions);
+        d["velocities"] = rowsArray(p.velocities);
+        d["colors"] = rowsArray(p.colors);
+        d["density"] = array1D(p.density);
+        d["incandescence"] = array1D(p.incandescence);
+        d["mass"] = array1D(p.mass);
+        d["flame"] = array1D(p.flame);
         d["sampled"] = frame.sampled;
         d["energy"] = frame.energy;
         d["merged"] = frame.merged;
@@ -228,10 +204,10 @@ void bindFlamesShape(py::module_& m) {
         for (const FlameLight& l : frame.lights) {
           py::dict ld;
           ld["flame_id"] = l.flameId;
-          ld["centre"] = py::make_tuple(l.centre.x, l.centre.y, l.centre.z);
+          ld["centre"] = vec3Tuple(l.centre);
           ld["radius"] = l.radius;
           ld["energy"] = l.energy;
-          ld["color"] = py::make_tuple(l.color.x, l.color.y, l.color.z);
+          ld["color"] = vec3Tuple(l.color);
           lights.append(ld);
         }
         d["lights"] = lights;
@@ -248,7 +224,7 @@ void bindFlamesShape(py::module_& m) {
          float temperatureScale, int frame, int threads) {
         FlameRasterParams r;
         r.voxelSize = voxelSize;
-        r.origin = glm::vec3(vec3Arg(origin, "origin"));
+        r.origin = glm::vec3(dvec3Arg(origin, "origin"));
         r.temperatureScale = temperatureScale;
         r.threads = threads;
         r.validate();

@@ -4,11 +4,11 @@
 /// and docstrings only; FlameSystem.step releases the GIL.
 
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
 
 #include "flames/flame_system.h"
 #include "flames/spine.h"
 
-#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <memory>
@@ -18,33 +18,14 @@ namespace py = pybind11;
 namespace plume::bindings {
 namespace {
 
-using DoubleC = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using FloatC = py::array_t<float, py::array::c_style | py::array::forcecast>;
-
-glm::dvec3 vec3Arg(const py::object& o, const char* name) {
-  const auto v = o.cast<std::vector<double>>();
-  if (v.size() != 3) throw py::value_error(std::string(name) + " must hold 3 numbers");
-  return {v[0], v[1], v[2]};
-}
-
-py::tuple vec3Tuple(const glm::dvec3& v) { return py::make_tuple(v.x, v.y, v.z); }
-
 /// An (N, 3) float64 array as points (ValueError otherwise).
-std::vector<glm::dvec3> pointsArg(const py::object& o, const char* name) {
-  const DoubleC a = DoubleC::ensure(o);
+std::vector<glm::dvec3> dpointsArg(const py::object& o, const char* name) {
+  const DoubleArrayC a = DoubleArrayC::ensure(o);
   if (!a || a.ndim() != 2 || a.shape(1) != 3)
     throw py::value_error(std::string(name) + " must be an array of shape (N, 3)");
   std::vector<glm::dvec3> p(std::size_t(a.shape(0)));
   for (py::ssize_t i = 0; i < a.shape(0); ++i) p[std::size_t(i)] = {a.at(i, 0), a.at(i, 1), a.at(i, 2)};
   return p;
-}
-
-py::array_t<double> rows3(const std::vector<glm::dvec3>& v) {
-  py::array_t<double> a({py::ssize_t(v.size()), py::ssize_t(3)});
-  auto m = a.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < v.size(); ++i)
-    for (int c = 0; c < 3; ++c) m(py::ssize_t(i), c) = v[i][c];
-  return a;
 }
 
 /// A dict of one flame: id, source, separated, age, lifespan, radius, intensity, temperature,
@@ -66,15 +47,15 @@ py::dict flameDict(const Flame& f) {
   d["radius"] = f.radius;
   d["intensity"] = f.intensity;
   d["temperature"] = f.temperature;
-  d["points"] = rows3(x);
-  d["velocities"] = rows3(v);
+  d["points"] = rowsArray(x);
+  d["velocities"] = rowsArray(v);
   d["ages"] = ages;
   return d;
 }
 
 /// A (nx, ny, nz) float grid from a NumPy array indexed [i, j, k].
 ScalarGrid scalarGridArg(const py::object& o, const char* name) {
-  const FloatC a = FloatC::ensure(o);
+  const FloatArrayC a = FloatArrayC::ensure(o);
   if (!a || a.ndim() != 3) throw py::value_error(std::string(name) + " must be an array of shape (nx, ny, nz)");
   ScalarGrid g(glm::ivec3(int(a.shape(0)), int(a.shape(1)), int(a.shape(2))));
   for (py::ssize_t i = 0; i < a.shape(0); ++i)
@@ -103,7 +84,7 @@ void bindSettings(py::module_& m) {
       .def_readwrite("diffusion", &FlameParams::diffusion, "Brownian diffusion D (m^2/s), scaled by T_p")
       .def_property(
           "gravity", [](const FlameParams& p) { return vec3Tuple(p.gravity); },
-          [](FlameParams& p, const py::object& g) { p.gravity = vec3Arg(g, "gravity"); })
+          [](FlameParams& p, const py::object& g) { p.gravity = dvec3Arg(g, "gravity"); })
       .def_readwrite("integrator", &FlameParams::integrator)
       .def_readwrite("obstacle_margin", &FlameParams::obstacleMargin, "m kept outside obstacles")
       .def("validate", &FlameParams::validate, "Raises ValueError naming a bad setting and its range.")
@@ -115,13 +96,13 @@ void bindSettings(py::module_& m) {
       .def(py::init<>())
       .def_property(
           "position", [](const FlameSource& s) { return vec3Tuple(s.position); },
-          [](FlameSource& s, const py::object& v) { s.position = vec3Arg(v, "position"); })
+          [](FlameSource& s, const py::object& v) { s.position = dvec3Arg(v, "position"); })
       .def_property(
           "normal", [](const FlameSource& s) { return vec3Tuple(s.normal); },
-          [](FlameSource& s, const py::object& v) { s.normal = vec3Arg(v, "normal"); })
+          [](FlameSource& s, const py::object& v) { s.normal = dvec3Arg(v, "normal"); })
       .def_property(
           "velocity", [](const FlameSource& s) { return vec3Tuple(s.velocity); },
-          [](FlameSource& s, const py::object& v) { s.velocity = vec3Arg(v, "velocity"); })
+          [](FlameSource& s, const py::object& v) { s.velocity = dvec3Arg(v, "velocity"); })
       .def_readwrite("radius", &FlameSource::radius)
       .def_readwrite("start_time", &FlameSource::startTime)
       .def_readwrite("end_time", &FlameSource::endTime)
@@ -136,19 +117,19 @@ void bindFields(py::module_& m) {
       .def(
           "evaluate",
           [](const WindField& w, const py::object& x, double t) {
-            std::vector<glm::dvec3> p = pointsArg(x, "points");
+            std::vector<glm::dvec3> p = dpointsArg(x, "points");
             for (glm::dvec3& v : p) v = w.evaluate(v, t);
-            return rows3(p);
+            return rowsArray(p);
           },
           py::arg("points"), py::arg("time") = 0.0, "Wind at (N, 3) points, as (N, 3).");
   py::class_<UniformWind, WindField, std::shared_ptr<UniformWind>>(
       m, "UniformWind", "Constant wind (Blender Wind: direction * strength).")
-      .def(py::init([](const py::object& v) { return std::make_shared<UniformWind>(vec3Arg(v, "velocity")); }),
+      .def(py::init([](const py::object& v) { return std::make_shared<UniformWind>(dvec3Arg(v, "velocity")); }),
            py::arg("velocity"));
   py::class_<VortexWind, WindField, std::shared_ptr<VortexWind>>(m, "VortexWind",
                                                                  "Rotation about an axis (Blender Vortex).")
       .def(py::init([](const py::object& c, const py::object& a, double s, double r) {
-             return std::make_shared<VortexWind>(vec3Arg(c, "center"), vec3Arg(a, "axis"), s, r);
+             return std::make_shared<VortexWind>(dvec3Arg(c, "center"), dvec3Arg(a, "axis"), s, r);
            }),
            py::arg("center"), py::arg("axis"), py::arg("strength"), py::arg("core_radius") = 0.1);
   py::class_<TurbulenceWind, WindField, std::shared_ptr<TurbulenceWind>>(
@@ -158,15 +139,10 @@ void bindFields(py::module_& m) {
   py::class_<GridWind, WindField, std::shared_ptr<GridWind>>(
       m, "GridWind", "Cell-centred velocity grid (nx, ny, nz, 3), read trilinearly (a solver cache).")
       .def(py::init([](const py::object& values, double cellSize, const py::object& origin) {
-             const FloatC a = FloatC::ensure(values);
+             const FloatArrayF a = FloatArrayF::ensure(values);
              if (!a || a.ndim() != 4 || a.shape(3) != 3)
                throw py::value_error("values must be an array of shape (nx, ny, nz, 3)");
-             VectorGrid g(glm::ivec3(int(a.shape(0)), int(a.shape(1)), int(a.shape(2))));
-             for (py::ssize_t i = 0; i < a.shape(0); ++i)
-               for (py::ssize_t j = 0; j < a.shape(1); ++j)
-                 for (py::ssize_t k = 0; k < a.shape(2); ++k)
-                   g(int(i), int(j), int(k)) = {a.at(i, j, k, 0), a.at(i, j, k, 1), a.at(i, j, k, 2)};
-             return std::make_shared<GridWind>(std::move(g), cellSize, vec3Arg(origin, "origin"));
+             return std::make_shared<GridWind>(vectorGridOf(a), cellSize, dvec3Arg(origin, "origin"));
            }),
            py::arg("values"), py::arg("cell_size"), py::arg("origin"));
   py::class_<MacWind, WindField, std::shared_ptr<MacWind>>(
@@ -179,7 +155,7 @@ void bindFields(py::module_& m) {
                throw py::value_error("u, v, w must have shapes (nx+1, ny, nz), (nx, ny+1, nz), (nx, ny, nz+1)");
              MacGrid3 mac(cells);
              for (int a = 0; a < 3; ++a) mac.component(a) = std::move(c[a]);
-             return std::make_shared<MacWind>(std::move(mac), cellSize, vec3Arg(origin, "origin"));
+             return std::make_shared<MacWind>(std::move(mac), cellSize, dvec3Arg(origin, "origin"));
            }),
            py::arg("u"), py::arg("v"), py::arg("w"), py::arg("cell_size"), py::arg("origin"));
 
@@ -188,24 +164,24 @@ void bindFields(py::module_& m) {
       .def(
           "distance",
           [](const ObstacleSdf& o, const py::object& x) {
-            const std::vector<glm::dvec3> p = pointsArg(x, "points");
+            const std::vector<glm::dvec3> p = dpointsArg(x, "points");
             py::array_t<double> d(py::ssize_t(p.size()));
             for (std::size_t i = 0; i < p.size(); ++i) d.mutable_data()[i] = o.distance(p[i]);
             return d;
           },
           py::arg("points"));
   py::class_<SphereSdf, ObstacleSdf, std::shared_ptr<SphereSdf>>(m, "SphereSdf")
-      .def(py::init([](const py::object& c, double r) { return std::make_shared<SphereSdf>(vec3Arg(c, "center"), r); }),
+      .def(py::init([](const py::object& c, double r) { return std::make_shared<SphereSdf>(dvec3Arg(c, "center"), r); }),
            py::arg("center"), py::arg("radius"));
   py::class_<BoxSdf, ObstacleSdf, std::shared_ptr<BoxSdf>>(m, "BoxSdf")
       .def(py::init([](const py::object& lo, const py::object& hi) {
-             return std::make_shared<BoxSdf>(vec3Arg(lo, "lower"), vec3Arg(hi, "upper"));
+             return std::make_shared<BoxSdf>(dvec3Arg(lo, "lower"), dvec3Arg(hi, "upper"));
            }),
            py::arg("lower"), py::arg("upper"));
   py::class_<GridSdf, ObstacleSdf, std::shared_ptr<GridSdf>>(
       m, "GridSdf", "Voxelized obstacle: cell-centred signed distances (nx, ny, nz), read trilinearly.")
       .def(py::init([](const py::object& v, double cellSize, const py::object& origin) {
-             return std::make_shared<GridSdf>(scalarGridArg(v, "values"), cellSize, vec3Arg(origin, "origin"));
+             return std::make_shared<GridSdf>(scalarGridArg(v, "values"), cellSize, dvec3Arg(origin, "origin"));
            }),
            py::arg("values"), py::arg("cell_size"), py::arg("origin"));
 }
@@ -255,7 +231,7 @@ void bindSystem(py::module_& m) {
 
 void bindSpine(py::module_& m) {
   py::class_<Spine>(m, "Spine", "Interpolating cubic B-spline through points, chord-length parameters (§4.1).")
-      .def(py::init([](const py::object& x) { return Spine(pointsArg(x, "points")); }), py::arg("points"))
+      .def(py::init([](const py::object& x) { return Spine(dpointsArg(x, "points")); }), py::arg("points"))
       .def_property_readonly("knots", &Spine::knots)
       .def_property_readonly("length", &Spine::length, "Arc length (m).")
       .def(
@@ -263,7 +239,7 @@ void bindSpine(py::module_& m) {
           [](const Spine& s, const std::vector<double>& u) {
             std::vector<glm::dvec3> p;
             for (double v : u) p.push_back(s.evaluate(v));
-            return rows3(p);
+            return rowsArray(p);
           },
           py::arg("u"), "Points at parameters u, as (N, 3).")
       .def(
@@ -271,7 +247,7 @@ void bindSpine(py::module_& m) {
           [](const Spine& s, const std::vector<double>& u) {
             std::vector<glm::dvec3> p;
             for (double v : u) p.push_back(s.tangent(v));
-            return rows3(p);
+            return rowsArray(p);
           },
           py::arg("u"), "Unit tangents at parameters u, as (N, 3).")
       .def("arc_length", &Spine::arcLength, py::arg("u"))
@@ -281,11 +257,11 @@ void bindSpine(py::module_& m) {
       [](const py::object& x, int count) {
         if (count < 2) throw py::value_error("count must be >= 2");
         std::vector<SpinePoint> pts;
-        for (const glm::dvec3& p : pointsArg(x, "points")) pts.push_back(SpinePoint{p, glm::dvec3(0.0), 0.0});
+        for (const glm::dvec3& p : dpointsArg(x, "points")) pts.push_back(SpinePoint{p, glm::dvec3(0.0), 0.0});
         if (pts.empty()) throw py::value_error("points must hold at least 1 point");
         std::vector<glm::dvec3> out;
         for (const SpinePoint& p : resampleSpine(pts, count)) out.push_back(p.x);
-        return rows3(out);
+        return rowsArray(out);
       },
       py::arg("points"), py::arg("count"),
       "count points evenly spaced along the curve through points (N, 3); first and last kept (§4.1).");

@@ -5,13 +5,13 @@
 /// release the GIL. std::invalid_argument becomes ValueError.
 
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
 
 #include "flowgraph/cost_matrix.h"
 #include "flowgraph/cost_matrix_image.h"
 #include "flowgraph/flow_graph.h"
 #include "flowgraph/random_walk.h"
 
-#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
@@ -21,9 +21,6 @@ namespace py = pybind11;
 
 namespace plume::bindings {
 namespace {
-
-using DoubleC = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using LongC = py::array_t<long long, py::array::c_style | py::array::forcecast>;
 
 /// A Python sequence of PathlineGroup as pointers (the sequence must outlive their use).
 std::vector<const PathlineGroup*> groupPointers(const py::sequence& groups) {
@@ -39,20 +36,13 @@ std::vector<const PathlineGroup*> groupPointers(const py::sequence& groups) {
 
 /// An (N, N) float64 array as a checked CostMatrix (ValueError otherwise).
 CostMatrix toCost(const py::object& o) {
-  const DoubleC a = DoubleC::ensure(o);
+  const DoubleArrayC a = DoubleArrayC::ensure(o);
   if (!a || a.ndim() != 2 || a.shape(0) != a.shape(1))
     throw py::value_error("cost must be a square (N, N) float array");
   std::vector<double> v(std::size_t(a.size()));
   if (!v.empty()) std::memcpy(v.data(), a.data(), v.size() * sizeof(double));
   py::gil_scoped_release release;
   return CostMatrix::fromValues(int(a.shape(0)), std::move(v));
-}
-
-template <typename T, typename Fn>
-py::array_t<T> arrayOf(std::size_t n, const Fn& fn) {
-  py::array_t<T> a(static_cast<py::ssize_t>(n));
-  for (std::size_t i = 0; i < n; ++i) a.mutable_data()[i] = T(fn(i));
-  return a;
 }
 
 /// The state node counts of a graph (before pruning).
@@ -167,10 +157,10 @@ void bindJob(py::module_& m) {
 py::dict selectionDict(const TransitionSelection& s) {
   const auto& c = s.candidates;
   py::dict d;
-  d["row"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].row; });
-  d["col"] = arrayOf<int>(c.size(), [&](std::size_t k) { return c[k].col; });
-  d["cost"] = arrayOf<double>(c.size(), [&](std::size_t k) { return c[k].cost; });
-  d["kept"] = arrayOf<bool>(c.size(), [&](std::size_t k) { return c[k].kept; });
+  d["row"] = arrayFrom<int>(c.size(), [&](std::size_t k) { return c[k].row; });
+  d["col"] = arrayFrom<int>(c.size(), [&](std::size_t k) { return c[k].col; });
+  d["cost"] = arrayFrom<double>(c.size(), [&](std::size_t k) { return c[k].cost; });
+  d["kept"] = arrayFrom<bool>(c.size(), [&](std::size_t k) { return c[k].kept; });
   d["a"] = s.a;
   d["b"] = s.b;
   d["epsilon"] = s.epsilon;
@@ -198,17 +188,17 @@ void bindGraph(py::module_& m) {
   g.def_property_readonly("state_node_counts", &stateCounts, "Nodes per state (before pruning).");
   g.def_property_readonly("pruned_per_state", &FlowGraph::prunedPerState, "Pruned nodes per state.");
   g.def_property_readonly(
-      "node_states", [](const FlowGraph& f) { return arrayOf<int>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.state(int(n)); }); },
+      "node_states", [](const FlowGraph& f) { return arrayFrom<int>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.state(int(n)); }); },
       "State of every node, (N,) int32.");
   g.def_property_readonly(
-      "node_steps", [](const FlowGraph& f) { return arrayOf<int>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.step(int(n)); }); },
+      "node_steps", [](const FlowGraph& f) { return arrayFrom<int>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.step(int(n)); }); },
       "Step of every node inside its state, (N,) int32.");
   g.def_property_readonly(
-      "pruned", [](const FlowGraph& f) { return arrayOf<bool>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.pruned(int(n)); }); },
+      "pruned", [](const FlowGraph& f) { return arrayFrom<bool>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.pruned(int(n)); }); },
       "True for the pruned nodes, (N,) bool.");
   g.def_property_readonly(
       "stays_in_state",
-      [](const FlowGraph& f) { return arrayOf<bool>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.staysInState(int(n)); }); },
+      [](const FlowGraph& f) { return arrayFrom<bool>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.staysInState(int(n)); }); },
       "True where a walk can stay in the node's state forever, (N,) bool.");
   g.def(
       "out_degree",
@@ -228,10 +218,10 @@ void bindGraph(py::module_& m) {
           for (int k = 0; k < f.outDegree(n); ++k) from.push_back(n);
         const FlowEdge* e = f.outEdges(0).begin();
         py::dict d;
-        d["from"] = arrayOf<int>(from.size(), [&](std::size_t k) { return from[k]; });
-        d["to"] = arrayOf<int>(from.size(), [&](std::size_t k) { return e[k].to; });
-        d["cost"] = arrayOf<double>(from.size(), [&](std::size_t k) { return e[k].cost; });
-        d["temporal"] = arrayOf<bool>(from.size(), [&](std::size_t k) { return e[k].temporal; });
+        d["from"] = array1D(from);
+        d["to"] = arrayFrom<int>(from.size(), [&](std::size_t k) { return e[k].to; });
+        d["cost"] = arrayFrom<double>(from.size(), [&](std::size_t k) { return e[k].cost; });
+        d["temporal"] = arrayFrom<bool>(from.size(), [&](std::size_t k) { return e[k].temporal; });
         return d;
       },
       "Every edge of the pruned graph: dict of (E,) arrays from, to, cost, temporal (by source node).");
@@ -282,7 +272,7 @@ void bindWalk(py::module_& m) {
   w.def(
       "run",
       [](RandomWalk& walk, const py::object& targets) {
-        const LongC t = LongC::ensure(targets);
+        const Int64ArrayC t = Int64ArrayC::ensure(targets);
         if (!t || t.ndim() != 1) throw py::value_error("targets must be a 1-D integer array");
         std::vector<int> nodes(std::size_t(t.size()));
         const std::vector<long long> tv(t.data(), t.data() + t.size());
@@ -291,14 +281,13 @@ void bindWalk(py::module_& m) {
           for (std::size_t k = 0; k < nodes.size(); ++k)
             nodes[k] = walk.next(int(std::max(-2LL, std::min(tv[k], 1LL << 30))));  // next() checks the range
         }
-        return arrayOf<int>(nodes.size(), [&](std::size_t k) { return nodes[k]; });
+        return array1D(nodes);
       },
       py::arg("targets"), "next(targets[k]) for every k (-1: no target); the nodes visited, (K,) int32.");
   w.def(
       "edge_probabilities",
       [](const RandomWalk& walk, int node, int target) {
-        const std::vector<double> p = walk.edgeProbabilities(node, target);
-        return arrayOf<double>(p.size(), [&](std::size_t k) { return p[k]; });
+        return array1D(walk.edgeProbabilities(node, target));
       },
       py::arg("node"), py::arg("target_state") = -1,
       "Probability of each out-edge of node (FlowGraph.edges order), eq. 12 or §5.1 target rule.");

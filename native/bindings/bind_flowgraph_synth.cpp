@@ -1,21 +1,19 @@
 /// \file bind_flowgraph_synth.cpp
-/// Flow-graph fire, data and synthesis side (graph_fire_synthesis.txt §4.2, §5.2-5.3): the
-/// pathline recorder of a fire bake with its file, pathline files, the synthesizer with uniform
-/// or grid external velocity, and rasterization into frame VDBs. Conversions and docstrings
-/// only; frames, file reads and writes, steps and rasterization release the GIL.
+/// Flow-graph fire, synthesis side (graph_fire_synthesis.txt §5.2-5.3): the synthesizer with
+/// uniform or grid external velocity, its cache of prepared groups, and rasterization into frame
+/// VDBs (the pathline recorder and files it reads are in bind_flowgraph_pathlines.cpp).
+/// Conversions and docstrings only; steps, file reads and writes and rasterization release the GIL.
 
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
 
 #include "flowgraph/fire_raster.h"
-#include "flowgraph/pathline_recorder.h"
 #include "flowgraph/synthesizer.h"
 #include "flowgraph/velocity_field.h"
 #include "io/pathline_file.h"
 
-#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include <cstring>
 #include <memory>
 
 namespace py = pybind11;
@@ -23,51 +21,11 @@ namespace py = pybind11;
 namespace plume::bindings {
 namespace {
 
-using FloatF = py::array_t<float, py::array::f_style | py::array::forcecast>;
-using FloatC = py::array_t<float, py::array::c_style | py::array::forcecast>;
-
-glm::vec3 vec3Arg(const py::object& o, const char* name) {
-  const auto v = o.cast<std::vector<float>>();
-  if (v.size() != 3) throw py::value_error(std::string(name) + " must hold 3 numbers");
-  return {v[0], v[1], v[2]};
-}
-
-py::array_t<float> rows3(const std::vector<glm::vec3>& v) {
-  py::array_t<float> a({py::ssize_t(v.size()), py::ssize_t(3)});
-  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(glm::vec3));
-  return a;
-}
-
-py::array_t<float> floats(const std::vector<float>& v) {
-  py::array_t<float> a(py::ssize_t(v.size()));
-  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(float));
-  return a;
-}
-
-/// A 1-D array of linear cell indices as a CellSet (ValueError for negative ones).
-CellSet cellsArg(const py::object& o) {
-  const auto a = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(o);
-  if (!a || a.ndim() != 1) throw py::value_error("fuel_cells must be a 1-D array of cell indices");
-  CellSet cells;
-  for (py::ssize_t n = 0; n < a.size(); ++n) {
-    const long long c = a.data()[n];
-    if (c < 0 || c > 0xffffffffLL) throw py::value_error("fuel_cells holds an index outside the grid");
-    cells.cells.push_back(std::uint32_t(c));
-  }
-  return cells;
-}
-
-/// A recorder writing its groups to a pathline file as they complete (one per bake).
-struct PathlineBake {
-  std::unique_ptr<PathlineFileWriter> writer;
-  std::unique_ptr<PathlineRecorder> recorder;
-};
-
 /// (N, 3) positions, (N,) density and temperature of equal N, viewed for rasterizeFire().
 struct ParticleArrays {
-  FloatC positions, density, temperature;
+  FloatArrayC positions, density, temperature;
   ParticleArrays(const py::object& x, const py::object& r, const py::object& t)
-      : positions(FloatC::ensure(x)), density(FloatC::ensure(r)), temperature(FloatC::ensure(t)) {
+      : positions(FloatArrayC::ensure(x)), density(FloatArrayC::ensure(r)), temperature(FloatArrayC::ensure(t)) {
     if (!positions || positions.ndim() != 2 || positions.shape(1) != 3)
       throw py::value_error("positions must be a float array of shape (N, 3)");
     const py::ssize_t n = positions.shape(0);
@@ -97,123 +55,11 @@ void withExternalVelocity(const py::object& ext, const F& f) {
   }
 }
 
+/// What write_vdb() and write_fire_vdb() return: dict(voxels=active voxels of the density).
 py::dict rasterStats(const FireGrids& g) {
   py::dict d;
   d["voxels"] = g.density->activeVoxelCount();
   return d;
-}
-
-void bindRecorder(py::module_& m) {
-  py::class_<PathlineParams> p(m, "PathlineParams", "Pathline sampling of a fire bake (§4.2).");
-  p.def(py::init([](int nodesPerFrame, float lifetime) {
-          PathlineParams s;
-          s.nodesPerFrame = nodesPerFrame;
-          s.lifetime = lifetime;
-          s.validate();
-          return s;
-        }),
-        py::arg("nodes_per_frame") = 2, py::arg("lifetime") = 1.f,
-        "ValueError on nodes_per_frame outside [1, 64] or a lifetime that is not > 0 s.");
-  p.def_readonly("nodes_per_frame", &PathlineParams::nodesPerFrame,
-                 "Node steps per frame: Δt_n = frame_dt / nodes_per_frame. Reproduction is accurate "
-                 "when the fastest particles cross about one cell per node step (§4.1: Δt = 0.5 Δx / U).");
-  p.def_readonly("lifetime", &PathlineParams::lifetime, "t_max, seconds: L = round(t_max / Δt_n).");
-  p.def("samples", &PathlineParams::samples, py::arg("frame_dt"), "L for frames of frame_dt seconds.");
-
-  py::class_<PathlineBake> r(
-      m, "PathlineRecorder",
-      "Records the pathline groups of a fire bake (§4.2-4.3) into a pathline file while the solver "
-      "runs: at every node step Δt_n, |Ω| particles seeded at spacing Δx/2 in the fuel cells, "
-      "integrated with RK4 across the solver's substeps, sampled L times. Groups are appended as "
-      "they complete; finish() makes the file complete (until then only '<path>.partial' exists).");
-  r.def(py::init([](const PathlineParams& params, const SmokeParams& smoke, const py::object& cells,
-                    const py::object& path, bool float16) {
-          auto bake = std::make_unique<PathlineBake>();
-          // The sink reaches the writer through the bake, whose address Python's holder keeps.
-          bake->recorder = std::make_unique<PathlineRecorder>(
-              params, smoke, cellsArg(cells),
-              [raw = bake.get()](const PathlineGroup& g, const std::vector<glm::vec3>&) {
-                raw->writer->append(g);
-              });
-          PathlineFileInfo info;
-          info.layout = bake->recorder->layout();
-          info.resolution = smoke.resolution;
-          info.cellSize = smoke.cellSize;
-          info.origin = smoke.origin;
-          info.nodesPerFrame = params.nodesPerFrame;
-          info.float16 = float16;
-          const std::string file = pathArg(path);
-          {
-            py::gil_scoped_release release;
-            bake->writer = std::make_unique<PathlineFileWriter>(file, info);
-          }
-          return bake;
-        }),
-        py::arg("params"), py::arg("smoke"), py::arg("fuel_cells"), py::arg("path"),
-        py::arg("float16") = false,
-        "params: PathlineParams; smoke: the bake's SmokeParams; fuel_cells: linear indices of the "
-        "cells where fuel is injected (source_cells() of every fuel source); path: the pathline "
-        "file (pathlines.bin in the bake folder). ValueError on bad settings or no fuel cell; "
-        "RuntimeError naming the file if it cannot be written.");
-  r.def(
-      "advance_frame",
-      [](PathlineBake& b, SmokeSolver& solver) {
-        py::gil_scoped_release release;
-        return solver.advanceFrame(b.recorder.get());
-      },
-      py::arg("solver"),
-      "solver.advance_frame() with the recorder following every substep. Releases the GIL. "
-      "Returns False when the solver or the recorder was cancelled (discard both).");
-  r.def("finish", [](PathlineBake& b) {
-          py::gil_scoped_release release;
-          b.writer->finish();
-        },
-        "Writes the node table and renames the file to its path (the groups still young are "
-        "dropped: they lack samples).");
-  r.def("discard", [](PathlineBake& b) { b.writer->discard(); },
-        "Removes the partial file (a cancelled bake).");
-  r.def("cancel", [](PathlineBake& b) { b.recorder->cancel(); },
-        "Thread-safe: a running advance_frame() returns False before its next step.");
-  r.def_property_readonly("layout", [](const PathlineBake& b) { return b.recorder->layout(); });
-  r.def_property_readonly("seeds", [](const PathlineBake& b) { return rows3(b.recorder->seeds()); },
-                          "Ω: (|Ω|, 3) float32 world positions.");
-  r.def_property_readonly("groups_seeded", [](const PathlineBake& b) { return b.recorder->groupsSeeded(); });
-  r.def_property_readonly("groups_completed",
-                          [](const PathlineBake& b) { return b.recorder->groupsCompleted(); },
-                          "Nodes written so far.");
-  r.def_property_readonly("path", [](const PathlineBake& b) { return b.writer->path(); });
-  r.def_property_readonly("partial_path", [](const PathlineBake& b) { return b.writer->partialPath(); });
-}
-
-void bindFile(py::module_& m) {
-  py::class_<PathlineFile> f(m, "PathlineFile",
-                             "A complete pathline file, read lazily: open() reads its header and "
-                             "node table, read_group() one node.");
-  f.def_static("open", [](const py::object& path) { return withPath(path, PathlineFile::open); },
-               py::arg("path"),
-               "RuntimeError naming the file when it is missing, incomplete, truncated or corrupt.");
-  f.def_property_readonly("path", &PathlineFile::path);
-  f.def_property_readonly("layout", &PathlineFile::layout);
-  f.def_property_readonly("node_count", &PathlineFile::nodeCount);
-  f.def_property_readonly("bytes_per_node", &PathlineFile::bytesPerNode);
-  f.def_property_readonly("float16", [](const PathlineFile& p) { return p.info().float16; });
-  f.def_property_readonly("nodes_per_frame", [](const PathlineFile& p) { return p.info().nodesPerFrame; });
-  f.def_property_readonly("resolution", [](const PathlineFile& p) {
-    const glm::ivec3 r = p.info().resolution;
-    return py::make_tuple(r.x, r.y, r.z);
-  });
-  f.def_property_readonly("cell_size", [](const PathlineFile& p) { return p.info().cellSize; });
-  f.def_property_readonly("origin", [](const PathlineFile& p) {
-    const glm::vec3 o = p.info().origin;
-    return py::make_tuple(o.x, o.y, o.z);
-  });
-  f.def("read_group", [](const PathlineFile& p, int k, int state) {
-          py::gil_scoped_release release;
-          return p.readGroup(k, state);
-        },
-        py::arg("node"), py::arg("state") = 0,
-        "Node k as a PathlineGroup (state copied into it). IndexError for a bad k, RuntimeError "
-        "naming the file for a corrupt block.");
 }
 
 void bindSynthesizer(py::module_& m) {
@@ -221,23 +67,14 @@ void bindSynthesizer(py::module_& m) {
                                   "u_ext on a cell-centred grid (§5.2), e.g. Blender's Wind and "
                                   "Turbulence force fields evaluated by the add-on.");
   v.def(py::init([](const py::object& values, float cellSize, const py::object& origin) {
-          const FloatF a = FloatF::ensure(values);
+          const FloatArrayF a = FloatArrayF::ensure(values);
           if (!a || a.ndim() != 4 || a.shape(3) != 3)
             throw py::value_error("values must be a float array of shape (nx, ny, nz, 3)");
-          VectorGrid g(glm::ivec3(int(a.shape(0)), int(a.shape(1)), int(a.shape(2))));
-          const auto r = a.unchecked<4>();
-          for (py::ssize_t k = 0; k < a.shape(2); ++k)
-            for (py::ssize_t j = 0; j < a.shape(1); ++j)
-              for (py::ssize_t i = 0; i < a.shape(0); ++i)
-                g(int(i), int(j), int(k)) = {r(i, j, k, 0), r(i, j, k, 1), r(i, j, k, 2)};
-          return GridVelocityField(std::move(g), cellSize, vec3Arg(origin, "origin"));
+          return GridVelocityField(vectorGridOf(a), cellSize, vec3Arg(origin, "origin"));
         }),
         py::arg("values"), py::arg("cell_size"), py::arg("origin"),
         "values[i, j, k] at origin + (i + 1/2, j + 1/2, k + 1/2) cell_size, m/s.");
-  v.def("at", [](const GridVelocityField& f, const py::object& x) {
-    const glm::vec3 u = f.at(vec3Arg(x, "x"));
-    return py::make_tuple(u.x, u.y, u.z);
-  });
+  v.def("at", [](const GridVelocityField& f, const py::object& x) { return vec3Tuple(f.at(vec3Arg(x, "x"))); });
 
   py::class_<PreparedGroupCache, std::shared_ptr<PreparedGroupCache>> cache(
       m, "PreparedGroupCache",
@@ -308,26 +145,24 @@ void bindSynthesizer(py::module_& m) {
             syn.gather(p);
           }
           py::dict d;
-          d["positions"] = rows3(p.positions);
-          d["density"] = floats(p.density);
-          d["temperature"] = floats(p.temperature);
+          d["positions"] = rowsArray(p.positions);
+          d["density"] = array1D(p.density);
+          d["temperature"] = array1D(p.temperature);
           return d;
         },
         "dict(positions (N, 3), density (N,), temperature (N,)) float32 copies, oldest group first.");
   s.def(
       "write_vdb",
       [](const Synthesizer& syn, const py::object& path, const FireRasterParams& params, int frame) {
-        const std::string p = pathArg(path);
-        FireGrids grids;
-        {
-          py::gil_scoped_release release;
+        return rasterStats(withPath(path, [&](const std::string& p) {
           SynthParticles parts;
           syn.gather(parts);
-          grids = rasterizeFire({parts.positions.data(), parts.density.data(),
-                                 parts.temperature.data(), parts.size()}, params);
+          const FireGrids grids = rasterizeFire(
+              {parts.positions.data(), parts.density.data(), parts.temperature.data(), parts.size()},
+              params);
           writeFireVdb(p, grids, frame);
-        }
-        return rasterStats(grids);
+          return grids;
+        }));
       },
       py::arg("path"), py::arg("params"), py::arg("frame"),
       "Rasterizes the live particles (write_fire_vdb) and writes them atomically; returns "
@@ -367,14 +202,11 @@ void bindRaster(py::module_& m) {
       [](const py::object& path, const py::object& positions, const py::object& density,
          const py::object& temperature, const FireRasterParams& params, int frame) {
         const ParticleArrays parts(positions, density, temperature);
-        const std::string p = pathArg(path);
-        FireGrids grids;
-        {
-          py::gil_scoped_release release;
-          grids = rasterizeFire(parts.view(), params);
+        return rasterStats(withPath(path, [&](const std::string& p) {
+          const FireGrids grids = rasterizeFire(parts.view(), params);
           writeFireVdb(p, grids, frame);
-        }
-        return rasterStats(grids);
+          return grids;
+        }));
       },
       py::arg("path"), py::arg("positions"), py::arg("density"), py::arg("temperature"),
       py::arg("params"), py::arg("frame") = 0,
@@ -386,8 +218,7 @@ void bindRaster(py::module_& m) {
 }  // namespace
 
 void bindFlowgraphSynth(py::module_& m) {
-  bindRecorder(m);
-  bindFile(m);
+  bindFlowgraphPathlines(m);
   bindSynthesizer(m);
   bindRaster(m);
 }

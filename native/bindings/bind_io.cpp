@@ -3,6 +3,7 @@
 /// NumPy box.
 
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
 
 #include "io/vdb_frame.h"
 
@@ -18,21 +19,12 @@ namespace plume::bindings {
 void bindIo(py::module_& m) {
   m.def(
       "vdb_grid_names",
-      [](const py::object& path) {
-        const std::string p = pathArg(path);
-        py::gil_scoped_release release;
-        return vdbGridNames(p);
-      },
+      [](const py::object& path) { return withPath(path, vdbGridNames); },
       py::arg("path"), "Names of the grids in a VDB file (RuntimeError if it cannot be read).");
   m.def(
       "read_vdb_grid",
       [](const py::object& path, const std::string& name) {
-        const std::string p = pathArg(path);
-        DenseGrid g;
-        {
-          py::gil_scoped_release release;
-          g = readVdbGrid(p, name);
-        }
+        const DenseGrid g = withPath(path, [&](const std::string& p) { return readVdbGrid(p, name); });
         const py::ssize_t c = g.components;
         std::vector<py::ssize_t> shape{g.size.x, g.size.y, g.size.z};
         // x fastest with components interleaved: Fortran order over (i, j, k), component last
@@ -48,10 +40,9 @@ void bindIo(py::module_& m) {
           std::memcpy(values.mutable_data(), g.values.data(), g.values.size() * sizeof(float));
         py::dict d;
         d["values"] = values;
-        d["min"] = py::make_tuple(g.min.x, g.min.y, g.min.z);
+        d["min"] = vec3Tuple(g.min);
         d["voxel_size"] = g.voxelSize;
-        d["world_of_voxel_zero"] =
-            py::make_tuple(g.worldOfVoxelZero.x, g.worldOfVoxelZero.y, g.worldOfVoxelZero.z);
+        d["world_of_voxel_zero"] = vec3Tuple(g.worldOfVoxelZero);
         return d;
       },
       py::arg("path"), py::arg("name"),

@@ -4,52 +4,33 @@
 /// tracer that runs through them. Conversions and docstrings only; file reads, writes and
 /// frames release the GIL.
 
-#include <pybind11/numpy.h>
-#include <pybind11/stl.h>
-
-#include <cstring>
-
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
+
 #include "io/mantaflow_cache.h"
 #include "io/streak_file.h"
 #include "tracers/mantaflow_driver.h"
+
+#include <pybind11/stl.h>
 
 namespace py = pybind11;
 
 namespace plume::bindings {
 namespace {
 
-using FloatC = py::array_t<float, py::array::c_style | py::array::forcecast>;
-
-/// (N, 3) float array as points (an empty array: none).
-std::vector<glm::vec3> pointsArg(const FloatC& a, const char* name) {
+/// (N, 3) float array as points (an empty array: none); the message gives no shape.
+std::vector<glm::vec3> pointsInput(const FloatArrayC& a, const char* name) {
   if (a.size() != 0 && (a.ndim() != 2 || a.shape(1) != 3))
     throw py::value_error(std::string(name) + " must have shape (N, 3)");
   const auto* p = reinterpret_cast<const glm::vec3*>(a.data());
   return std::vector<glm::vec3>(p, p + a.size() / 3);
 }
 
-py::array_t<float> pointsResult(const std::vector<glm::vec3>& p) {
-  py::array_t<float> a({py::ssize_t(p.size()), py::ssize_t(3)});
-  if (!p.empty()) std::memcpy(a.mutable_data(), p.data(), p.size() * sizeof(glm::vec3));
-  return a;
-}
-
-/// A copy of a grid as an (nx, ny, nz) Fortran-ordered array, indexed [i, j, k].
-py::array_t<float> gridResult(const ScalarGrid& g) {
-  const glm::ivec3 n = g.size();
-  py::array_t<float, py::array::f_style> a({py::ssize_t(n.x), py::ssize_t(n.y), py::ssize_t(n.z)});
-  std::memcpy(a.mutable_data(), g.data(), sizeof(float) * g.count());
-  return a;
-}
-
-glm::vec3 vec3Arg(const std::array<float, 3>& v) { return {v[0], v[1], v[2]}; }
-
 template <typename Map>
-py::array_t<float> mapPoints(const FloatC& points, const Map& map) {
-  std::vector<glm::vec3> p = pointsArg(points, "points");
+py::array_t<float> mapPoints(const FloatArrayC& points, const Map& map) {
+  std::vector<glm::vec3> p = pointsInput(points, "points");
   for (glm::vec3& q : p) q = map(q);
-  return pointsResult(p);
+  return rowsArray(p);
 }
 
 void bindGrid(py::module_& m) {
@@ -60,36 +41,29 @@ void bindGrid(py::module_& m) {
       "cells, so cells are not cubic), and Mantaflow time units per second (2.5).");
   g.def(py::init([](const std::array<int, 3>& res, const std::array<float, 3>& origin,
                     const std::array<float, 3>& cellSize, float unitsPerSecond) {
-          MantaflowGrid grid{glm::ivec3(res[0], res[1], res[2]), vec3Arg(origin), vec3Arg(cellSize),
-                             unitsPerSecond};
+          MantaflowGrid grid{ivec3Of(res), vec3Of(origin), vec3Of(cellSize), unitsPerSecond};
           grid.validate();
           return grid;
         }),
         py::arg("resolution"), py::arg("origin"), py::arg("cell_size"),
         py::arg("time_units_per_second") = kMantaflowTimeUnitsPerSecond,
         "ValueError on a resolution outside [1, 2048] or a cell size <= 0.");
-  g.def_property_readonly("resolution", [](const MantaflowGrid& x) {
-    return py::make_tuple(x.resolution.x, x.resolution.y, x.resolution.z);
-  });
-  g.def_property_readonly("origin", [](const MantaflowGrid& x) {
-    return py::make_tuple(x.origin.x, x.origin.y, x.origin.z);
-  });
-  g.def_property_readonly("cell_size", [](const MantaflowGrid& x) {
-    return py::make_tuple(x.cellSize.x, x.cellSize.y, x.cellSize.z);
-  });
+  g.def_property_readonly("resolution", [](const MantaflowGrid& x) { return vec3Tuple(x.resolution); });
+  g.def_property_readonly("origin", [](const MantaflowGrid& x) { return vec3Tuple(x.origin); });
+  g.def_property_readonly("cell_size", [](const MantaflowGrid& x) { return vec3Tuple(x.cellSize); });
   g.def_property_readonly("time_units_per_second",
                           [](const MantaflowGrid& x) { return x.timeUnitsPerSecond; });
   g.def_property_readonly("vdb_voxel_size", &MantaflowGrid::vdbVoxelSize,
                           "Voxel size of the cache's VDB transform (longest side / resolution).");
   g.def(
       "index_to_world",
-      [](const MantaflowGrid& x, const FloatC& p) {
+      [](const MantaflowGrid& x, const FloatArrayC& p) {
         return mapPoints(p, [&](glm::vec3 q) { return x.indexToWorld(q); });
       },
       py::arg("points"), "(N, 3) cell coordinates (cell (i,j,k) spans [i, i+1]...) to world.");
   g.def(
       "world_to_index",
-      [](const MantaflowGrid& x, const FloatC& p) {
+      [](const MantaflowGrid& x, const FloatArrayC& p) {
         return mapPoints(p, [&](glm::vec3 q) { return x.worldToIndex(q); });
       },
       py::arg("points"), "(N, 3) world positions to cell coordinates.");
@@ -106,13 +80,12 @@ void bindFrame(py::module_& m) {
       },
       py::arg("resolution"), "The state before the first cached frame: all zero.");
   f.def(
-      "density", [](const MantaflowFrame& x) { return gridResult(x.density); },
+      "density", [](const MantaflowFrame& x) { return gridArray(x.density); },
       "Copy of the density, (nx, ny, nz) float32.");
   f.def(
       "velocity",
       [](const MantaflowFrame& x) {
-        const MacGrid3& v = x.velocity;
-        return py::make_tuple(gridResult(v.u()), gridResult(v.v()), gridResult(v.w()));
+        return macArrays(x.velocity);
       },
       "Copies of the face velocities (u, v, w) in m/s, shaped (nx+1, ny, nz), (nx, ny+1, nz), "
       "(nx, ny, nz+1) as SmokeSolver.get_velocity().");
@@ -122,9 +95,7 @@ void bindFrame(py::module_& m) {
   m.def(
       "read_mantaflow_frame",
       [](const py::object& path, const MantaflowGrid& grid) {
-        const std::string p = pathArg(path);
-        py::gil_scoped_release release;
-        return readMantaflowFrame(p, grid);
+        return withPath(path, [&](const std::string& p) { return readMantaflowFrame(p, grid); });
       },
       py::arg("path"), py::arg("grid"),
       "Reads density and velocity of a Blender Mantaflow fluid_data_####.vdb onto grid "
@@ -135,9 +106,7 @@ void bindFrame(py::module_& m) {
       "write_mantaflow_volume",
       [](const py::object& path, const MantaflowFrame& frame, const MantaflowGrid& grid,
          int number) {
-        const std::string p = pathArg(path);
-        py::gil_scoped_release release;
-        writeMantaflowVolume(p, frame, grid, number);
+        withPath(path, [&](const std::string& p) { writeMantaflowVolume(p, frame, grid, number); });
       },
       py::arg("path"), py::arg("frame"), py::arg("grid"), py::arg("frame_number"),
       "Writes the frame as a Plume volume VDB (density, cell-centred velocity where there is "
@@ -168,8 +137,8 @@ void bindTracer(py::module_& m) {
         "on emission_period outside [1, 100000] or cfl outside [0.05, 10].");
   t.def(
       "add_point_sources",
-      [](MantaflowTracer& x, const FloatC& positions, const std::vector<int>& groups) {
-        return x.addPointSources(pointsArg(positions, "positions"), groups);
+      [](MantaflowTracer& x, const FloatArrayC& positions, const std::vector<int>& groups) {
+        return x.addPointSources(pointsInput(positions, "positions"), groups);
       },
       py::arg("positions"), py::arg("groups"),
       "Still point sources at world positions (N, 3), candidate group of each (N,); only before "
@@ -189,9 +158,7 @@ void bindTracer(py::module_& m) {
   t.def(
       "write_snapshot",
       [](const MantaflowTracer& x, const py::object& path) {
-        const std::string p = pathArg(path);
-        py::gil_scoped_release release;
-        writeStreakFile(p, x.snapshot());
+        withPath(path, [&](const std::string& p) { writeStreakFile(p, x.snapshot()); });
       },
       py::arg("path"),
       "Writes the streaklines now (world positions) as a streak file, atomically.");

@@ -34,7 +34,7 @@ py::array_t<float> evaluateAt(const py::handle& uObj, const py::handle& vObj, F 
   py::module_ np = py::module_::import("numpy");
   py::tuple b = np.attr("broadcast_arrays")(np.attr("asarray")(uObj, "float64"),
                                             np.attr("asarray")(vObj, "float64"));
-  const DArray u = DArray::ensure(b[0]), v = DArray::ensure(b[1]);
+  const DoubleArrayC u = DoubleArrayC::ensure(b[0]), v = DoubleArrayC::ensure(b[1]);
   std::vector<py::ssize_t> shape(u.shape(), u.shape() + u.ndim());
   shape.push_back(3);
   py::array_t<float> out(shape);
@@ -50,10 +50,17 @@ py::array_t<float> evaluateAt(const py::handle& uObj, const py::handle& vObj, F 
   return out;
 }
 
+/// A density map as a (height, width) float32 image, row = v, column = u.
+py::array_t<float> mapArray(const DensityMap& map) {
+  py::array_t<float> a({py::ssize_t(map.height), py::ssize_t(map.width)});
+  std::memcpy(a.mutable_data(), map.values.data(), map.values.size() * sizeof(float));
+  return a;
+}
+
 }  // namespace
 
 void bindNurbs(py::module_& m) {
-  m.def("nurbs_knots", [](int n, int order, bool endpoint) { return array1(blenderKnots(n, order, endpoint)); },
+  m.def("nurbs_knots", [](int n, int order, bool endpoint) { return array1D(blenderKnots(n, order, endpoint)); },
         py::arg("point_count"), py::arg("order"), py::arg("endpoint") = true,
         "Blender 3.4's knot vector (curve.cc calcknots) for point_count points of this order, "
         "endpoint (clamped) or uniform: float32 array of point_count + order knots.");
@@ -67,29 +74,29 @@ void bindNurbs(py::module_& m) {
       "(start, end): the parameter interval Blender draws, [knots[order-1], knots[point_count]].");
   m.def("nurbs_samples",
         [](int n, int order, bool endpoint, int resolution) {
-          return array1(blenderSamples(n, order, endpoint, resolution));
+          return array1D(blenderSamples(n, order, endpoint, resolution));
         },
         py::arg("point_count"), py::arg("order"), py::arg("endpoint"), py::arg("resolution"),
         "The point_count * resolution parameters BKE_nurb_makeFaces samples (float32, as Blender).");
   m.def(
       "greville_abscissae",
       [](int n, int order, bool endpoint) {
-        return array1(grevilleAbscissae(blenderKnots(n, order, endpoint), n, order));
+        return array1D(grevilleAbscissae(blenderKnots(n, order, endpoint), n, order));
       },
       py::arg("point_count"), py::arg("order"), py::arg("endpoint") = true,
       "Greville abscissae of Blender's knots (float64).");
   m.def("interpolation_parameters",
-        [](int n, int order, bool endpoint) { return array1(interpolationParameters(n, order, endpoint)); },
+        [](int n, int order, bool endpoint) { return array1D(interpolationParameters(n, order, endpoint)); },
         py::arg("point_count"), py::arg("order"), py::arg("endpoint") = true,
         "Parameters of the particles (§3.3): Greville abscissae mapped onto the drawn interval.");
   m.def("supersample_parameters",
-        [](const std::vector<double>& nodes, int rate) { return array1(supersampleParameters(nodes, rate)); },
+        [](const std::vector<double>& nodes, int rate) { return array1D(supersampleParameters(nodes, rate)); },
         py::arg("nodes"), py::arg("rate"),
         "§3.4: the nodes plus `rate` evenly spaced parameters between consecutive ones.");
 
   m.def(
       "interpolate_surface",
-      [](const DArray& points, int orderU, int orderV, bool endpointU, bool endpointV) {
+      [](const DoubleArrayC& points, int orderU, int orderV, bool endpointU, bool endpointV) {
         int nu = 0, nv = 0;
         const std::vector<glm::vec3> q = gridPointsFrom(points, nu, nv);
         SurfaceSpec spec;
@@ -157,7 +164,7 @@ void bindNurbs(py::module_& m) {
           s = surfaceFrom(surfaceOrPoints.cast<py::dict>());
         } else {
           int nu = 0, nv = 0;
-          const std::vector<glm::vec3> q = gridPointsFrom(DArray::ensure(surfaceOrPoints), nu, nv);
+          const std::vector<glm::vec3> q = gridPointsFrom(DoubleArrayC::ensure(surfaceOrPoints), nu, nv);
           s = interpolateSurface(q, nu, nv, SurfaceSpec{});
         }
         const ScalarGrid grid = gridFrom(density);
@@ -165,16 +172,14 @@ void bindNurbs(py::module_& m) {
         p.samplingU = kU;
         p.samplingV = kV;
         p.interpolation = interpolation;
-        p.origin = vec3From(origin, "origin");
+        p.origin = vec3Arg(origin, "origin", "must be 3 numbers");
         p.cellSize = cellSize;
         DensityMap map;
         {
           py::gil_scoped_release release;
           map = densityMap(s, grid, p);
         }
-        py::array_t<float> a({py::ssize_t(map.height), py::ssize_t(map.width)});
-        std::memcpy(a.mutable_data(), map.values.data(), map.values.size() * sizeof(float));
-        return a;
+        return mapArray(map);
       },
       py::arg("surface"), py::arg("density"), py::arg("origin"), py::arg("cell_size"),
       py::arg("k_u") = 4, py::arg("k_v") = 2, py::arg("interpolation") = Interpolation::MonotonicCubic,
@@ -190,7 +195,7 @@ void bindNurbs(py::module_& m) {
         const ScalarGrid grid = gridFrom(density);
         DensityMapParams p;
         p.interpolation = interpolation;
-        p.origin = vec3From(origin, "origin");
+        p.origin = vec3Arg(origin, "origin", "must be 3 numbers");
         p.cellSize = cellSize;
         DensityMap map;
         {
@@ -199,9 +204,7 @@ void bindNurbs(py::module_& m) {
           map = densityMapAt(s, grid, p, evenParameters(dom.u.start, dom.u.end, width),
                              evenParameters(dom.v.start, dom.v.end, height));
         }
-        py::array_t<float> a({py::ssize_t(map.height), py::ssize_t(map.width)});
-        std::memcpy(a.mutable_data(), map.values.data(), map.values.size() * sizeof(float));
-        return a;
+        return mapArray(map);
       },
       py::arg("surface"), py::arg("density"), py::arg("origin"), py::arg("cell_size"),
       py::arg("width"), py::arg("height"), py::arg("interpolation") = Interpolation::MonotonicCubic,
@@ -228,7 +231,7 @@ void bindNurbs(py::module_& m) {
         std::vector<float> image;
         int width = 0, height = 0;
         if (!density.is_none()) {
-          const FArray d = FArray::ensure(density);
+          const FloatArrayC d = FloatArrayC::ensure(density);
           if (!d || d.ndim() != 2)
             throw py::value_error("density must be a 2-D density map (rows = v, columns = u)");
           height = int(d.shape(0));
@@ -243,11 +246,9 @@ void bindNurbs(py::module_& m) {
           py::gil_scoped_release release;
           mesh = subdivideControlNet(cps, nu, nv, p, image, width, height);
         }
-        py::array_t<int> quads({py::ssize_t(mesh.quads.size()), py::ssize_t(4)});
-        std::memcpy(quads.mutable_data(), mesh.quads.data(), mesh.quads.size() * sizeof(glm::ivec4));
         py::object dens = py::none();
-        if (!mesh.density.empty()) dens = array1(mesh.density);
-        return py::make_tuple(pointsArray(mesh.vertices, 3), quads, dens);
+        if (!mesh.density.empty()) dens = array1D(mesh.density);
+        return py::make_tuple(rowsArray(mesh.vertices), rowsArray(mesh.quads), dens);
       },
       py::arg("control_points"), py::arg("nu"), py::arg("nv"), py::arg("level") = 2,
       py::arg("density") = py::none(), py::arg("limit") = true,

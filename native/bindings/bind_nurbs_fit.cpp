@@ -25,18 +25,18 @@ namespace {
 
 using namespace nurbs_convert;
 
-using KeepArray = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
+using KeepArray = UInt8ArrayC;
 
 /// Frames of points (frames, lines, particles, 3) float32 and keep flags (frames, lines,
 /// particles) as StreakGrids that point into both arrays (kept alive by the caller).
-std::vector<StreakGrid> shotFrom(const FArray& a, const KeepArray& keep) {
+std::vector<StreakGrid> shotFrom(const FloatArrayC& a, const KeepArray& keep) {
   if (a.ndim() != 4 || a.shape(3) != 3 || a.shape(0) < 1 || a.shape(1) < 1 || a.shape(2) < 1)
     throw py::value_error("points must have shape (frames, lines, particles, 3) with every size "
-                          ">= 1, got " + shapeOf(a));
+                          ">= 1, got " + shapeText(a));
   if (keep.ndim() != 3 || keep.shape(0) != a.shape(0) || keep.shape(1) != a.shape(1) ||
       keep.shape(2) != a.shape(2))
     throw py::value_error("keep must have shape (frames, lines, particles) of points " +
-                          shapeOf(a) + ", got " + shapeOf(keep));
+                          shapeText(a) + ", got " + shapeText(keep));
   std::vector<StreakGrid> frames(std::size_t(a.shape(0)));
   const std::size_t perFrame = std::size_t(a.shape(1) * a.shape(2));
   const glm::vec3* base = reinterpret_cast<const glm::vec3*>(a.data());
@@ -57,7 +57,7 @@ py::array_t<double> paramsArray(const SurfaceFit& f, int lines, int particles) {
 py::dict fitDict(const SurfaceFit& f, int lines, int particles) {
   py::dict d = surfaceDict(f.surface);
   d["params_u"] = paramsArray(f, lines, particles);
-  d["params_v"] = array1(f.paramsV);
+  d["params_v"] = array1D(f.paramsV);
   d["max_residual"] = f.maxResidual;
   d["net_deviation"] = f.netDeviation;
   d["net_to_particles"] = f.netToParticles;
@@ -69,17 +69,17 @@ py::dict fitDict(const SurfaceFit& f, int lines, int particles) {
 void bindNurbsFit(py::module_& m) {
   m.def(
       "fit_surface",
-      [](const FArray& points, const py::object& keepObj, int nu, int nv, int orderU, int orderV,
+      [](const FloatArrayC& points, const py::object& keepObj, int nu, int nv, int orderU, int orderV,
          double smoothing, double exponentU, double exponentV) {
         if (points.ndim() != 3 || points.shape(2) != 3 || points.shape(0) < 1 || points.shape(1) < 1)
           throw py::value_error("points must have shape (lines, particles, 3) with lines, particles "
-                                ">= 1, got " + shapeOf(points));
+                                ">= 1, got " + shapeText(points));
         const py::ssize_t lines = points.shape(0), particles = points.shape(1);
         KeepArray keep =
             keepObj.is_none() ? KeepArray({lines, particles}) : KeepArray::ensure(keepObj);
         if (!keep || keep.ndim() != 2 || keep.shape(0) != lines || keep.shape(1) != particles)
           throw py::value_error("keep must be flags of shape (lines, particles) of points " +
-                                shapeOf(points));
+                                shapeText(points));
         if (keepObj.is_none()) std::fill_n(keep.mutable_data(), keep.size(), std::uint8_t(1));
         const StreakGrid g{reinterpret_cast<const glm::vec3*>(points.data()), keep.data(),
                            int(particles), int(lines)};
@@ -112,7 +112,7 @@ void bindNurbsFit(py::module_& m) {
       "distance from a control point to the nearest kept particle.");
   m.def(
       "fit_streak_shot",
-      [](const FArray& points, const KeepArray& keep, double tolerance, double netTolerance,
+      [](const FloatArrayC& points, const KeepArray& keep, double tolerance, double netTolerance,
          double particleTolerance, int orderU, int orderV, double smoothing, double exponentU,
          double exponentV, int nu, int nv) {
         const std::vector<StreakGrid> frames = shotFrom(points, keep);
@@ -153,7 +153,7 @@ void bindNurbsFit(py::module_& m) {
           deviation.mutable_data()[f] = fits[f].netDeviation;
           toParticles.mutable_data()[f] = fits[f].netToParticles;
           paramsU.append(paramsArray(fits[f], frames[f].lines, frames[f].particles));
-          paramsV.append(array1(fits[f].paramsV));
+          paramsV.append(array1D(fits[f].paramsV));
         }
         py::dict d;
         d["nu"] = s0.nu;

@@ -4,10 +4,9 @@
 /// NumPy views into the group (alive as long as any view is).
 
 #include "bindings/bindings.h"
+#include "bindings/convert.h"
 
 #include "flowgraph/pathline_group.h"
-
-#include <pybind11/numpy.h>
 
 #include <cmath>
 #include <cstring>
@@ -16,8 +15,6 @@ namespace py = pybind11;
 
 namespace plume::bindings {
 namespace {
-
-using FloatC = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
 /// A read-only view of `shape` floats at `data`, kept alive by the Python object `owner`.
 py::array view(const py::object& owner, const float* data, std::vector<py::ssize_t> shape) {
@@ -30,7 +27,7 @@ py::array view(const py::object& owner, const float* data, std::vector<py::ssize
 template <typename T>
 void copyExact(const py::object& o, const std::vector<py::ssize_t>& shape, std::vector<T>& out,
                const char* name) {
-  const FloatC a = FloatC::ensure(o);
+  const FloatArrayC a = FloatArrayC::ensure(o);
   bool ok = a && a.ndim() == py::ssize_t(shape.size());
   for (std::size_t d = 0; ok && d < shape.size(); ++d) ok = a.shape(py::ssize_t(d)) == shape[d];
   if (!ok) {
@@ -71,8 +68,8 @@ void bindPathlineGroup(py::module_& m) {
       "Δt_n apart. A particle that left the domain samples zeros from then on.");
   g.def(py::init([](const py::object& start, const py::object& velocity, const py::object& density,
                     const py::object& temperature, float sampleDt, int state, int step) {
-          const FloatC s = FloatC::ensure(start);
-          const FloatC d = FloatC::ensure(density);
+          const FloatArrayC s = FloatArrayC::ensure(start);
+          const FloatArrayC d = FloatArrayC::ensure(density);
           if (!s || s.ndim() != 2 || s.shape(1) != 3)
             throw py::value_error("start must be a float array of shape (particles, 3)");
           if (!d || d.ndim() != 2 || d.shape(0) != s.shape(0))

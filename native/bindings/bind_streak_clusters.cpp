@@ -4,11 +4,10 @@
 /// the greedy order. Conversions and docstrings only; long calls release the GIL.
 
 #include "bindings/bindings.h"
-#include "bindings/streak_frames.h"
+#include "bindings/convert.h"
 
 #include "streak/clustering.h"
 
-#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <memory>
@@ -32,13 +31,6 @@ SharedStreakFrames sharedFrames(const py::object& frames) {
       toStreakFrames(py::reinterpret_borrow<py::sequence>(frames), /*positionsOnly=*/true));
 }
 
-template <typename T, typename S>
-py::array_t<T> toNumpy(const std::vector<S>& v) {
-  py::array_t<T> a(py::ssize_t(v.size()));
-  for (std::size_t n = 0; n < v.size(); ++n) a.mutable_data()[n] = T(v[n]);
-  return a;
-}
-
 /// The held pairs (a < b) as three arrays, sorted by (a, b).
 py::tuple pairsToNumpy(const StreakDistances& d) {
   std::vector<int> a, b;
@@ -53,7 +45,7 @@ py::tuple pairsToNumpy(const StreakDistances& d) {
         b.push_back(d.neighbours(m)[i]);
         h.push_back(d.neighbourDistances(m)[i]);
       }
-  return py::make_tuple(toNumpy<std::int32_t>(a), toNumpy<std::int32_t>(b), toNumpy<double>(h));
+  return py::make_tuple(array1DAs<std::int32_t>(a), array1DAs<std::int32_t>(b), array1DAs<double>(h));
 }
 
 void checkMember(const StreakDistances& d, int a) {
@@ -113,8 +105,8 @@ void bindDistances(py::module_& m) {
           surfaces.push_back(s.surfaces);
           lines.push_back(s.streaklines);
         }
-        return py::make_tuple(toNumpy<double>(d.curve().values), toNumpy<std::int32_t>(surfaces),
-                              toNumpy<std::int32_t>(lines));
+        return py::make_tuple(array1DAs<double>(d.curve().values), array1DAs<std::int32_t>(surfaces),
+                              array1DAs<std::int32_t>(lines));
       },
       "Figure 4 as steps: (values float64 (K,), surfaces int32 (K,), streaklines int32 (K,)). "
       "For values[k] < h0 <= values[k+1] (and h0 <= reach) the threshold h0 gives surfaces[k] "

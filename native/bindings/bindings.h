@@ -1,16 +1,17 @@
 #pragma once
 /// \file bindings.h
 /// One bind function per component; module.cpp calls them in order (enums first, since the
-/// other bindings use them as argument types and defaults).
+/// other bindings use them as argument types and defaults). The conversions they share are in
+/// convert.h.
 
 #include <pybind11/pybind11.h>
 
-#include <string>
-
 namespace plume::bindings {
 
-/// SmokeParams, SourceSettings, SmokeSolver (bind_solver.cpp).
+/// SmokeParams, SourceSettings (bindSolverParams, bind_solver_params.cpp), then SmokeSolver
+/// (bind_solver.cpp).
 void bindSolver(pybind11::module_& m);
+void bindSolverParams(pybind11::module_& m);
 /// vdb_grid_names, read_vdb_grid (bind_io.cpp).
 void bindIo(pybind11::module_& m);
 /// Streak-surface NURBS: interpolation, evaluation, tessellation, density map, OpenSubdiv export
@@ -26,13 +27,17 @@ void bindStreak(pybind11::module_& m);
 void bindStreakClusters(pybind11::module_& m);
 /// Mantaflow cache frames, volumes and the tracer driven by them (bind_mantaflow.cpp).
 void bindMantaflow(pybind11::module_& m);
-/// Toon smoke: particles, billboards, depth differences, toon files (bind_toon.cpp).
+/// Toon smoke: params and fields (bind_toon.cpp), then particles, billboards, depth
+/// differences, toon files (bindToonParticles, bind_toon_particles.cpp).
 void bindToon(pybind11::module_& m);
+void bindToonParticles(pybind11::module_& m);
 /// PathlineLayout and PathlineGroup, the flow-graph node type (bind_pathline_group.cpp).
 void bindPathlineGroup(pybind11::module_& m);
-/// Flow-graph fire data and synthesis: PathlineRecorder, PathlineFile, Synthesizer,
-/// VelocityField, FireRasterParams, write_fire_vdb (bind_flowgraph_synth.cpp).
+/// Flow-graph fire data and synthesis: PathlineParams, PathlineRecorder, PathlineFile
+/// (bindFlowgraphPathlines, bind_flowgraph_pathlines.cpp), then Synthesizer, VelocityField,
+/// FireRasterParams, write_fire_vdb (bind_flowgraph_synth.cpp).
 void bindFlowgraphSynth(pybind11::module_& m);
+void bindFlowgraphPathlines(pybind11::module_& m);
 /// Flow graph: FlowGraphParams, cost_matrix, FlowGraph, RandomWalk, cost_matrix_image
 /// (bind_flowgraph_graph.cpp).
 void bindFlowgraphGraph(pybind11::module_& m);
@@ -44,19 +49,5 @@ void bindFlamesStructure(pybind11::module_& m);
 /// Structural flames, shape and render: FlameProfile, FlameCamera, FlameShaper, write_flames_vdb
 /// (bind_flames_shape.cpp).
 void bindFlamesShape(pybind11::module_& m);
-
-/// A path argument given as str or os.PathLike, as a std::string (needs the GIL).
-inline std::string pathArg(const pybind11::object& path) {
-  return pybind11::str(pybind11::module_::import("os").attr("fspath")(path)).cast<std::string>();
-}
-
-/// fn(path) with the GIL released (file reads and writes), for a path given as str or
-/// os.PathLike; returns what fn returns (a C++ value: no Python object is touched without the GIL).
-template <typename Fn>
-auto withPath(const pybind11::object& path, const Fn& fn) {
-  const std::string p = pathArg(path);
-  pybind11::gil_scoped_release release;
-  return fn(p);
-}
 
 }  // namespace plume::bindings

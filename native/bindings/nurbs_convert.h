@@ -1,8 +1,10 @@
 #pragma once
 /// \file nurbs_convert.h
-/// Conversions shared by the NURBS bindings (bind_nurbs.cpp, bind_nurbs_fit.cpp): NumPy arrays
-/// and the surface dict <-> the core's NurbsSurface, grids and vectors.
+/// Conversions shared by the NURBS bindings (bind_nurbs.cpp, bind_nurbs_fit.cpp): the surface
+/// dict <-> the core's NurbsSurface, control points, point grids and density grids (the
+/// conversions of every component are in convert.h).
 
+#include "bindings/convert.h"
 #include "core/grid3.h"
 #include "nurbs/evaluation.h"
 #include "nurbs/interpolation.h"
@@ -22,40 +24,9 @@
 namespace plume::bindings {
 namespace nurbs_convert {
 
-namespace py = pybind11;
-
-using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using FArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using FArrayF = py::array_t<float, py::array::f_style | py::array::forcecast>;
-
-inline std::string shapeOf(const py::array& a) {
-  std::ostringstream s;
-  s << "(";
-  for (py::ssize_t d = 0; d < a.ndim(); ++d) s << (d ? ", " : "") << a.shape(d);
-  s << (a.ndim() == 1 ? ",)" : ")");
-  return s.str();
-}
-
-template <typename T>
-inline py::array_t<T> array1(const std::vector<T>& v) {
-  py::array_t<T> a(py::ssize_t(v.size()));
-  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
-  return a;
-}
-
-/// (rows, 3) or (rows, 4) float32 copy of points.
-template <typename V>
-inline py::array_t<float> pointsArray(const std::vector<V>& pts, int components) {
-  py::array_t<float> a({py::ssize_t(pts.size()), py::ssize_t(components)});
-  float* d = a.mutable_data();
-  for (std::size_t n = 0; n < pts.size(); ++n)
-    for (int c = 0; c < components; ++c) d[n * components + c] = pts[n][c];
-  return a;
-}
-
 inline py::dict surfaceDict(const NurbsSurface& s) {
   py::dict d;
-  d["control_points"] = pointsArray(s.controlPoints, 4);
+  d["control_points"] = rowsArray(s.controlPoints);
   d["nu"] = s.nu;
   d["nv"] = s.nv;
   d["order_u"] = s.orderU;
@@ -65,18 +36,18 @@ inline py::dict surfaceDict(const NurbsSurface& s) {
   const SurfaceKnots k = surfaceKnots(s);
   const SurfaceDomain dom = surfaceDomain(s);
   const SurfaceParameters p = particleParameters(s);
-  d["knots_u"] = array1(k.u);
-  d["knots_v"] = array1(k.v);
+  d["knots_u"] = array1D(k.u);
+  d["knots_v"] = array1D(k.v);
   d["domain_u"] = py::make_tuple(dom.u.start, dom.u.end);
   d["domain_v"] = py::make_tuple(dom.v.start, dom.v.end);
-  d["params_u"] = array1(p.u);
-  d["params_v"] = array1(p.v);
+  d["params_u"] = array1D(p.u);
+  d["params_v"] = array1D(p.v);
   return d;
 }
 
 /// Control points given as (nu * nv, 3|4) or (nv, nu, 3|4); w = 1 when absent.
 inline std::vector<glm::vec4> controlPointsFrom(const py::handle& obj, int nu, int nv) {
-  const FArray a = FArray::ensure(obj);
+  const FloatArrayC a = FloatArrayC::ensure(obj);
   if (!a) throw py::value_error("control_points must be a float array");
   const py::ssize_t comps = a.ndim() >= 1 ? a.shape(a.ndim() - 1) : 0;
   const py::ssize_t count = comps > 0 ? a.size() / comps : 0;
@@ -84,7 +55,7 @@ inline std::vector<glm::vec4> controlPointsFrom(const py::handle& obj, int nu, i
       count != py::ssize_t(nu) * nv) {
     std::ostringstream s;
     s << "control_points must have shape (nu * nv, 4) or (nu * nv, 3) with nu * nv = "
-      << py::ssize_t(nu) * nv << ", got " << shapeOf(a);
+      << py::ssize_t(nu) * nv << ", got " << shapeText(a);
     throw py::value_error(s.str());
   }
   std::vector<glm::vec4> out(static_cast<std::size_t>(count));
@@ -111,9 +82,9 @@ inline NurbsSurface surfaceFrom(const py::dict& d) {
 }
 
 /// Points (nv, nu, 3): Q[v][u], u along a streakline, v across streaklines.
-inline std::vector<glm::vec3> gridPointsFrom(const DArray& a, int& nu, int& nv) {
+inline std::vector<glm::vec3> gridPointsFrom(const DoubleArrayC& a, int& nu, int& nv) {
   if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) < 1)
-    throw py::value_error("points must have shape (nv, nu, 3) with nv, nu >= 1, got " + shapeOf(a));
+    throw py::value_error("points must have shape (nv, nu, 3) with nv, nu >= 1, got " + shapeText(a));
   nv = int(a.shape(0));
   nu = int(a.shape(1));
   std::vector<glm::vec3> q(std::size_t(nu) * std::size_t(nv));
@@ -123,7 +94,7 @@ inline std::vector<glm::vec3> gridPointsFrom(const DArray& a, int& nu, int& nv) 
 }
 
 inline ScalarGrid gridFrom(const py::handle& obj) {
-  const FArrayF a = FArrayF::ensure(obj);
+  const FloatArrayF a = FloatArrayF::ensure(obj);
   if (!a || a.ndim() != 3 || a.shape(0) < 1 || a.shape(1) < 1 || a.shape(2) < 1)
     throw py::value_error("density must be a float array of shape (nx, ny, nz)");
   ScalarGrid g({int(a.shape(0)), int(a.shape(1)), int(a.shape(2))});
@@ -131,12 +102,6 @@ inline ScalarGrid gridFrom(const py::handle& obj) {
   for (std::size_t n = 0; n < g.count(); ++n)
     if (!std::isfinite(g[n])) throw py::value_error("density contains NaN or inf");
   return g;
-}
-
-inline glm::vec3 vec3From(const py::handle& o, const char* name) {
-  const DArray a = DArray::ensure(o);
-  if (!a || a.size() != 3) throw py::value_error(std::string(name) + " must be 3 numbers");
-  return {float(a.data()[0]), float(a.data()[1]), float(a.data()[2])};
 }
 
 }  // namespace nurbs_convert

@@ -34,6 +34,23 @@ void PointEmitter::validate() const {
                                 std::to_string(densityRate) + ")");
 }
 
+std::vector<PointEmitter> pointEmittersFrom(std::size_t count, const float* positions,
+                                            const float* radii, const float* densityRates,
+                                            const float* velocities, const float* temperatures) {
+  std::vector<PointEmitter> emitters(count);
+  for (std::size_t n = 0; n < count; ++n) {
+    PointEmitter& e = emitters[n];
+    for (int a = 0; a < 3; ++a) {
+      e.position[a] = positions[3 * n + std::size_t(a)];
+      e.velocity[a] = velocities[3 * n + std::size_t(a)];
+    }
+    e.radius = radii[n];
+    e.densityRate = densityRates[n];
+    e.temperature = temperatures[n];
+  }
+  return emitters;
+}
+
 void emitPoints(const std::vector<PointEmitter>& emitters, const GridFrame& grid,
                 float ambientTemperature, const FlagGrid* cellTypes, float dt,
                 ScalarGrid& density, ScalarGrid& temperature, MacGrid3& velocity) {

@@ -29,6 +29,12 @@ struct PointEmitter {
   void validate() const;
 };
 
+/// `count` emitters from parallel arrays (the layout NumPy hands over): positions and velocities
+/// as x, y, z triples, radii, density rates and temperatures one value each.
+std::vector<PointEmitter> pointEmittersFrom(std::size_t count, const float* positions,
+                                            const float* radii, const float* densityRates,
+                                            const float* velocities, const float* temperatures);
+
 /// Adds the emitters of one step of length dt: each puts densityRate · dt of mass into the
 /// fluid cells whose centres lie within R = max(radius, Δx) of its position, weighted by
 /// w = 1 − (d/R)² and normalized so that Σ ρ Δx³ grows by exactly densityRate · dt (the mass a

@@ -103,4 +103,10 @@ void validateToonGrid(const GridFrame& grid) {
   if (!finite(grid.origin)) throw std::invalid_argument("origin must be finite");
 }
 
+GridFrame toonGrid(glm::ivec3 resolution, glm::vec3 origin, float cellSize) {
+  const GridFrame grid{resolution, cellSize, origin, 1.f / 24.f};
+  validateToonGrid(grid);
+  return grid;
+}
+
 }  // namespace plume

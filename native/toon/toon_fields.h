@@ -39,4 +39,8 @@ struct ToonSources {
 /// a finite origin.
 void validateToonGrid(const GridFrame& grid);
 
+/// The grid of a toon build on a bake of `resolution` cells of `cellSize` metres from `origin`
+/// (the frame time is unused: 1/24 s), checked by validateToonGrid().
+GridFrame toonGrid(glm::ivec3 resolution, glm::vec3 origin, float cellSize);
+
 }  // namespace plume

@@ -1,0 +1,231 @@
+/// \file convert.cpp
+/// The shared conversions of convert.h that are more than a few lines: vectors, grids, meshes
+/// and streak snapshot dicts between NumPy and the core.
+
+#include "bindings/convert.h"
+
+#include <sstream>
+
+namespace plume::bindings {
+
+std::string shapeText(const py::array& a) {
+  std::ostringstream s;
+  s << "(";
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) s << (d ? ", " : "") << a.shape(d);
+  s << (a.ndim() == 1 ? ",)" : ")");
+  return s.str();
+}
+
+// --- small vectors ------------------------------------------------------------------------
+
+glm::dvec3 dvec3Arg(const py::handle& o, const char* name, const char* wording) {
+  const DoubleArrayC a = DoubleArrayC::ensure(o);
+  if (!a || a.size() != 3) {
+    PyErr_Clear();
+    throw py::value_error(std::string(name) + " " + wording);
+  }
+  return {a.data()[0], a.data()[1], a.data()[2]};
+}
+
+glm::ivec3 ivec3Arg(const py::handle& o, const char* name, long long lo, long long hi, const char* range) {
+  if (!py::isinstance<py::sequence>(o) || py::len(o) != 3)
+    throw py::value_error(std::string(name) + " must be a sequence of 3 integers");
+  const py::sequence s = py::reinterpret_borrow<py::sequence>(o);
+  glm::ivec3 r;
+  for (int a = 0; a < 3; ++a) {
+    const long long v = s[std::size_t(a)].cast<long long>();
+    if (v < lo || v > hi) throw py::value_error(std::string(name) + " must be " + range);
+    r[a] = int(v);
+  }
+  return r;
+}
+
+// --- grids ----------------------------------------------------------------------------------
+
+py::tuple macArrays(const MacGrid3& v) {
+  return py::make_tuple(gridArray(v.u()), gridArray(v.v()), gridArray(v.w()));
+}
+
+void checkGridShape(const py::array& a, glm::ivec3 n, const std::string& name) {
+  if (a.ndim() != 3 || a.shape(0) != n.x || a.shape(1) != n.y || a.shape(2) != n.z) {
+    std::ostringstream s;
+    s << name << " must have shape (" << n.x << ", " << n.y << ", " << n.z << "), got "
+      << shapeText(a);
+    throw py::value_error(s.str());
+  }
+}
+
+void copyGrid(const FloatArrayF& a, glm::ivec3 n, ScalarGrid& g, const std::string& name) {
+  checkGridShape(a, n, name);
+  g.resize(n);
+  std::memcpy(g.data(), a.data(), g.count() * sizeof(float));
+}
+
+VectorGrid vectorGridOf(const FloatArrayF& a) {
+  VectorGrid g(glm::ivec3(int(a.shape(0)), int(a.shape(1)), int(a.shape(2))));
+  const auto r = a.unchecked<4>();
+  for (py::ssize_t k = 0; k < a.shape(2); ++k)
+    for (py::ssize_t j = 0; j < a.shape(1); ++j)
+      for (py::ssize_t i = 0; i < a.shape(0); ++i)
+        g(int(i), int(j), int(k)) = {r(i, j, k, 0), r(i, j, k, 1), r(i, j, k, 2)};
+  return g;
+}
+
+void copyMac(const py::handle& uvw, glm::ivec3 cells, MacGrid3& mac, const char* name) {
+  if (!py::isinstance<py::sequence>(uvw) || py::len(uvw) != 3)
+    throw py::value_error(std::string(name) + " must be a tuple (u, v, w)");
+  const py::sequence s = py::reinterpret_borrow<py::sequence>(uvw);
+  mac.resize(cells);
+  static const char* kComponent[3] = {"u", "v", "w"};
+  for (int a = 0; a < 3; ++a) {
+    glm::ivec3 size = cells;
+    size[a] += 1;
+    const std::string what = std::string(name) + " " + kComponent[a];
+    copyGrid(ensureArray<FloatArrayF>(s[std::size_t(a)], what), size, mac.component(a), what);
+  }
+}
+
+// --- points, integers, matrices, meshes -------------------------------------------------------
+
+std::vector<glm::vec3> pointsArg(const FloatArrayC& a, const char* name) {
+  if (a.size() == 0) return {};
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw py::value_error(std::string(name) + " must have shape (N, 3), got " + shapeText(a));
+  std::vector<glm::vec3> p(std::size_t(a.shape(0)));
+  std::memcpy(p.data(), a.data(), p.size() * sizeof(glm::vec3));
+  return p;
+}
+
+std::vector<int> intsArg(const Int64ArrayC& a, const char* name) {
+  if (a.size() == 0) return {};
+  if (a.ndim() != 1)
+    throw py::value_error(std::string(name) + " must be one-dimensional, got " + shapeText(a));
+  std::vector<int> v(std::size_t(a.shape(0)));
+  for (std::size_t n = 0; n < v.size(); ++n) {
+    const long long x = a.data()[n];
+    if (x < -2147483648LL || x > 2147483647LL)
+      throw py::value_error(std::string(name) + " holds " + std::to_string(x) + ", outside int32");
+    v[n] = int(x);
+  }
+  return v;
+}
+
+std::vector<int> toIntVector(const py::object& values, const std::string& name) {
+  return intsArg(ensureArray<Int64ArrayC>(values, name), name.c_str());
+}
+
+glm::mat4 matrixArg(const DoubleArrayC& a, const char* name) {
+  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4)
+    throw py::value_error(std::string(name) + " must be a 4x4 matrix, got shape " + shapeText(a));
+  glm::mat4 m;
+  // numpy.array(obj.matrix_world) is row-major (world = M @ [x, y, z, 1]); glm is column-major.
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) m[col][row] = float(a.data()[row * 4 + col]);
+  return m;
+}
+
+EmitterMesh emitterMeshArg(const FloatArrayC& vertices, const Int64ArrayC& triangles,
+                           const DoubleArrayC& matrix, const DoubleArrayC& matrixNext,
+                           const std::string& name) {
+  EmitterMesh mesh;
+  mesh.name = name;
+  if (vertices.size() != 0 && (vertices.ndim() != 2 || vertices.shape(1) != 3))
+    throw py::value_error("vertices of '" + name + "' must have shape (N, 3), got " +
+                          shapeText(vertices));
+  if (triangles.size() != 0 && (triangles.ndim() != 2 || triangles.shape(1) != 3))
+    throw py::value_error("triangles of '" + name + "' must have shape (M, 3), got " +
+                          shapeText(triangles));
+  mesh.vertices = pointsArg(vertices, "vertices");
+  const std::size_t nv = mesh.vertices.size();
+  const std::size_t nt = triangles.size() == 0 ? 0 : std::size_t(triangles.shape(0));
+  mesh.triangles.resize(nt);
+  const long long* t = triangles.data();
+  for (std::size_t n = 0; n < nt * 3; ++n) {
+    if (t[n] < 0 || t[n] >= (long long)nv)
+      throw py::value_error("triangles of '" + name + "' index vertex " + std::to_string(t[n]) +
+                            ", outside [0, " + std::to_string(nv) + ")");
+    mesh.triangles[n / 3][int(n % 3)] = int(t[n]);
+  }
+  mesh.matrix = matrixArg(matrix, "matrix");
+  mesh.matrixNext = matrixArg(matrixNext, "matrix_next");
+  return mesh;
+}
+
+// --- streak snapshots -----------------------------------------------------------------------
+
+StreakFrame streakFrameArg(const py::handle& obj, bool needDensity, const std::string& what,
+                           bool positionsOnly) {
+  if (!py::isinstance<py::dict>(obj))
+    throw py::value_error(what + " must be a dict with counts, positions, density");
+  const py::dict d = py::reinterpret_borrow<py::dict>(obj);
+  auto get = [&](const char* key, bool required) -> py::object {
+    if (d.contains(key)) return d[key];
+    if (required) throw py::value_error(what + " has no '" + key + "'");
+    return py::none();
+  };
+  StreakFrame f;
+  f.counts = intsArg(ensureArray<Int64ArrayC>(get("counts", true), what + ": counts"), "counts");
+  f.positions =
+      pointsArg(ensureArray<FloatArrayC>(get("positions", true), what + ": positions"), "positions");
+  const std::size_t m = f.positions.size();
+  const py::object groups = get("groups", false);
+  const auto groupsOf = [&] {
+    return groups.is_none() ? std::vector<int>(f.counts.size(), 0)
+                            : intsArg(ensureArray<Int64ArrayC>(groups, what + ": groups"), "groups");
+  };
+  if (positionsOnly) {
+    f.groups = groupsOf();
+    std::size_t total = 0;
+    for (int c : f.counts) {
+      if (c < 0) throw py::value_error(what + ": counts hold " + std::to_string(c) + " (negative)");
+      total += std::size_t(c);
+    }
+    if (f.groups.size() != f.counts.size())
+      throw py::value_error(what + ": " + std::to_string(f.groups.size()) + " groups for " +
+                            std::to_string(f.counts.size()) + " sources");
+    if (m != total)
+      throw py::value_error(what + ": counts sum to " + std::to_string(total) +
+                            " particles but there are " + std::to_string(m) + " positions");
+    return f;
+  }
+  const py::object density = get("density", needDensity);
+  if (density.is_none()) {
+    f.density.assign(m, 0.f);
+  } else {
+    const FloatArrayC a = ensureArray<FloatArrayC>(density, what + ": density");
+    if (a.ndim() != 1) throw py::value_error(what + ": density must be one-dimensional");
+    f.density.assign(a.data(), a.data() + a.size());
+  }
+  f.groups = groupsOf();
+  const py::object outside = get("outside", false);
+  if (outside.is_none()) {
+    f.outside.assign(m, 0);
+  } else {
+    const UInt8ArrayC a = ensureArray<UInt8ArrayC>(outside, what + ": outside");
+    if (a.ndim() != 1) throw py::value_error(what + ": outside must be one-dimensional");
+    f.outside.assign(a.data(), a.data() + a.size());
+    for (std::uint8_t& o : f.outside) o = o ? 1 : 0;
+  }
+  f.validate();  // std::invalid_argument -> ValueError
+  return f;
+}
+
+std::vector<StreakFrame> toStreakFrames(const py::sequence& snapshots, bool positionsOnly) {
+  std::vector<StreakFrame> out;
+  out.reserve(std::size_t(py::len(snapshots)));
+  for (std::size_t t = 0; t < std::size_t(py::len(snapshots)); ++t)
+    out.push_back(streakFrameArg(snapshots[t], false, "snapshot " + std::to_string(t), positionsOnly));
+  return out;
+}
+
+py::dict streakFrameDict(const StreakFrame& f) {
+  py::dict d;
+  d["counts"] = array1DAs<std::int32_t>(f.counts);
+  d["positions"] = rowsArray(f.positions);
+  d["density"] = array1DAs<float>(f.density);
+  d["groups"] = array1DAs<std::int32_t>(f.groups);
+  d["outside"] = array1DAs<bool>(f.outside);
+  return d;
+}
+
+}  // namespace plume::bindings
