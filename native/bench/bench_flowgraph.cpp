@@ -11,10 +11,10 @@
 // Run: build/native/plume_bench_flowgraph
 #include "core/parallel.h"
 #include "core/rng.h"
-#include "flowgraph/fire_raster.h"
+#include "fields/fire_raster.h"
 #include "flowgraph/pathline_recorder.h"
 #include "flowgraph/synthesizer.h"
-#include "io/pathline_file.h"
+#include "flowgraph/pathline_file.h"
 #include "tests/flowgraph_fire.h"
 
 #include <benchmark/benchmark.h>

@@ -7,7 +7,7 @@
 #include "bindings/convert.h"
 
 #include "flowgraph/pathline_recorder.h"
-#include "io/pathline_file.h"
+#include "flowgraph/pathline_file.h"
 
 #include <pybind11/stl.h>
 

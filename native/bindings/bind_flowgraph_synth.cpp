@@ -7,10 +7,10 @@
 #include "bindings/bindings.h"
 #include "bindings/convert.h"
 
-#include "flowgraph/fire_raster.h"
+#include "fields/fire_raster.h"
 #include "flowgraph/synthesizer.h"
-#include "flowgraph/velocity_field.h"
-#include "io/pathline_file.h"
+#include "fields/velocity_field.h"
+#include "flowgraph/pathline_file.h"
 
 #include <pybind11/stl.h>
 

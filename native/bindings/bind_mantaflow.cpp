@@ -8,7 +8,7 @@
 #include "bindings/convert.h"
 
 #include "io/mantaflow_cache.h"
-#include "io/streak_file.h"
+#include "tracers/streak_file.h"
 #include "tracers/mantaflow_driver.h"
 
 #include <pybind11/stl.h>

@@ -6,7 +6,7 @@
 #include "bindings/bindings.h"
 #include "bindings/convert.h"
 
-#include "io/state_file.h"
+#include "solver/state_file.h"
 #include "io/vdb_frame.h"
 #include "solver/emitters.h"
 #include "solver/point_emitters.h"

@@ -6,8 +6,8 @@
 #include "bindings/bindings.h"
 #include "bindings/convert.h"
 
-#include "io/streak_file.h"
-#include "io/tracer_state_file.h"
+#include "tracers/streak_file.h"
+#include "tracers/tracer_state_file.h"
 #include "solver/emitters.h"
 #include "solver/smoke_solver.h"
 #include "tracers/point_sources.h"

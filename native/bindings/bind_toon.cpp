@@ -7,7 +7,7 @@
 #include "bindings/bindings.h"
 #include "bindings/convert.h"
 
-#include "io/toon_volume.h"
+#include "toon/toon_volume.h"
 #include "toon/toon_fields.h"
 #include "toon/toon_params.h"
 

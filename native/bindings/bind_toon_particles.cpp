@@ -7,8 +7,8 @@
 #include "bindings/bindings.h"
 #include "bindings/convert.h"
 
-#include "io/toon_file.h"
-#include "io/toon_volume.h"
+#include "toon/toon_file.h"
+#include "toon/toon_volume.h"
 #include "toon/billboard.h"
 #include "toon/depth_differences.h"
 #include "toon/toon_particles.h"

@@ -4,7 +4,7 @@
 #include "flames/flame_raster.h"
 
 #include "core/parallel.h"
-#include "flowgraph/fire_raster.h"
+#include "fields/fire_raster.h"
 #include "io/vdb_grids.h"
 
 #include <openvdb/points/PointAttribute.h>

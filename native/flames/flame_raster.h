@@ -2,7 +2,7 @@
 /// \file flame_raster.h
 /// Flame particles into the VDB grids of a frame (structural_flames.txt §5.3: "ideally, the
 /// deformed flames should be volume rendered directly"), for Blender's Principled Volume:
-///   density      Σ mass_i w_i(v) / Δx³: the particles' splatted mass (flowgraph/fire_raster's
+///   density      Σ mass_i w_i(v) / Δx³: the particles' splatted mass (fields/fire_raster's
 ///                conserving hat kernel), so the grid approximates eq. 4's d(x) in world space
 ///                whatever the particle count
 ///   temperature  T_scale · (mean d_i/I of the particles around the voxel): Kelvin for
@@ -11,7 +11,7 @@
 ///   flame        temperature / T_scale, clamped to [0, 1]: emission strength
 ///   color        mean base colour (§5.1), vec3 (Principled Volume's Color attribute)
 ///   velocity     mean particle velocity, vec3, for motion blur (§5.3)
-/// density/temperature/flame come from rasterizeFire() (flowgraph/fire_raster.h), color and
+/// density/temperature/flame come from rasterizeFire() (fields/fire_raster.h), color and
 /// velocity from OpenVDB's points::rasterizeTrilinear on the same voxels (cell-centred,
 /// voxel (i,j,k) centred at origin + (i + ½, j + ½, k + ½) Δx).
 

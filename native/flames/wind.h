@@ -8,7 +8,7 @@
 
 #include "core/grid3.h"
 #include "core/mac_grid3.h"
-#include "flowgraph/velocity_field.h"
+#include "fields/velocity_field.h"
 
 #include <glm/glm.hpp>
 

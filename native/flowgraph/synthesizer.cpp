@@ -1,7 +1,7 @@
 #include "flowgraph/synthesizer.h"
 
 #include "core/parallel.h"
-#include "io/pathline_file.h"
+#include "flowgraph/pathline_file.h"
 
 #include <algorithm>
 #include <cmath>

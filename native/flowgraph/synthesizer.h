@@ -26,6 +26,7 @@
 /// are formed (pathline part + external part) by gather(). Parallel over particles with fixed
 /// chunks, so results do not depend on the thread count, nor on the cache.
 
+#include "fields/velocity_field.h"
 #include "flowgraph/pathline_group.h"
 #include "flowgraph/prepared_group.h"
 #include "flowgraph/prepared_group_cache.h"
@@ -40,16 +41,6 @@
 namespace plume {
 
 class PathlineFile;
-
-/// An external velocity field u_ext(x, t) (§5.2: "velocity introduced by (optional) external
-/// forces, useful for fire deformation"), evaluated in batches.
-class ExternalVelocity {
- public:
-  virtual ~ExternalVelocity() = default;
-  /// u_ext (m/s) at the n world positions x, at synthesis time t (s), into out. Called from
-  /// several threads at once, on disjoint ranges.
-  virtual void evaluate(const glm::vec3* x, int n, double t, glm::vec3* out) const = 0;
-};
 
 /// Live particles as gathered: world positions, density and temperature from the samples of
 /// their age (oldest group first, particle order within a group).

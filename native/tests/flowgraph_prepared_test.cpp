@@ -7,7 +7,7 @@
 #include "flowgraph/prepared_group.h"
 #include "flowgraph/prepared_group_cache.h"
 #include "flowgraph/synthesizer.h"
-#include "io/pathline_file.h"
+#include "flowgraph/pathline_file.h"
 #include "tests/flowgraph_groups.h"
 
 #include <gtest/gtest.h>

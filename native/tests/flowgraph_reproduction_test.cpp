@@ -22,7 +22,7 @@
 
 #include "flowgraph/pathline_recorder.h"
 #include "flowgraph/synthesizer.h"
-#include "io/pathline_file.h"
+#include "flowgraph/pathline_file.h"
 #include "tests/flowgraph_fire.h"
 
 #include <gtest/gtest.h>

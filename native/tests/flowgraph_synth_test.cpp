@@ -5,12 +5,12 @@
 
 #include "core/parallel.h"
 #include "core/rng.h"
-#include "flowgraph/fire_raster.h"
+#include "fields/fire_raster.h"
 #include "flowgraph/pathline_integrator.h"
 #include "flowgraph/pathline_recorder.h"
 #include "flowgraph/synthesizer.h"
-#include "flowgraph/velocity_field.h"
-#include "io/pathline_file.h"
+#include "fields/velocity_field.h"
+#include "flowgraph/pathline_file.h"
 #include "io/vdb_frame.h"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 /// \file io_test.cpp
 /// Per-frame VDB files and solver checkpoints: round trips, atomic writes, corrupt files.
 
-#include "io/state_file.h"
+#include "solver/state_file.h"
 #include "io/vdb_frame.h"
 
 #include <gtest/gtest.h>

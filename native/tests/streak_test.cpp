@@ -6,7 +6,7 @@
 
 #include "core/parallel.h"
 #include "core/rng.h"
-#include "io/streak_file.h"
+#include "tracers/streak_file.h"
 #include "streak/brute_force.h"
 #include "streak/clustering.h"
 #include "streak/streak_moments.h"

@@ -4,7 +4,7 @@
 /// frames that drive the particles.
 
 #include "io/mantaflow_cache.h"
-#include "io/toon_volume.h"
+#include "toon/toon_volume.h"
 #include "toon/billboard.h"
 #include "toon/depth_differences.h"
 

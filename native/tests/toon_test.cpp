@@ -2,7 +2,7 @@
 /// Toon particles (cartoon_smoke.txt §2.1-2.3): bounded size changes, shrink before death, birth
 /// in empty dense cells, the particle budget, determinism, parameter checks and the toon file.
 
-#include "io/toon_file.h"
+#include "toon/toon_file.h"
 #include "tests/toon_plume.h"
 #include "toon/toon_particles.h"
 

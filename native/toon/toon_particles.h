@@ -37,7 +37,7 @@
 namespace plume {
 
 /// Every particle of a toon frame (structure of arrays, one entry per particle, ids ascending)
-/// and the counters that make the next frame deterministic. A toon file (io/toon_file.h) holds
+/// and the counters that make the next frame deterministic. A toon file (toon/toon_file.h) holds
 /// one, so a build can resume from any written frame.
 struct ToonParticleState {
   std::vector<std::uint64_t> ids;

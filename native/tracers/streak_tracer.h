@@ -64,7 +64,7 @@ struct PointSource {
 /// particles, emission-major (particle e of source s at e * sources.size() + s), with the density
 /// sampled at each, the outside flag and exit velocity of particles that left through an open
 /// side, the particle rows emitted, the steps seen and the pause switch (Figure 10). A checkpoint
-/// (io/tracer_state_file.h) saves it so that a traced bake resumes bit for bit.
+/// (tracers/tracer_state_file.h) saves it so that a traced bake resumes bit for bit.
 struct StreakTracerState {
   std::vector<PointSource> sources;
   std::vector<glm::vec3> positions;
@@ -102,7 +102,7 @@ class StreakTracer {
   /// Sides (-x, +x, -y, +y, -z, +z) through which particles leave.
   const std::array<Boundary, 6>& boundaries() const { return mBoundaries; }
 
-  /// Sources, particles and counters, for checkpoints (io/tracer_state_file.h).
+  /// Sources, particles and counters, for checkpoints (tracers/tracer_state_file.h).
   const StreakTracerState& state() const { return mState; }
   /// Replaces sources, particles and counters with a saved state. Throws std::invalid_argument
   /// (StreakTracerState::validate, or a source outside the domain), leaving the tracer unchanged.

@@ -1,7 +1,7 @@
 /// \file pathline_file.cpp
 /// Pathline files (graph_fire_synthesis.txt §4.2): incremental writer and lazy reader.
 
-#include "io/pathline_file.h"
+#include "flowgraph/pathline_file.h"
 
 #include "io/byte_buffer.h"
 

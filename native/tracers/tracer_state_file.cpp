@@ -12,7 +12,7 @@
 /// then are the arrays allocated and parsed, and the tracer is touched only once all is read.
 /// Version 1 files (written before emission could pause) are read as never paused.
 
-#include "io/tracer_state_file.h"
+#include "tracers/tracer_state_file.h"
 
 #include "io/byte_buffer.h"
 

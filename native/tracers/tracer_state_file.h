@@ -4,7 +4,7 @@
 /// binary file holding a StreakTracer's settings and its whole StreakTracerState (point sources,
 /// particles, density, outside flags, exit velocities, emission count, steps, the pause switch of
 /// Figure 10 and the step of the youngest emission), written next to the
-/// solver's state file (io/state_file.h) for the same frame. Sizes are checked on read.
+/// solver's state file (solver/state_file.h) for the same frame. Sizes are checked on read.
 
 #include "tracers/streak_tracer.h"
 

@@ -8,7 +8,7 @@
 /// the checksum, and only then allocates and parses the arrays, which must then pass
 /// ToonParticleState::validate.
 
-#include "io/toon_file.h"
+#include "toon/toon_file.h"
 
 #include "io/byte_buffer.h"
 

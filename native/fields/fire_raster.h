@@ -1,8 +1,10 @@
 #pragma once
 /// \file fire_raster.h
-/// Synthesized fire particles into VDB grids `density`, `temperature` and `flame`
+/// Particles into VDB grids `density`, `temperature` and `flame`, shared by the two fire
+/// pipelines: flow-graph fire rasterizes its synthesized particles with it
 /// (graph_fire_synthesis.txt §5.3; DESIGN.md: "rasterization of particles into VDB grids with
-/// OpenVDB's point tools"), on the bake's voxels, written as a frame VDB (io/vdb_grids.h).
+/// OpenVDB's point tools"), structural flames its scalar grids (flames/flame_raster.cpp). On the
+/// bake's voxels, written as a frame VDB (io/vdb_grids.h).
 ///
 /// The particles become an OpenVDB PointDataGrid (attributes `density`, `temperature`) and are
 /// rasterized with OpenVDB's point transfer framework (openvdb/points/PointTransfer.h,

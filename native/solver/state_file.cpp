@@ -6,7 +6,7 @@
 /// Reading checks the header against the solver, then the exact file size, then the checksum,
 /// before any grid is parsed; the solver is only touched once everything has been read.
 
-#include "io/state_file.h"
+#include "solver/state_file.h"
 
 #include "core/parallel.h"
 #include "io/byte_buffer.h"

@@ -1,4 +1,8 @@
-#include "flowgraph/fire_raster.h"
+/// \file fire_raster.cpp
+/// Particle rasterization shared by flow-graph fire and structural flames (see fire_raster.h):
+/// OpenVDB point transfer into density, temperature and flame grids, and their frame VDB.
+
+#include "fields/fire_raster.h"
 
 #include "core/parallel.h"
 #include "io/vdb_grids.h"

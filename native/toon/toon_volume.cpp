@@ -1,7 +1,7 @@
 /// \file toon_volume.cpp
 /// Plume volume frames to toon fields: dense boxes from io/vdb_frame placed on the bake's grid.
 
-#include "io/toon_volume.h"
+#include "toon/toon_volume.h"
 
 #include "core/parallel.h"
 #include "io/mac_faces.h"

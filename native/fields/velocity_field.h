@@ -1,15 +1,26 @@
 #pragma once
 /// \file velocity_field.h
-/// An external velocity u_ext(x) for synthesis (graph_fire_synthesis.txt §5.2, eq. 13: "velocity
-/// introduced by (optional) external forces, useful for fire deformation") given on a grid: the
-/// add-on evaluates Blender's Wind and Turbulence force fields at cell centres once per frame.
+/// External velocity fields shared by flow-graph fire and structural flames: the interface
+/// u_ext(x, t) the synthesizer moves particles with (graph_fire_synthesis.txt §5.2, eq. 13:
+/// "velocity introduced by (optional) external forces, useful for fire deformation"), and its
+/// grid form, which flames' GridWind (flames/wind.h) reads too. The add-on evaluates Blender's
+/// Wind and Turbulence force fields at cell centres once per frame.
 
 #include "core/grid3.h"
-#include "flowgraph/synthesizer.h"
 
 #include <glm/glm.hpp>
 
 namespace plume {
+
+/// An external velocity field u_ext(x, t) (§5.2: "velocity introduced by (optional) external
+/// forces, useful for fire deformation"), evaluated in batches.
+class ExternalVelocity {
+ public:
+  virtual ~ExternalVelocity() = default;
+  /// u_ext (m/s) at the n world positions x, at synthesis time t (s), into out. Called from
+  /// several threads at once, on disjoint ranges.
+  virtual void evaluate(const glm::vec3* x, int n, double t, glm::vec3* out) const = 0;
+};
 
 /// u_ext on a cell-centred grid: value (i,j,k) at origin + (i + 1/2, j + 1/2, k + 1/2) Δx, read
 /// trilinearly; positions outside take the nearest values (clamped). Constant in time between

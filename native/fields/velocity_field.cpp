@@ -1,4 +1,8 @@
-#include "flowgraph/velocity_field.h"
+/// \file velocity_field.cpp
+/// The grid form of an external velocity field, shared by flow-graph synthesis and flames'
+/// GridWind (see velocity_field.h): trilinear reads with clamping.
+
+#include "fields/velocity_field.h"
 
 #include "core/sample_points.h"
 

@@ -6,7 +6,7 @@
 /// with M = Σ counts. Reading checks the header, then that the counts fit in the file, then the
 /// exact size, then the checksum, and only then allocates and parses the arrays.
 
-#include "io/streak_file.h"
+#include "tracers/streak_file.h"
 
 #include "io/byte_buffer.h"
 
