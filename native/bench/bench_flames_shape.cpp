@@ -1,6 +1,6 @@
 // Benchmark of the shape stage of structural flames (structural_flames.txt §4.4–4.5, §5):
 // sampling, flow noise, spine mapping, Kolmogorov noise, merging, incandescence for one frame of
-// the torch (5 flames × 9,000 particles; issue budget ≤ 10 ms per frame including structure; the
+// the torch (5 flames × 9,000 particles; budget ≤ 10 ms per frame including structure; the
 // paper: 2.7 s) and of the dragon breath (80 flames, 1.5 M particles, merging off as in the
 // paper; budget ≤ 0.5 s; the paper: 34 s). Rasterization into VDB grids is timed separately.
 // Time: wall (real_time), CPU of the calling thread (Time's CPU column) and of the whole process

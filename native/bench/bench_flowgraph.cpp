@@ -1,5 +1,5 @@
 // Benchmark of flow-graph fire synthesis (graph_fire_synthesis.txt §5.2, Table 1):
-// - synthesis per step at 3,200 pathlines per node with L = 48 (issue: <= 1 ms; the paper's
+// - synthesis per step at 3,200 pathlines per node with L = 48 (budget: <= 1 ms; the paper's
 //   campfire, 3,217 pathlines per node: 35 ms), with a uniform and with a field u_ext (the
 //   emitted group prepared at every step), and the gather of all live particles (positions,
 //   density, temperature) a frame's output needs, and the read of one node from a pathline file
@@ -196,7 +196,7 @@ class TimedRecorder final : public StepObserver {
 };
 
 void BM_RecorderPerSolverStep64(benchmark::State& state) {
-  // 64³ fire with a burner of 20 x 10 x 2 cells: 400 cells, the issue's 3,200 seeds.
+  // 64³ fire with a burner of 20 x 10 x 2 cells: 400 cells, the 3,200 seeds of the synthesis budget.
   const int n = 64;
   const SmokeParams params = testing::fireParams(n, int(state.range(0)));
   SmokeSolver solver(params);

@@ -1,6 +1,7 @@
 /// \file pressure.cpp
 /// MGPCG (McAdams, Sifakis & Teran 2010): conjugate gradients on the 7-point pressure operator,
-/// preconditioned by one symmetric multigrid V-cycle on a cell-centred hierarchy.
+/// preconditioned by one symmetric multigrid V-cycle on a cell-centred hierarchy. The cycle's
+/// smoothing and transfer operators are in multigrid_cycle.cpp.
 ///
 /// Storage: every vector of the hierarchy is padded by one ghost cell on each side. Ghost cells
 /// and solid cells hold 0 in every vector at all times and have diag = 0, so the inner loops need
@@ -28,11 +29,15 @@ namespace {
 
 using detail::BandSolver;
 using detail::Level;
+using detail::forRows;
+using detail::keepIf;
+using detail::kOmega;
+using detail::prolongAdd;
+using detail::restrictResidual;
+using detail::smooth;
+using detail::smoothFromZero;
+using detail::smoothRow;
 
-/// Jacobi damping ω. The smoother S = ω D⁻¹ is convergent in the A-norm (which makes the V-cycle
-/// SPD) iff 2 D/ω - A is SPD; Gershgorin gives λ_max(D⁻¹A) <= 2, so any ω < 1 is safe. 6/7, the
-/// optimal smoothing factor of the 3-D 7-point Laplacian, also measured best (vs 2/3 .. 0.9).
-constexpr float kOmega = 6.f / 7.f;
 // Pre- and post-smoothing sweeps are 2 each (equal counts keep the V-cycle symmetric): V(2,2)
 // needed the least time per solve (V(1,1): 1.6x the iterations; V(3,3): about even).
 constexpr int kMaxLevels = 16;
@@ -47,22 +52,9 @@ constexpr int kMaxRestarts = 2;
 /// error), so the true relative residual cannot go much below that times |p|/|b|.
 constexpr double kRoundOffFloor = 3e-7;
 
-/// Restriction weight. Level l's operator is the rediscretized stencil, i.e. H_l²·(-∇²) with
-/// H_l = 2^l Δx (our fine operator is Δx²·(-∇²)). For a smooth error e with -∇²e = f the fine
-/// residual is r_h ≈ h² f per cell, while the coarse equation A_H e_H = H² f = 4 h² f needs
-/// 4 × (average of the 8 children) = ½ × (sum of the children). With piecewise constant
-/// prolongation P this restriction is R = ½ Pᵀ, which keeps the V-cycle symmetric.
-constexpr float kRestrict = 0.5f;
-
-template <typename RowFn>
-void forRows(glm::ivec3 n, const RowFn& fn) {
-  parallelFor(0, n.z, [&](int k) {
-    for (int j = 0; j < n.y; ++j) fn(j, k);
-  });
-}
-
 /// Σ a_i b_i (b = nullptr: Σ a_i): float products summed in double in four fixed lanes i mod 4
-/// (deterministic; vectorized). The row kernels below are PLUME_AVX2_CLONES: the solve is
+/// (deterministic; vectorized). The row kernels below (and those of multigrid_cycle.cpp) are
+/// PLUME_AVX2_CLONES: the solve is
 /// bound by these loops, AVX2 runs them about 20% faster, with the same values.
 PLUME_AVX2_CLONES double dotRow(const float* a, const float* b, int n) {
   double s[4] = {0, 0, 0, 0};
@@ -75,104 +67,6 @@ PLUME_AVX2_CLONES double dotRow(const float* a, const float* b, int n) {
       for (int l = 0; l < 4; ++l) s[l] += a[i + l];
   for (; i < n; ++i) s[0] += double(a[i]) * (b ? b[i] : 1.f);
   return (s[0] + s[1]) + (s[2] + s[3]);
-}
-
-/// v where `mask` (diag or wInv: 0 exactly on solid cells) is nonzero, else 0. Bitwise, since
-/// GCC does not if-convert float compares (they may trap), which would keep loops scalar.
-inline float keepIf(float mask, float v) {
-  std::uint32_t vb, mb;
-  std::memcpy(&vb, &v, 4);
-  std::memcpy(&mb, &mask, 4);
-  vb &= 0u - std::uint32_t(mb != 0);
-  std::memcpy(&v, &vb, 4);
-  return v;
-}
-
-/// Sum of the 6 neighbours of every cell in a padded row.
-#define PLUME_NEIGHBOURS(v, i) (v[i - 1] + v[i + 1] + v[i - sy] + v[i + sy] + v[i - sz] + v[i + sz])
-
-/// smoothFromZero() on the row at padded offset o.
-PLUME_AVX2_CLONES void smoothFromZeroRow(Level& L, std::size_t o) {
-  const std::ptrdiff_t sy = L.sy, sz = L.sz;
-  const int nx = L.n.x;
-  const float* __restrict b = L.b.data() + o;
-  const float* __restrict w = L.wInv.data() + o;
-  float* __restrict y = L.x.data() + o;
-  for (int i = 0; i < nx; ++i) {
-    const float s = w[i - 1] * b[i - 1] + w[i + 1] * b[i + 1] + w[i - sy] * b[i - sy] +
-                    w[i + sy] * b[i + sy] + w[i - sz] * b[i - sz] + w[i + sz] * b[i + sz];
-    y[i] = w[i] * ((2.f - kOmega) * b[i] + s);
-  }
-}
-
-/// The first two Jacobi sweeps from x = 0, fused: x1 = W b, x2 = (1-ω) x1 + W (b + N x1)
-/// = W ((2-ω) b + N (W b)), where N sums the neighbours.
-void smoothFromZero(Level& L) {
-  forRows(L.n, [&](int j, int k) { smoothFromZeroRow(L, L.at(0, j, k)); });
-}
-
-/// One damped Jacobi sweep on a row, y = x + W (b - A x) = (1-ω) x + W (b + N x).
-PLUME_AVX2_CLONES void smoothRow(const Level& L, const float* __restrict x, float* __restrict y, std::size_t o) {
-  const std::ptrdiff_t sy = L.sy, sz = L.sz;
-  const float* __restrict b = L.b.data() + o;
-  const float* __restrict w = L.wInv.data() + o;
-  x += o;
-  y += o;
-  const int nx = L.n.x;
-  for (int i = 0; i < nx; ++i)
-    y[i] = (1.f - kOmega) * x[i] + w[i] * (b[i] + PLUME_NEIGHBOURS(x, i));
-}
-
-void smooth(Level& L) {
-  forRows(L.n, [&](int j, int k) { smoothRow(L, L.x.data(), L.t.data(), L.at(0, j, k)); });
-  std::swap(L.x, L.t);
-}
-
-/// s = b - A x on one row (0 on solid cells).
-PLUME_AVX2_CLONES void residualRow(const Level& L, std::size_t o, float* __restrict s) {
-  const std::ptrdiff_t sy = L.sy, sz = L.sz;
-  const float* __restrict x = L.x.data() + o;
-  const float* __restrict b = L.b.data() + o;
-  const float* __restrict d = L.diag.data() + o;
-  const int nx = L.n.x;
-  for (int i = 0; i < nx; ++i) s[i] = keepIf(d[i], b[i] - d[i] * x[i] + PLUME_NEIGHBOURS(x, i));
-}
-
-/// c_I += ½ (s_2I + s_2I+1): a residual row restricted along x.
-PLUME_AVX2_CLONES void restrictPairs(int n, const float* __restrict s, float* __restrict c) {
-  for (int ic = 0; ic < n; ++ic) c[ic] += kRestrict * (s[2 * ic] + s[2 * ic + 1]);
-}
-
-/// Coarse rhs = R (b - A x), R = ½ × sum of the children (see kRestrict).
-void restrictResidual(Level& F, Level& C) {
-  parallelFor(0, C.n.z, [&](int kc) {
-    float* s = F.rows.data() + std::size_t(kc) * (F.n.x + 2);
-    s[F.n.x] = 0.f;  // odd nx: the last coarse cell has one child along x
-    for (int jc = 0; jc < C.n.y; ++jc) std::fill_n(&C.b[C.at(0, jc, kc)], C.n.x, 0.f);
-    for (int k = 2 * kc; k < std::min(2 * kc + 2, F.n.z); ++k)
-      for (int j = 0; j < F.n.y; ++j) {
-        residualRow(F, F.at(0, j, k), s);
-        restrictPairs(C.n.x, s, &C.b[C.at(0, j >> 1, kc)]);
-      }
-  });
-}
-
-/// x_2I += e_I, x_2I+1 += e_I on fluid cells: a coarse row prolonged along x.
-PLUME_AVX2_CLONES void prolongPairs(int n, const float* __restrict e, const float* __restrict d,
-                  float* __restrict x) {
-  for (int ic = 0; ic < n / 2; ++ic) {
-    x[2 * ic] += keepIf(d[2 * ic], e[ic]);
-    x[2 * ic + 1] += keepIf(d[2 * ic + 1], e[ic]);
-  }
-  if (n & 1) x[n - 1] += keepIf(d[n - 1], e[n / 2]);
-}
-
-/// x += P e (piecewise constant), on fluid cells only.
-void prolongAdd(Level& F, const Level& C) {
-  forRows(F.n, [&](int j, int k) {
-    const std::size_t o = F.at(0, j, k);
-    prolongPairs(F.n.x, C.x.data() + C.at(0, j >> 1, k >> 1), F.diag.data() + o, F.x.data() + o);
-  });
 }
 
 /// q = A d on a padded row (0 on solid cells).

@@ -81,7 +81,7 @@ TEST(FlameStructure, MovingSourceLeavesATrailingFlame) {
 TEST(FlameStructure, BreakawayRateAndSeparatedLifespan) {
   // Rate: statistical breakaways per flame-second spent longer than H_i (breakaway.h). Eight
   // sources, f = 6 Hz, no forced breaks (H_max far). About 2.4·10^4 breaks: a Poisson count's
-  // relative SE is 1/√N ≈ 0.65%, so the 10% is ~15 SE.
+  // relative SE is 1/√N ≈ 0.65%, so the 10% tolerance below is ~15 SE.
   FlameParams p;
   p.points = 8;
   p.heightPersistent = 0.05;

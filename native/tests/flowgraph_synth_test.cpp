@@ -1,7 +1,8 @@
 /// \file flowgraph_synth_test.cpp
-/// Flow-graph fire synthesis (graph_fire_synthesis.txt §4.2, §5.2): RK4 pathlines (eq. 6), the
-/// pathline file, the synthesizer (eq. 13) and the VDB rasterization. The reproduction of a real
-/// bake by a temporal walk is in flowgraph_reproduction_test.cpp.
+/// Flow-graph fire synthesis (graph_fire_synthesis.txt §4.2, §5.2): the pathline file, the
+/// synthesizer (eq. 13) and grid external velocities. RK4 pathlines are in
+/// flowgraph_pathlines_test.cpp, the rasterization in fire_raster_test.cpp, the reproduction of
+/// a real bake by a temporal walk in flowgraph_reproduction_test.cpp.
 
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -27,120 +28,6 @@ namespace fs = std::filesystem;
 
 namespace plume {
 namespace {
-
-constexpr int kN = 16;
-constexpr float kH = 1.f / kN;
-const glm::vec3 kCentre(0.5f, 0.5f, 0.5f);
-
-/// A MAC grid of kN³ cells of size kH at the origin holding u(x) = ω ẑ × (x - c): linear, so
-/// trilinear sampling reproduces it exactly inside the grid.
-MacGrid3 rotation(float omega) {
-  MacGrid3 m{glm::ivec3(kN)};
-  for (int a = 0; a < 2; ++a) {
-    ScalarGrid& g = m.component(a);
-    const glm::ivec3 n = g.size();
-    for (int k = 0; k < n.z; ++k)
-      for (int j = 0; j < n.y; ++j)
-        for (int i = 0; i < n.x; ++i) {
-          glm::vec3 x = (glm::vec3(i, j, k) + glm::vec3(0.5f)) * kH;
-          x[a] -= 0.5f * kH;  // faces of axis a sit half a cell lower
-          g(i, j, k) = a == 0 ? -omega * (x.y - kCentre.y) : omega * (x.x - kCentre.x);
-        }
-  }
-  return m;
-}
-
-MacGrid3 uniform(glm::vec3 u) {
-  MacGrid3 m{glm::ivec3(kN)};
-  for (int a = 0; a < 3; ++a) m.component(a).fill(u[a]);
-  return m;
-}
-
-glm::vec3 rotated(glm::vec3 x, float angle) {
-  const glm::vec3 d = x - kCentre;
-  return kCentre + glm::vec3(std::cos(angle) * d.x - std::sin(angle) * d.y,
-                             std::sin(angle) * d.x + std::cos(angle) * d.y, d.z);
-}
-
-TEST(PathlineIntegrator, ExactOnAFieldLinearInTime) {
-  // u(t) = a + θ (b - a) everywhere: x(θ) = x0 + dt (θ a + θ²/2 (b - a)), a quadratic RK4 is
-  // exact for.
-  const glm::vec3 a(0.3f, -0.2f, 0.5f), b(-0.1f, 0.4f, 0.9f);
-  const MacGrid3 ga = uniform(a), gb = uniform(b);
-  const SubstepVelocity u(ga, gb, kH, glm::vec3(0.f));
-  const glm::vec3 x0(0.4f, 0.5f, 0.3f);
-  const float dt = 0.2f;
-  const glm::vec3 x = integrateRk4(u, x0, 0.25f, 0.75f, dt, 1);
-  const glm::vec3 exact = x0 + dt * (0.5f * a + 0.5f * (0.75f * 0.75f - 0.25f * 0.25f) * (b - a));
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(x[c], exact[c], 1e-6f);
-}
-
-TEST(PathlineIntegrator, FourthOrderOnAnUnsteadyRotation) {
-  // ω blends from ω0 at the substep's start to ω1 at its end; rotations about one axis commute,
-  // so the exact pathline turns by ∫ω dt = dt (ω0 + ω1) / 2.
-  const float w0 = 2.f, w1 = 4.f, dt = 1.f;
-  const MacGrid3 g0 = rotation(w0), g1 = rotation(w1);
-  const SubstepVelocity u(g0, g1, kH, glm::vec3(0.f));
-  const glm::vec3 x0(0.75f, 0.5f, 0.5f);
-  const glm::vec3 exact = rotated(x0, dt * 0.5f * (w0 + w1));
-  double error[3];
-  const int steps[3] = {4, 8, 16};
-  for (int n = 0; n < 3; ++n) error[n] = glm::length(integrateRk4(u, x0, 0.f, 1.f, dt, steps[n]) - exact);
-  const double order1 = std::log2(error[0] / error[1]), order2 = std::log2(error[1] / error[2]);
-  std::cout << "RK4 errors " << error[0] << " " << error[1] << " " << error[2] << ", orders "
-            << order1 << " " << order2 << "\n";
-  EXPECT_GE(order1, 3.5);
-  EXPECT_GE(order2, 3.5);
-  EXPECT_LT(error[2], 1e-4);
-}
-
-TEST(PathlineIntegrator, StepCountFollowsTheSpeed) {
-  // 3 cells in one substep need 3 steps; advancePathline() then matches integrateRk4(3).
-  const MacGrid3 g = rotation(3.f);
-  const SubstepVelocity u(g, g, kH, glm::vec3(0.f));
-  const glm::vec3 x0(0.75f, 0.5f, 0.5f);  // speed 0.75 m/s = 12 cells/s
-  const float dt = 0.25f;                  // 3 cells
-  const glm::vec3 a = advancePathline(u, x0, 0.f, 1.f, dt, kH);
-  const glm::vec3 b = integrateRk4(u, x0, 0.f, 1.f, dt, 3);
-  EXPECT_EQ(a, b);
-  EXPECT_NEAR(glm::length(a - rotated(x0, 0.75f)), 0.f, 2e-4f);
-}
-
-TEST(PathlineSeeds, EightPerCellAtHalfCellSpacing) {
-  CellSet cells;
-  cells.cells = {5, 3, 5};  // duplicates and order do not matter
-  const auto seeds = pathlineSeeds(cells, glm::ivec3(4, 2, 2), 0.5f, glm::vec3(1.f, 0.f, 0.f));
-  ASSERT_EQ(seeds.size(), 16u);
-  // Cell 3 = (3, 0, 0) first, x fastest: (3.25, 0.25, 0.25) Δx, then (3.75, 0.25, 0.25) Δx.
-  EXPECT_EQ(seeds[0], glm::vec3(1.f + 3.25f * 0.5f, 0.125f, 0.125f));
-  EXPECT_EQ(seeds[1], glm::vec3(1.f + 3.75f * 0.5f, 0.125f, 0.125f));
-  EXPECT_EQ(seeds[2], glm::vec3(1.f + 3.25f * 0.5f, 0.375f, 0.125f));
-  EXPECT_EQ(seeds[8], glm::vec3(1.f + 1.25f * 0.5f, 0.625f, 0.125f));  // cell 5 = (1, 1, 0)
-  EXPECT_THROW(pathlineSeeds(CellSet{}, glm::ivec3(4), 1.f, glm::vec3(0.f)), std::invalid_argument);
-  cells.cells = {64};
-  EXPECT_THROW(pathlineSeeds(cells, glm::ivec3(4), 1.f, glm::vec3(0.f)), std::invalid_argument);
-}
-
-TEST(PathlineParams, ValidateNamesTheSetting) {
-  auto message = [](const PathlineParams& p, float frameDt) {
-    try {
-      p.validate();
-      p.samples(frameDt);
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
-  PathlineParams p;
-  EXPECT_EQ(p.samples(1.f / 24.f), 48);  // 1 s at 2 nodes per frame
-  p.nodesPerFrame = 0;
-  EXPECT_NE(message(p, 1.f / 24.f).find("nodes_per_frame"), std::string::npos);
-  p = PathlineParams();
-  p.lifetime = -1.f;
-  EXPECT_NE(message(p, 1.f / 24.f).find("lifetime"), std::string::npos);
-  p.lifetime = 0.01f;  // less than two node steps
-  EXPECT_NE(message(p, 1.f / 24.f).find("lifetime"), std::string::npos);
-}
 
 // --- pathline files -----------------------------------------------------------------------
 
@@ -221,7 +108,7 @@ TEST(PathlineFile, RoundTripIsExactInFloat32) {
   }
   EXPECT_EQ(fs::file_size(path), 80 + 5 * f.bytesPerNode() + 16 * 5 + 8);
   EXPECT_THROW(f.readGroup(5), std::out_of_range);
-  // The size: |Ω| = 3,200, L = 48.
+  // The size the synthesis budget is set for: |Ω| = 3,200, L = 48.
   PathlineFileInfo big = fileInfo(PathlineLayout{3200, 48, 1.f / 48.f}, false);
   std::cout << "bytes per node (3200 pathlines, 48 samples): float32 " << big.blockBytes();
   big.float16 = true;
@@ -467,94 +354,6 @@ TEST(GridVelocityField, TrilinearInsideClampedOutside) {
   EXPECT_THROW(GridVelocityField(g, 0.f, origin), std::invalid_argument);
   g(1, 1, 1).x = NAN;
   EXPECT_THROW(GridVelocityField(g, h, origin), std::invalid_argument);
-}
-
-// --- rasterization --------------------------------------------------------------------------
-
-struct Cloud {
-  std::vector<glm::vec3> x;
-  std::vector<float> r, t;
-  FireParticleView view() const { return {x.data(), r.data(), t.data(), x.size()}; }
-};
-
-Cloud randomCloud(int count) {
-  Cloud c;
-  Rng rng(5);
-  for (int n = 0; n < count; ++n) {
-    c.x.emplace_back(0.3 + 0.4 * rng.uniform(), 0.2 + 0.5 * rng.uniform(), 0.1 + 0.8 * rng.uniform());
-    c.r.push_back(float(rng.uniform()));
-    c.t.push_back(float(5.0 * rng.uniform()));
-  }
-  return c;
-}
-
-double gridSum(const openvdb::FloatGrid& g) {
-  double s = 0.0;
-  for (auto it = g.cbeginValueOn(); it; ++it) s += double(*it);
-  return s;
-}
-
-TEST(FireRaster, ConservesMassAndMapsFlame) {
-  FireRasterParams p;
-  p.voxelSize = 1.f / 32.f;
-  const Cloud c = randomCloud(20000);
-  const FireGrids g = rasterizeFire(c.view(), p);
-  // Σ ρ_v Δx³ = Σ R_p V_p with V_p = (Δx/2)³.
-  double mass = 0.0;
-  for (float r : c.r) mass += double(r) * std::pow(0.5 * p.voxelSize, 3.0);
-  const double h3 = std::pow(double(p.voxelSize), 3.0);
-  EXPECT_NEAR(gridSum(*g.density) * h3, mass, 1e-5 * mass);
-  // Temperatures are means of particle temperatures in [0, 5]; flame maps [1, 4] to [0, 1].
-  for (auto it = g.temperature->cbeginValueOn(); it; ++it) {
-    ASSERT_GE(*it, 0.f);
-    ASSERT_LE(*it, 5.f + 1e-4f);
-    const float f = g.flame->tree().getValue(it.getCoord());
-    ASSERT_NEAR(f, std::min(1.f, std::max(0.f, (*it - 1.f) / 3.f)), 1e-6f);
-  }
-  EXPECT_EQ(g.density->getName(), "density");
-  EXPECT_EQ(g.flame->getGridClass(), openvdb::GRID_FOG_VOLUME);
-}
-
-TEST(FireRaster, OneParticleAtAVoxelCentre) {
-  FireRasterParams p;
-  p.voxelSize = 0.1f;
-  p.origin = glm::vec3(-1.f, 0.f, 0.f);
-  p.particleVolume = 0.002f;
-  // Voxel (3, 4, 5) is centred at origin + (3.5, 4.5, 5.5) Δx.
-  const glm::vec3 x = p.origin + glm::vec3(3.5f, 4.5f, 5.5f) * p.voxelSize;
-  const float r = 2.f, t = 3.f;
-  const FireGrids g = rasterizeFire({&x, &r, &t, 1}, p);
-  const openvdb::Coord ijk(3, 4, 5);
-  EXPECT_NEAR(g.density->tree().getValue(ijk), r * p.particleVolume / 0.001f, 1e-4f);
-  EXPECT_NEAR(g.temperature->tree().getValue(ijk), t, 1e-5f);  // weight 1: its own temperature
-  EXPECT_NEAR(g.flame->tree().getValue(ijk), 2.f / 3.f, 1e-5f);
-  // Its neighbours get the rest of the hat weight: nothing but float rounding here.
-  EXPECT_NEAR(gridSum(*g.density), r * p.particleVolume / 0.001f, 1e-4f);
-}
-
-TEST(FireRaster, DeterministicAndWrittenAsAFrameVdb) {
-  const Cloud c = randomCloud(30000);
-  FireGrids g[2];
-  for (int t = 0; t < 2; ++t) {
-    FireRasterParams p;
-    p.voxelSize = 1.f / 48.f;
-    p.threads = t + 1;
-    g[t] = rasterizeFire(c.view(), p);
-  }
-  for (auto pick : {&FireGrids::density, &FireGrids::temperature, &FireGrids::flame}) {
-    const openvdb::FloatGrid& a = *(g[0].*pick);
-    const openvdb::FloatGrid& b = *(g[1].*pick);
-    ASSERT_EQ(a.activeVoxelCount(), b.activeVoxelCount());
-    for (auto it = a.cbeginValueOn(); it; ++it) ASSERT_EQ(*it, b.tree().getValue(it.getCoord()));
-  }
-  const std::string path = tempPath("fire_0001.vdb");
-  writeFireVdb(path, g[0], 1);
-  auto names = vdbGridNames(path);
-  std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"density", "flame", "temperature"}));
-  const DenseGrid d = readVdbGrid(path, "density");
-  EXPECT_NEAR(d.voxelSize, 1.f / 48.f, 1e-7f);
-  EXPECT_FALSE(fs::exists(path + ".tmp"));
 }
 
 }  // namespace

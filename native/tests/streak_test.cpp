@@ -301,7 +301,7 @@ TEST(BuildSurfaces, OneOrderedSurfacePerSeparatedGroupOfLines) {
 }
 
 TEST(BuildSurfaces, TwentySourcesThreeHundredFramesTiming) {
-  // The benchmark size: 20 point sources, 300 frames, two substeps a frame (N(t) = 2t + 1).
+  // The benchmark size: 20 point sources, 300 frames, two substeps a frame (N(t) = 2t + 1).
   const int sources = 20, frames = 300;
   std::vector<int> n;
   for (int t = 1; t <= frames; ++t) n.push_back(2 * t + 1);
