@@ -55,12 +55,10 @@ py::dict flameDict(const Flame& f) {
 
 /// A (nx, ny, nz) float grid from a NumPy array indexed [i, j, k].
 ScalarGrid scalarGridArg(const py::object& o, const char* name) {
-  const FloatArrayC a = FloatArrayC::ensure(o);
+  const FloatArrayF a = FloatArrayF::ensure(o);
   if (!a || a.ndim() != 3) throw py::value_error(std::string(name) + " must be an array of shape (nx, ny, nz)");
-  ScalarGrid g(glm::ivec3(int(a.shape(0)), int(a.shape(1)), int(a.shape(2))));
-  for (py::ssize_t i = 0; i < a.shape(0); ++i)
-    for (py::ssize_t j = 0; j < a.shape(1); ++j)
-      for (py::ssize_t k = 0; k < a.shape(2); ++k) g(int(i), int(j), int(k)) = a.at(i, j, k);
+  ScalarGrid g;
+  copyGrid(a, glm::ivec3(int(a.shape(0)), int(a.shape(1)), int(a.shape(2))), g, name);
   return g;
 }
 

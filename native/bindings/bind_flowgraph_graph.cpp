@@ -45,13 +45,6 @@ CostMatrix toCost(const py::object& o) {
   return CostMatrix::fromValues(int(a.shape(0)), std::move(v));
 }
 
-/// The state node counts of a graph (before pruning).
-std::vector<int> stateCounts(const FlowGraph& g) {
-  std::vector<int> c;
-  for (int s = 0; s < g.stateCount(); ++s) c.push_back(g.stateNodeCount(s));
-  return c;
-}
-
 /// An (N, N) float64 NumPy copy of C.
 py::array_t<double> costArray(const CostMatrix& c) {
   py::array_t<double> a({py::ssize_t(c.size()), py::ssize_t(c.size())});
@@ -185,7 +178,7 @@ void bindGraph(py::module_& m) {
       "then those of state 1, ... ValueError if a state's first node is pruned.");
   g.def_property_readonly("node_count", &FlowGraph::nodeCount, "N, pruned nodes included.");
   g.def_property_readonly("state_count", &FlowGraph::stateCount, "Number of states.");
-  g.def_property_readonly("state_node_counts", &stateCounts, "Nodes per state (before pruning).");
+  g.def_property_readonly("state_node_counts", &FlowGraph::stateNodeCounts, "Nodes per state (before pruning).");
   g.def_property_readonly("pruned_per_state", &FlowGraph::prunedPerState, "Pruned nodes per state.");
   g.def_property_readonly(
       "node_states", [](const FlowGraph& f) { return arrayFrom<int>(std::size_t(f.nodeCount()), [&](std::size_t n) { return f.state(int(n)); }); },
@@ -250,7 +243,7 @@ void bindGraph(py::module_& m) {
         RgbImage img;
         {
           py::gil_scoped_release release;
-          img = costMatrixImage(c, graph.transitions(), stateCounts(graph), size);
+          img = costMatrixImage(c, graph.transitions(), graph.stateNodeCounts(), size);
         }
         py::array_t<std::uint8_t> a({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(3)});
         std::memcpy(a.mutable_data(), img.pixels.data(), img.pixels.size());

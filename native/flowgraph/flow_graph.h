@@ -71,6 +71,12 @@ class FlowGraph {
   int node(int state, int step) const { return mOffsets[std::size_t(state)] + step; }
   /// Nodes of a state before pruning.
   int stateNodeCount(int state) const { return mOffsets[std::size_t(state) + 1] - mOffsets[std::size_t(state)]; }
+  /// stateNodeCount() of every state, in order (the counts the graph was built from).
+  std::vector<int> stateNodeCounts() const {
+    std::vector<int> c;
+    for (int s = 0; s < stateCount(); ++s) c.push_back(stateNodeCount(s));
+    return c;
+  }
   /// True when the node was pruned (it could not reach a cycle, or it was a trap).
   bool pruned(int node) const { return mPruned[std::size_t(node)] != 0; }
   /// Pruned nodes per state.
