@@ -20,42 +20,6 @@ namespace py = pybind11;
 namespace plume::bindings {
 namespace {
 
-/// An (N, k) array (ValueError naming `what` otherwise).
-DoubleArrayC rowsArg(const py::handle& o, py::ssize_t k, const char* what) {
-  const DoubleArrayC a = DoubleArrayC::ensure(o);
-  if (!a || a.ndim() != 2 || a.shape(1) != k)
-    throw py::value_error(std::string(what) + " must be an array of shape (N, " + std::to_string(k) + ")");
-  return a;
-}
-
-Flame flameArg(const py::handle& h, std::size_t index) {
-  const py::dict d = py::reinterpret_borrow<py::dict>(h);
-  const std::string name = "flames[" + std::to_string(index) + "]";
-  if (!d.contains("points")) throw py::value_error(name + " needs 'points'");
-  const DoubleArrayC x = rowsArg(d["points"], 3, (name + ".points").c_str());
-  const py::ssize_t n = x.shape(0);
-  Flame f;
-  f.points.resize(std::size_t(n));
-  for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].x = {x.at(k, 0), x.at(k, 1), x.at(k, 2)};
-  if (d.contains("velocities")) {
-    const DoubleArrayC v = rowsArg(d["velocities"], 3, (name + ".velocities").c_str());
-    if (v.shape(0) != n) throw py::value_error(name + ".velocities must have one row per point");
-    for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].v = {v.at(k, 0), v.at(k, 1), v.at(k, 2)};
-  }
-  if (d.contains("ages")) {
-    const DoubleArrayC a = DoubleArrayC::ensure(d["ages"]);
-    if (!a || a.ndim() != 1 || a.shape(0) != n) throw py::value_error(name + ".ages must have shape (N,)");
-    for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].age = a.at(k);
-  }
-  f.radius = d.contains("radius") ? d["radius"].cast<double>() : 0.0;
-  if (d.contains("intensity")) f.intensity = d["intensity"].cast<double>();
-  if (d.contains("temperature")) f.temperature = d["temperature"].cast<double>();
-  f.id = d.contains("id") ? d["id"].cast<std::uint32_t>() : std::uint32_t(index + 1);
-  if (d.contains("source")) f.source = d["source"].cast<int>();
-  if (d.contains("separated")) f.separated = d["separated"].cast<bool>();
-  return f;
-}
-
 ColorImage imageArg(const py::handle& o) {
   const FloatArrayC a = FloatArrayC::ensure(o);
   if (!a || a.ndim() != 3 || a.shape(2) != 3)
@@ -101,7 +65,7 @@ void bindFlamesShape(py::module_& m) {
   profile.def_static(
       "from_curve",
       [](const py::object& points) {
-        const DoubleArrayC a = rowsArg(points, 2, "points");
+        const DoubleArrayC a = doubleRowsArg(points, 2, "points");
         std::vector<glm::dvec2> p;
         for (py::ssize_t k = 0; k < a.shape(0); ++k) p.push_back({a.at(k, 0), a.at(k, 1)});
         return FlameProfile::fromCurve(p);

@@ -28,31 +28,6 @@ std::vector<glm::dvec3> dpointsArg(const py::object& o, const char* name) {
   return p;
 }
 
-/// A dict of one flame: id, source, separated, age, lifespan, radius, intensity, temperature,
-/// points (n, 3), velocities (n, 3), ages (n,).
-py::dict flameDict(const Flame& f) {
-  std::vector<glm::dvec3> x, v;
-  py::array_t<double> ages(py::ssize_t(f.points.size()));
-  for (std::size_t i = 0; i < f.points.size(); ++i) {
-    x.push_back(f.points[i].x);
-    v.push_back(f.points[i].v);
-    ages.mutable_data()[i] = f.points[i].age;
-  }
-  py::dict d;
-  d["id"] = f.id;
-  d["source"] = f.source;
-  d["separated"] = f.separated;
-  d["age"] = f.age;
-  d["lifespan"] = f.lifespan;
-  d["radius"] = f.radius;
-  d["intensity"] = f.intensity;
-  d["temperature"] = f.temperature;
-  d["points"] = rowsArray(x);
-  d["velocities"] = rowsArray(v);
-  d["ages"] = ages;
-  return d;
-}
-
 /// A (nx, ny, nz) float grid from a NumPy array indexed [i, j, k].
 ScalarGrid scalarGridArg(const py::object& o, const char* name) {
   const FloatArrayF a = FloatArrayF::ensure(o);

@@ -1,6 +1,6 @@
 /// \file convert.cpp
-/// The shared conversions of convert.h that are more than a few lines: vectors, grids, meshes
-/// and streak snapshot dicts between NumPy and the core.
+/// The shared conversions of convert.h that are more than a few lines: vectors, grids, meshes,
+/// streak snapshot dicts and flame dicts between NumPy and the core.
 
 #include "bindings/convert.h"
 
@@ -225,6 +225,66 @@ py::dict streakFrameDict(const StreakFrame& f) {
   d["density"] = array1DAs<float>(f.density);
   d["groups"] = array1DAs<std::int32_t>(f.groups);
   d["outside"] = array1DAs<bool>(f.outside);
+  return d;
+}
+
+// --- flame dicts ---------------------------------------------------------------------------
+
+DoubleArrayC doubleRowsArg(const py::handle& o, py::ssize_t k, const char* what) {
+  const DoubleArrayC a = DoubleArrayC::ensure(o);
+  if (!a || a.ndim() != 2 || a.shape(1) != k)
+    throw py::value_error(std::string(what) + " must be an array of shape (N, " + std::to_string(k) + ")");
+  return a;
+}
+
+Flame flameArg(const py::handle& h, std::size_t index) {
+  const py::dict d = py::reinterpret_borrow<py::dict>(h);
+  const std::string name = "flames[" + std::to_string(index) + "]";
+  if (!d.contains("points")) throw py::value_error(name + " needs 'points'");
+  const DoubleArrayC x = doubleRowsArg(d["points"], 3, (name + ".points").c_str());
+  const py::ssize_t n = x.shape(0);
+  Flame f;
+  f.points.resize(std::size_t(n));
+  for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].x = {x.at(k, 0), x.at(k, 1), x.at(k, 2)};
+  if (d.contains("velocities")) {
+    const DoubleArrayC v = doubleRowsArg(d["velocities"], 3, (name + ".velocities").c_str());
+    if (v.shape(0) != n) throw py::value_error(name + ".velocities must have one row per point");
+    for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].v = {v.at(k, 0), v.at(k, 1), v.at(k, 2)};
+  }
+  if (d.contains("ages")) {
+    const DoubleArrayC a = DoubleArrayC::ensure(d["ages"]);
+    if (!a || a.ndim() != 1 || a.shape(0) != n) throw py::value_error(name + ".ages must have shape (N,)");
+    for (py::ssize_t k = 0; k < n; ++k) f.points[std::size_t(k)].age = a.at(k);
+  }
+  f.radius = d.contains("radius") ? d["radius"].cast<double>() : 0.0;
+  if (d.contains("intensity")) f.intensity = d["intensity"].cast<double>();
+  if (d.contains("temperature")) f.temperature = d["temperature"].cast<double>();
+  f.id = d.contains("id") ? d["id"].cast<std::uint32_t>() : std::uint32_t(index + 1);
+  if (d.contains("source")) f.source = d["source"].cast<int>();
+  if (d.contains("separated")) f.separated = d["separated"].cast<bool>();
+  return f;
+}
+
+py::dict flameDict(const Flame& f) {
+  std::vector<glm::dvec3> x, v;
+  py::array_t<double> ages(py::ssize_t(f.points.size()));
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    x.push_back(f.points[i].x);
+    v.push_back(f.points[i].v);
+    ages.mutable_data()[i] = f.points[i].age;
+  }
+  py::dict d;
+  d["id"] = f.id;
+  d["source"] = f.source;
+  d["separated"] = f.separated;
+  d["age"] = f.age;
+  d["lifespan"] = f.lifespan;
+  d["radius"] = f.radius;
+  d["intensity"] = f.intensity;
+  d["temperature"] = f.temperature;
+  d["points"] = rowsArray(x);
+  d["velocities"] = rowsArray(v);
+  d["ages"] = ages;
   return d;
 }
 

@@ -3,11 +3,12 @@
 /// The conversions every binding file shares, defined once: NumPy argument types, small vectors
 /// to and from Python, the shape text of error messages, copies of vectors and grids into NumPy
 /// arrays, path arguments with the GIL released, and the argument structures more than one
-/// component takes (meshes as SmokeSolver.add_source takes them, face velocities, streak
-/// snapshot dicts). Messages name the argument so a script can tell which one was wrong.
+/// component takes or gives (meshes as SmokeSolver.add_source takes them, face velocities,
+/// streak snapshot dicts, flame dicts). Messages name the argument so a script can tell which one was wrong.
 
 #include "core/grid3.h"
 #include "core/mac_grid3.h"
+#include "flames/flame.h"
 #include "solver/emitters.h"
 #include "tracers/streak_frame.h"
 
@@ -176,6 +177,20 @@ std::vector<StreakFrame> toStreakFrames(const py::sequence& snapshots, bool posi
 /// A StreakFrame as the snapshot dict: counts (S,) int32, positions (M, 3) float32, density (M,)
 /// float32, groups (S,) int32, outside (M,) bool.
 py::dict streakFrameDict(const StreakFrame& f);
+
+// --- flame dicts (FlameSystem.flames(), FlameShaper.shape()) --------------------------------
+
+/// An (N, k) float64 array; ValueError "<what> must be an array of shape (N, k)" otherwise.
+DoubleArrayC doubleRowsArg(const py::handle& o, py::ssize_t k, const char* what);
+
+/// flames[index] as a Flame: points (N, 3) base to tip required; velocities (N, 3), ages (N,),
+/// radius, intensity, temperature, id (default index + 1), source, separated optional.
+/// ValueError naming "flames[index].<key>".
+Flame flameArg(const py::handle& h, std::size_t index);
+
+/// A flame as a dict: id, source, separated, age, lifespan, radius, intensity, temperature,
+/// points (n, 3), velocities (n, 3), ages (n,) (float64).
+py::dict flameDict(const Flame& f);
 
 // --- paths ----------------------------------------------------------------------------------
 
