@@ -172,7 +172,7 @@ void bindNurbs(py::module_& m) {
         p.samplingU = kU;
         p.samplingV = kV;
         p.interpolation = interpolation;
-        p.origin = vec3Arg(origin, "origin", "must be 3 numbers");
+        p.origin = vec3Arg(origin, "origin", Vec3Form::Array);
         p.cellSize = cellSize;
         DensityMap map;
         {
@@ -195,7 +195,7 @@ void bindNurbs(py::module_& m) {
         const ScalarGrid grid = gridFrom(density);
         DensityMapParams p;
         p.interpolation = interpolation;
-        p.origin = vec3Arg(origin, "origin", "must be 3 numbers");
+        p.origin = vec3Arg(origin, "origin", Vec3Form::Array);
         p.cellSize = cellSize;
         DensityMap map;
         {

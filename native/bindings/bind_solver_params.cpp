@@ -18,9 +18,6 @@ namespace py = pybind11;
 namespace plume::bindings {
 namespace {
 
-/// How the solver's vector settings have always worded a bad value.
-constexpr const char* kSequenceOf3 = "must be a sequence of 3 numbers";
-
 /// Adds a read/write property for a plain field.
 template <typename T>
 void field(py::class_<SmokeParams>& c, const char* name, T SmokeParams::*member, const char* doc) {
@@ -64,7 +61,7 @@ void bindParams(py::module_& m) {
   c.def_readwrite("cell_size", &SmokeParams::cellSize, "Δx, metres.");
   c.def_property(
       "origin", [](const SmokeParams& p) { return vec3Tuple(p.origin); },
-      [](SmokeParams& p, const py::object& v) { p.origin = vec3Arg(v, "origin", kSequenceOf3); },
+      [](SmokeParams& p, const py::object& v) { p.origin = vec3Arg(v, "origin", Vec3Form::Sequence); },
       "World position of the domain's minimum corner.");
   c.def_property(
       "boundaries",
@@ -90,14 +87,14 @@ void bindParams(py::module_& m) {
         "through open sides.");
   c.def_property(
       "gravity", [](const SmokeParams& p) { return vec3Tuple(p.gravity); },
-      [](SmokeParams& p, const py::object& v) { p.gravity = vec3Arg(v, "gravity", kSequenceOf3); },
+      [](SmokeParams& p, const py::object& v) { p.gravity = vec3Arg(v, "gravity", Vec3Form::Sequence); },
       "g, m/s²; buoyancy acts against it.");
   field(c, "alpha", &SmokeParams::alpha, "α: buoyancy from density (Fedkiw 2001 eq. 8).");
   field(c, "beta", &SmokeParams::beta, "β: buoyancy from heat, f = -g (α ρ + β (T - T_amb)).");
   field(c, "ambient_temperature", &SmokeParams::ambientTemperature, "T_amb (T_0 of the fire paper).");
   c.def_property(
       "wind", [](const SmokeParams& p) { return vec3Tuple(p.wind); },
-      [](SmokeParams& p, const py::object& v) { p.wind = vec3Arg(v, "wind", kSequenceOf3); },
+      [](SmokeParams& p, const py::object& v) { p.wind = vec3Arg(v, "wind", Vec3Form::Sequence); },
       "Wind velocity u_wind the air is pulled towards, m/s.");
   field(c, "wind_strength", &SmokeParams::windStrength, "k_w: f_wind = k_w (u_wind - u), 1/s.");
   field(c, "vorticity", &SmokeParams::vorticity, "ε: vorticity confinement (Fedkiw 2001 eq. 11).");
@@ -136,7 +133,7 @@ void bindSourceSettings(py::module_& m) {
   c.def_readwrite("fuel", &SourceSettings::fuel, "F set in source cells (combustion).");
   c.def_property(
       "velocity", [](const SourceSettings& s) { return vec3Tuple(s.velocity); },
-      [](SourceSettings& s, const py::object& v) { s.velocity = vec3Arg(v, "velocity", kSequenceOf3); },
+      [](SourceSettings& s, const py::object& v) { s.velocity = vec3Arg(v, "velocity", Vec3Form::Sequence); },
       "Initial velocity, m/s (smoke_surfaces §3.2).");
   c.def_readwrite("motion_factor", &SourceSettings::motionFactor,
                   "Share of the source object's own motion added to its velocity.");

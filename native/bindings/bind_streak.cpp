@@ -128,7 +128,7 @@ void bindStreak(py::module_& m) {
         }
         const glm::ivec3 res = ivec3Arg(resolution, "resolution", 1, 1 << 20, "in [1, 1048576] per axis");
         return rowsArray(
-            randomPointsInCells(set, res, cellSize, vec3Arg(origin, "origin", "must be a sequence of 3 numbers"), pointsPerCell, seed, stream));
+            randomPointsInCells(set, res, cellSize, vec3Arg(origin, "origin", Vec3Form::Sequence), pointsPerCell, seed, stream));
       },
       py::arg("cells"), py::arg("resolution"), py::arg("cell_size"), py::arg("origin"),
       py::arg("points_per_cell"), py::arg("seed"), py::arg("stream") = 0,

@@ -4,6 +4,8 @@
 
 #include "bindings/convert.h"
 
+#include <pybind11/stl.h>
+
 #include <sstream>
 
 namespace plume::bindings {
@@ -18,13 +20,21 @@ std::string shapeText(const py::array& a) {
 
 // --- small vectors ------------------------------------------------------------------------
 
-glm::dvec3 dvec3Arg(const py::handle& o, const char* name, const char* wording) {
-  const DoubleArrayC a = DoubleArrayC::ensure(o);
-  if (!a || a.size() != 3) {
-    PyErr_Clear();
-    throw py::value_error(std::string(name) + " " + wording);
+glm::dvec3 dvec3Arg(const py::handle& o, const char* name, Vec3Form form) {
+  if (form == Vec3Form::Array) {
+    const DoubleArrayC a = DoubleArrayC::ensure(o);
+    if (!a || a.size() != 3) throw py::value_error(std::string(name) + " must be 3 numbers");
+    return {a.data()[0], a.data()[1], a.data()[2]};
   }
-  return {a.data()[0], a.data()[1], a.data()[2]};
+  if (form == Vec3Form::Sequence) {
+    if (!py::isinstance<py::sequence>(o) || py::len(o) != 3)
+      throw py::value_error(std::string(name) + " must be a sequence of 3 numbers");
+    const py::sequence s = py::reinterpret_borrow<py::sequence>(o);
+    return {s[0].cast<double>(), s[1].cast<double>(), s[2].cast<double>()};
+  }
+  const auto v = o.cast<std::vector<double>>();
+  if (v.size() != 3) throw py::value_error(std::string(name) + " must hold 3 numbers");
+  return {v[0], v[1], v[2]};
 }
 
 glm::ivec3 ivec3Arg(const py::handle& o, const char* name, long long lo, long long hi, const char* range) {

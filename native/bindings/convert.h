@@ -54,13 +54,24 @@ A ensureArray(const py::handle& o, const std::string& name) {
 
 // --- small vectors ------------------------------------------------------------------------
 
-/// Three numbers (a sequence or an array of 3) as a glm vector; ValueError "<name> <wording>"
-/// otherwise. The wording is the one each argument has always used.
-glm::dvec3 dvec3Arg(const py::handle& o, const char* name, const char* wording = "must hold 3 numbers");
+/// How a vector argument is checked, each the way its arguments always have been (scripts see
+/// the same errors).
+enum class Vec3Form {
+  /// ValueError "<name> must hold 3 numbers" unless a sequence of 3 numbers (another kind of
+  /// object: pybind11's cast error).
+  Numbers,
+  /// ValueError "<name> must be a sequence of 3 numbers" unless a sequence of length 3.
+  Sequence,
+  /// ValueError "<name> must be 3 numbers" unless NumPy makes an array of 3 numbers of it.
+  Array,
+};
+
+/// Three numbers as a glm vector, checked as `form` says.
+glm::dvec3 dvec3Arg(const py::handle& o, const char* name, Vec3Form form = Vec3Form::Numbers);
 
 /// dvec3Arg() in single precision.
-inline glm::vec3 vec3Arg(const py::handle& o, const char* name, const char* wording = "must hold 3 numbers") {
-  return glm::vec3(dvec3Arg(o, name, wording));
+inline glm::vec3 vec3Arg(const py::handle& o, const char* name, Vec3Form form = Vec3Form::Numbers) {
+  return glm::vec3(dvec3Arg(o, name, form));
 }
 
 /// A sequence of 3 integers each in [lo, hi]; ValueError "<name> must be a sequence of 3
