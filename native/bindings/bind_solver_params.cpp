@@ -48,15 +48,29 @@ void bindParams(py::module_& m) {
         }),
         "SmokeParams(**settings): defaults, then the given settings by name.");
   c.def(py::init<const SmokeParams&>(), "A copy.");
+  c.def_static(
+      "ranges",
+      [] {
+        py::dict d;
+        for (const SettingRange& r : smokeSettingRanges()) d[r.name] = py::make_tuple(r.lo, r.hi);
+        return d;
+      },
+      "{setting: (lo, hi)}: the accepted range of every bounded numeric setting (resolution per "
+      "axis), the one definition validate() checks and the add-on's properties read.");
   c.def("__copy__", [](const SmokeParams& p) { return SmokeParams(p); });
   c.def("__deepcopy__", [](const SmokeParams& p, py::dict) { return SmokeParams(p); });
 
   c.def_property(
       "resolution",
       [](const SmokeParams& p) { return vec3Tuple(p.resolution); },
-      [](SmokeParams& p, const py::object& v) { p.resolution = ivec3Arg(v, "resolution", std::numeric_limits<int>::min(),
-                                                       std::numeric_limits<int>::max(),
-                                                       "in [2, 1024] cells per axis"); },
+      [](SmokeParams& p, const py::object& v) {
+        // Beyond an int: refused here, in validate()'s words; within it, validate() checks.
+        const SettingRange& r = smokeSettingRange("resolution");
+        const std::string range = "in [" + std::to_string(int(r.lo)) + ", " +
+                                  std::to_string(int(r.hi)) + "] cells per axis";
+        p.resolution = ivec3Arg(v, "resolution", std::numeric_limits<int>::min(),
+                                std::numeric_limits<int>::max(), range.c_str());
+      },
       "Cells per axis (nx, ny, nz).");
   c.def_readwrite("cell_size", &SmokeParams::cellSize, "Δx, metres.");
   c.def_property(

@@ -17,13 +17,21 @@ void checkFinite(const std::string& name, double v) {
   if (!std::isfinite(v)) fail(name, "a finite number", v);
 }
 
-void checkRange(const std::string& name, double v, double lo, double hi) {
+std::string rangeText(const SettingRange& r, const char* unit = "") {
+  std::ostringstream s;
+  s << "in [" << r.lo << ", " << r.hi << "]" << unit;
+  return s.str();
+}
+
+void checkRange(const std::string& name, double v) {
   checkFinite(name, v);
-  if (v < lo || v > hi) {
-    std::ostringstream r;
-    r << "in [" << lo << ", " << hi << "]";
-    fail(name, r.str(), v);
-  }
+  const SettingRange& r = smokeSettingRange(name);
+  if (v < r.lo || v > r.hi) fail(name, rangeText(r), v);
+}
+
+void checkCount(const std::string& name, int v, const char* unit = "") {
+  const SettingRange& r = smokeSettingRange(name);
+  if (v < r.lo || v > r.hi) fail(name, rangeText(r, unit), v);
 }
 
 void checkVec(const std::string& name, glm::vec3 v) {
@@ -32,9 +40,40 @@ void checkVec(const std::string& name, glm::vec3 v) {
 
 }  // namespace
 
+const std::vector<SettingRange>& smokeSettingRanges() {
+  static const std::vector<SettingRange> ranges = {
+      {"resolution", 2, 1024},  // cells per axis
+      {"cell_size", 1e-6, 1e6},
+      {"frame_dt", 1e-6, 10.0},
+      {"substeps", 1, 1000},
+      {"cfl", 0.1, 100.0},
+      {"alpha", -1e4, 1e4},
+      {"beta", -1e4, 1e4},
+      {"ambient_temperature", -1e6, 1e6},
+      {"wind_strength", 0.0, 1e4},
+      {"vorticity", 0.0, 1e3},
+      {"density_dissipation", 0.0, 1e3},
+      {"pressure_tolerance", 1e-8, 0.5},
+      {"max_pressure_iterations", 1, 100000},
+      {"burn_rate", 0.0, 1e4},
+      {"soot_yield", 0.0, 1e4},
+      {"heat_yield", 0.0, 1e4},
+      {"conductivity", 0.0, 1e4},
+      {"cooling_rate", 0.0, 1e6},
+      {"expansion", 0.0, 1e4},
+      {"threads", 0, 1024},  // 0 = all cores
+  };
+  return ranges;
+}
+
+const SettingRange& smokeSettingRange(const std::string& name) {
+  for (const SettingRange& r : smokeSettingRanges())
+    if (name == r.name) return r;
+  throw std::out_of_range("SmokeParams has no range for '" + name + "'");
+}
+
 void SmokeParams::validate() const {
-  for (int a = 0; a < 3; ++a)
-    if (resolution[a] < 2 || resolution[a] > 1024) fail("resolution", "in [2, 1024] cells per axis", resolution[a]);
+  for (int a = 0; a < 3; ++a) checkCount("resolution", resolution[a], " cells per axis");
   const double cells = double(resolution.x) * resolution.y * resolution.z;
   if (cells > kMaxCells) {
     std::ostringstream s;
@@ -42,32 +81,31 @@ void SmokeParams::validate() const {
       << " fit in memory (about 64 bytes per cell)";
     throw std::invalid_argument(s.str());
   }
-  checkRange("cell_size", cellSize, 1e-6, 1e6);
+  checkRange("cell_size", cellSize);
   checkVec("origin", origin);
-  checkRange("frame_dt", frameDt, 1e-6, 10.0);
-  if (substeps < 1 || substeps > 1000) fail("substeps", "in [1, 1000]", substeps);
-  checkRange("cfl", cfl, 0.1, 100.0);
+  checkRange("frame_dt", frameDt);
+  checkCount("substeps", substeps);
+  checkRange("cfl", cfl);
   checkVec("gravity", gravity);
-  checkRange("alpha", alpha, -1e4, 1e4);
-  checkRange("beta", beta, -1e4, 1e4);
-  checkRange("ambient_temperature", ambientTemperature, -1e6, 1e6);
+  checkRange("alpha", alpha);
+  checkRange("beta", beta);
+  checkRange("ambient_temperature", ambientTemperature);
   checkVec("wind", wind);
-  checkRange("wind_strength", windStrength, 0.0, 1e4);
-  checkRange("vorticity", vorticity, 0.0, 1e3);
-  checkRange("density_dissipation", densityDissipation, 0.0, 1e3);
-  checkRange("pressure_tolerance", pressureTolerance, 1e-8, 0.5);
-  if (maxPressureIterations < 1 || maxPressureIterations > 100000)
-    fail("max_pressure_iterations", "in [1, 100000]", maxPressureIterations);
-  checkRange("burn_rate", burnRate, 0.0, 1e4);
-  checkRange("soot_yield", sootYield, 0.0, 1e4);
-  checkRange("heat_yield", heatYield, 0.0, 1e4);
-  checkRange("conductivity", conductivity, 0.0, 1e4);
-  checkRange("cooling_rate", coolingRate, 0.0, 1e6);
+  checkRange("wind_strength", windStrength);
+  checkRange("vorticity", vorticity);
+  checkRange("density_dissipation", densityDissipation);
+  checkRange("pressure_tolerance", pressureTolerance);
+  checkCount("max_pressure_iterations", maxPressureIterations);
+  checkRange("burn_rate", burnRate);
+  checkRange("soot_yield", sootYield);
+  checkRange("heat_yield", heatYield);
+  checkRange("conductivity", conductivity);
+  checkRange("cooling_rate", coolingRate);
   checkFinite("max_temperature", maxTemperature);
   if (combustion && !(maxTemperature > ambientTemperature))
     fail("max_temperature", "greater than ambient_temperature", maxTemperature);
-  checkRange("expansion", expansion, 0.0, 1e4);
-  if (threads < 0 || threads > 1024) fail("threads", "in [0, 1024] (0 = all cores)", threads);
+  checkRange("expansion", expansion);
+  checkCount("threads", threads, " (0 = all cores)");
 }
 
 }  // namespace plume

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace plume {
 
@@ -92,5 +93,19 @@ struct SmokeParams {
 
 /// Upper bound on cells a bake may allocate (about 64 bytes each); validate() rejects more.
 constexpr double kMaxCells = 512.0 * 512.0 * 512.0;
+
+/// Accepted range [lo, hi] of one numeric setting of SmokeParams, by its Python name. The one
+/// definition: validate() checks against it, and the add-on's properties and bake-time messages
+/// read it (SmokeParams.ranges()).
+struct SettingRange {
+  const char* name;
+  double lo;
+  double hi;
+};
+
+/// Every bounded numeric setting of SmokeParams (resolution is per axis).
+const std::vector<SettingRange>& smokeSettingRanges();
+/// The range of setting `name`; std::out_of_range when it has none.
+const SettingRange& smokeSettingRange(const std::string& name);
 
 }  // namespace plume

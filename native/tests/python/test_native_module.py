@@ -1,6 +1,7 @@
 """The plume._native module from Python: settings, arrays, emitters, VDB and state files, cancel."""
 import math
 import pathlib
+import re
 import threading
 import time
 
@@ -117,6 +118,33 @@ def test_params_validate_messages():
     p.vorticity = -0.5
     with pytest.raises(ValueError, match="vorticity"):
         p.validate()
+
+
+def test_params_ranges_are_what_validate_checks():
+    """SmokeParams.ranges() is the one definition of each bound: values at the bounds are
+    accepted, and a step past it is refused with a message naming the setting and that range."""
+    ranges = _native.SmokeParams.ranges()
+    assert ranges["resolution"] == (2, 1024)
+    assert {"cfl", "vorticity", "threads", "substeps", "pressure_tolerance"} <= set(ranges)
+    for name, (lo, hi) in ranges.items():
+        whole = isinstance(getattr(_native.SmokeParams(), name), (int, tuple))
+        # Float settings are float32 in the core: their bounds are tried a millionth inside.
+        inside = 0 if whole else 1e-6 * (hi - lo)
+        below = lo - (1 if whole else 1e-3 * max(1, abs(lo)))
+        for value, ok in ((lo + inside, True), (hi - inside, True), (below, False)):
+            p = _native.SmokeParams()
+            if name == "resolution":
+                p.resolution = (int(value), 8, 8)
+            else:
+                setattr(p, name, int(value) if whole else value)
+            if name in ("alpha", "beta", "ambient_temperature") or ok:
+                p.max_temperature = 2e6  # above any ambient temperature tried
+            if ok:
+                p.validate()
+            else:
+                message = re.escape(f"{name} must be in [{lo:g}, {hi:g}]")
+                with pytest.raises(ValueError, match=message):
+                    p.validate()
 
 
 def test_params_setter_errors():
