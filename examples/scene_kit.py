@@ -2,9 +2,12 @@
 add-on enabled, a dark studio (camera, sun, world), Cycles CPU settings, and a strip image of
 several rendered frames for the README.
 
-Import from an example run as ``blender -b --python examples/NAME.py``::
+The examples sit in one folder per pipeline (examples/<pipeline>/NAME.py, beside that
+pipeline's manual, README.md); this module and the other kits stay in examples/ so that every
+example imports them the same way, as its first lines after the standard imports::
 
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    HERE = os.path.dirname(os.path.abspath(__file__))
+    sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/
     import scene_kit
 """
 

@@ -1,6 +1,6 @@
 """Flames spreading over a board from a greyscale activation map: §6.2 of structural_flames.txt.
 
-    blender -b --factory-startup --python examples/flame_spread.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flames/flame_spread.py -- OUT_DIR [FRAMES]
 
 A wooden board (1.2 x 0.5 m) lies on the ground; it is a Flame Source of 48 flames (TORCH
 profile, r = 2.5 cm) with Spread = Maps. Its Activation Map, made here with numpy and saved as
@@ -22,12 +22,13 @@ import sys
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import flame_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "flame_spread"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py -- OUT_DIR [FRAMES]"
 DEFAULT_FRAMES = 60
 SHOW = (0.2, 0.45, 0.7, 0.95)
 MAP_SIZE = 64           # texels per side of the generated maps
