@@ -9,7 +9,7 @@ A = 0.5 s, rising as loose tongues of fire; merging (§4.5) is on, so neighbouri
 into one body. A light breeze from a Blender Wind force field leans the fire.
 
 Writes OUT_DIR/campfire_flames.blend (flames cache in OUT_DIR/plume_cache/flames),
-campfire_flames_####.png for a few frames and campfire_flames_strip.png (the README's image);
+campfire_flames_####.png for a few frames and campfire_flames_strip.png (the manual's image);
 prints the bake time per frame, the flames and particles per frame and the render time. Needs
 the Plume add-on (README).
 """

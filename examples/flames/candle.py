@@ -12,7 +12,7 @@ steadily), and a separated tip lives at most A = 1/12 s. The flame's light (§5.
 of radius h/3) is the only light of the room.
 
 Writes OUT_DIR/candle.blend (flames cache in OUT_DIR/plume_cache/flames), candle_####.png for a
-few frames and candle_strip.png (the README's image); prints the bake time per frame, the flames
+few frames and candle_strip.png (the manual's image); prints the bake time per frame, the flames
 and particles per frame and the render time. Needs the Plume add-on (README).
 """
 

@@ -13,7 +13,7 @@ breakaway frequency is raised to 20 Hz (the automatic 0.50 (g/2r)^½ is 3.9 Hz) 
 stylized, fast-shredding breath.
 
 Writes OUT_DIR/dragon_breath.blend (flames cache in OUT_DIR/plume_cache/flames),
-dragon_breath_####.png for a few frames and dragon_breath_strip.png (the README's image);
+dragon_breath_####.png for a few frames and dragon_breath_strip.png (the manual's image);
 prints the bake time per frame, the flame count per frame (Figure 5: 5 -> 80+), the particles
 per frame and the render time. Needs the Plume add-on (README).
 """

@@ -11,7 +11,7 @@ fire runs along the board from left to right, leaving it burnt out behind.
 
 Writes OUT_DIR/flame_spread.blend (flames cache in OUT_DIR/plume_cache/flames), the maps
 OUT_DIR/flame_spread_activation.png and _duration.png, flame_spread_####.png for a few frames
-and flame_spread_strip.png (the README's image); prints the bake time per frame, the burning
+and flame_spread_strip.png (the manual's image); prints the bake time per frame, the burning
 flames per frame (they rise as the front spreads, then fall as it burns out) and the render
 time. Needs the Plume add-on (README).
 """

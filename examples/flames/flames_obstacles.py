@@ -15,7 +15,7 @@ that carries the flames is then smoke-filled, and the flames read its velocity; 
 Volume is hidden from renders.
 
 Writes OUT_DIR/flames_obstacles.blend (caches in OUT_DIR/plume_cache), flames_obstacles_####.png
-for a few frames and flames_obstacles_strip.png (the README's image); prints the solver bake,
+for a few frames and flames_obstacles_strip.png (the manual's image); prints the solver bake,
 the flames bake time per frame, the flames and particles per frame and the render time. Needs
 the Plume add-on (README).
 """

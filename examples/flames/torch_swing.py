@@ -11,7 +11,7 @@ flames trail behind the torch and swap sides when it turns back. Buoyancy and Ko
 act on the control points as in Figure 1.
 
 Writes OUT_DIR/torch_swing.blend (flames cache in OUT_DIR/plume_cache/flames),
-torch_swing_####.png for a few frames and torch_swing_strip.png (the README's image); prints the
+torch_swing_####.png for a few frames and torch_swing_strip.png (the manual's image); prints the
 bake time per frame, the flames and particles per frame and the render time. Needs the Plume
 add-on (README).
 """

@@ -19,7 +19,7 @@ with Plume's fire material plays.
 
 Writes OUT_DIR/campfire.blend, the caches in OUT_DIR/plume_cache (the graph and the synthesized
 fire/fire_####.vdb with state 0), campfire_cost.png (the cost matrix), campfire_####.png for a
-few frames and campfire_strip.png (the README's images). Prints the bake time per state and per
+few frames and campfire_strip.png (the manual's images). Prints the bake time per state and per
 frame, the pathline files (size, bytes per node, RAM of the graph build), the graph build time,
 the synthesis and render times. Needs the Plume add-on installed (README). The synthesis cost
 split and its ratio to the simulation: examples/flowgraph_fire/flowgraph_speed.py OUT_DIR after

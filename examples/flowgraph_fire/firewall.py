@@ -13,7 +13,7 @@ graph for FRAMES frames (default 400), keyed to stay in the low state for the fi
 shot and then steered into the high one (§5.1).
 
 Writes OUT_DIR/firewall.blend, the caches in OUT_DIR/plume_cache, firewall_cost.png,
-firewall_####.png for a few frames and firewall_strip.png (the README's images); prints the
+firewall_####.png for a few frames and firewall_strip.png (the manual's images); prints the
 bake, graph, synthesis and render times. Needs the Plume add-on installed (README).
 """
 

@@ -12,7 +12,7 @@ Source Mesh, baked and built three ways, the same frame rendered each time:
 The paper: (a) "too opaque and thick", (b) better but "unpredictable depending on the user
 skill", (c) a consistent semi-transparent look.
 
-Writes OUT_DIR/figure3.blend, figure3_{a,b,c}.png and figure3_strip.png (the README's image), and
+Writes OUT_DIR/figure3.blend, figure3_{a,b,c}.png and figure3_strip.png (the manual's image), and
 prints the surfaces and times of each. Needs the Plume add-on installed (README).
 """
 

@@ -14,7 +14,7 @@ them in Cycles (the add-on's Fast Sheet Render) with the density opacity map p =
 (§3.4).
 
 Writes OUT_DIR/incense.blend, the cache in OUT_DIR/plume_cache, incense_####.png for a few frames
-and incense_strip.png (those frames side by side, the README's image). Prints the bake, build and
+and incense_strip.png (those frames side by side, the manual's image). Prints the bake, build and
 render times and the surfaces found. Needs the Plume add-on installed (README).
 """
 

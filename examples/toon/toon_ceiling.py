@@ -14,7 +14,7 @@ give the big puffy shapes, where a particle born in every dense cell (the paper'
 
 Writes OUT_DIR/toon_ceiling.blend (cache in OUT_DIR/plume_cache), toon_ceiling_speed_####.png
 and toon_ceiling_white_####.png for a few frames and toon_ceiling_strip.png (the two rows, the
-README's image); prints the bake, build and render times. Needs the Plume add-on (README).
+manual's image); prints the bake, build and render times. Needs the Plume add-on (README).
 """
 
 import os

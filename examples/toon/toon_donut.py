@@ -11,7 +11,7 @@ is denser than 0.3, 0.8 stencil sizes apart, so the ring stays whole as it sprea
 topology change; the camera looks at the ring's plane at an angle, so the hole shows.
 
 Writes OUT_DIR/toon_donut.blend (cache in OUT_DIR/plume_cache), toon_donut_####.png for a few
-frames and toon_donut_strip.png (the README's image); prints the bake, build and render times.
+frames and toon_donut_strip.png (the manual's image); prints the bake, build and render times.
 Needs the Plume add-on (README).
 """
 

@@ -16,7 +16,7 @@ where the smoke is denser than 0.3, 0.8 stencil sizes apart, which keeps the slu
 whole. The floor is drawn as a flat box.
 
 Writes OUT_DIR/toon_explosion.blend (cache in OUT_DIR/plume_cache), toon_explosion_####.png for
-a few frames and toon_explosion_strip.png (the README's image); prints the bake, build and
+a few frames and toon_explosion_strip.png (the manual's image); prints the bake, build and
 render times. Needs the Plume add-on (README).
 """
 

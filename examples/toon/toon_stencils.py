@@ -13,7 +13,7 @@ stencil, and the middle frame of the shot is rendered with each. The strip's top
 puff drawn with it.
 
 Writes OUT_DIR/toon_stencils.blend (cache in OUT_DIR/plume_cache), toon_stencils_<kind>_####.png,
-stencil_<kind>.png and toon_stencils_strip.png (the README's image); prints the bake, build and
+stencil_<kind>.png and toon_stencils_strip.png (the manual's image); prints the bake, build and
 render times. Needs the Plume add-on (README).
 """
 
