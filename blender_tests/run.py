@@ -5,7 +5,7 @@
     blender_tests/run.py --blender 5.0 test_bake.py -- BakeTest.test_cache_free
     blender_tests/run.py --blender all                          # every file in every Blender
     blender_tests/run.py --setup all                            # create the bpy venvs only
-    blender_tests/run.py --blender 4.5 --script examples/compare_mantaflow.py -- 64 48
+    blender_tests/run.py --blender 4.5 --script examples/smoke/compare_mantaflow.py -- 64 48
 
 Blenders: "3.4" is Debian 12's packaged 3.4.1 (``blender -b --factory-startup``); "4.5" and "5.0"
 are the ``bpy`` wheels from the Python package index, pinned below, each in its own CPython 3.11

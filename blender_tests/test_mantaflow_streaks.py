@@ -1,9 +1,10 @@
-"""Streak surfaces driven by a Blender Mantaflow cache (issue 4; smoke_surfaces.txt §3.2): a
-Quick Smoke domain (resolution 32, 20 frames, OpenVDB) is baked once by Mantaflow; a Plume domain
-with motion_source 'MANTAFLOW' traces it (no Plume simulation) and plume.surfaces_build makes
-surfaces from the result; plume.toon_build makes toon smoke from it (issue 5). The particles rise with the Mantaflow smoke and stay in it, checked
-against Blender's own reading of the cache. Bad input (no Mantaflow domain set, a domain not
-baked, a cache in another format) gives a clear error and writes nothing.
+"""Streak surfaces driven by a Blender Mantaflow cache (smoke_surfaces.txt §3.2): a Quick Smoke
+domain (resolution 32, 20 frames, OpenVDB) is baked once by Mantaflow; a Plume domain with
+motion_source 'MANTAFLOW' traces it (no Plume simulation) and plume.surfaces_build makes surfaces
+from the result; plume.toon_build makes toon smoke from it (cartoon_smoke.txt). The particles rise
+with the Mantaflow smoke and stay in it, checked against Blender's own reading of the cache. Bad
+input (no Mantaflow domain set, a domain not baked, a cache in another format) gives a clear error
+and writes nothing.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_mantaflow_streaks.py
@@ -212,7 +213,7 @@ class MantaflowStreaksTest(unittest.TestCase):
         self.expect_error(dom, "cache_data_format is UNI", "OpenVDB")
 
     def test_toon_smoke_follows_the_mantaflow_smoke(self):
-        """Issue 5: toon smoke from a Mantaflow cache. With streak surfaces off the bake only
+        """Toon smoke from a Mantaflow cache. With streak surfaces off the bake only
         places the Mantaflow frames; plume.toon_build resamples them onto cubic cells (the
         Mantaflow cells are not cubic) and its particles sit in Mantaflow's smoke."""
         dom = plume_domain("ToonTraced", self.tmp, self.manta)

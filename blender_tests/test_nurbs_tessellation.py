@@ -1,11 +1,12 @@
 """The surface Blender tessellates is the core's surface (smoke_surfaces.txt §3.3).
 
-For 2, 3, 5 and 11 streaklines of 1, 2, 3, 4 and 7 particles, with endpoint and uniform knots:
-the core interpolates the particles (plume._native.interpolate_surface), a SURFACE object is built
-from its control points by the add-on's builder (BLENDER_NOTES.md §2), and the vertices of the object's
-evaluated mesh must equal plume._native.tessellate() (<= 1e-4 of the domain size). The same for
-least-squares nets with fewer control points than particles (plume._native.fit_surface, what
-Build Surfaces makes), orders 4, 3 and 2 across the streaklines.
+For 2, 3, 5 and 11 streaklines of 1, 2, 3, 4 and 7 particles, with endpoint and uniform knots: the
+core interpolates the particles (plume._native.interpolate_surface), a SURFACE object is built from
+its control points by the add-on's builder (nu NURBS rows of nv points joined by Make Segment into
+one net), and the vertices of the object's evaluated mesh must equal plume._native.tessellate()
+(<= 1e-4 of the domain size). The same for least-squares nets with fewer control points than
+particles (plume._native.fit_surface, what Build Surfaces makes), orders 4, 3 and 2 across the
+streaklines.
 
 Uses the installed add-on's native module (CI installs the fresh build before running this).
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
@@ -40,9 +41,9 @@ def particles(nv, nu, seed):
 
 
 def surface_object(name, surface, resolution_u, resolution_v):
-    """A SURFACE object with the core's control net, made by the add-on's own builder (the
-    BLENDER_NOTES.md §2 recipe, with its 2-streakline workaround), so the test checks the objects
-    Build Surfaces makes."""
+    """A SURFACE object with the core's control net, made by the add-on's own builder (rows joined
+    by Make Segment; with 2 streaklines, which 3.4.1 leaves unmerged, one row extruded once), so
+    the test checks the objects Build Surfaces makes."""
     from plume.build.surfaces import surface_object as make_net
     nu, nv = surface["nu"], surface["nv"]
     ob = make_net(name, bpy.context.scene.collection, nu, nv, bpy.context.view_layer)

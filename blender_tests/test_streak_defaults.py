@@ -25,7 +25,7 @@ FRAMES = 3
 
 
 def artist_scene(cache_dir, frame_end=FRAMES):
-    """The issue's scene: defaults everywhere but Streak Surfaces on."""
+    """The newcomer's sphere scene: defaults everywhere but Streak Surfaces on."""
     add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35))
     dom = add_domain(resolution=40, frame_end=frame_end, cache_directory=cache_dir + "/")
     dom.plume.domain.streaks = True

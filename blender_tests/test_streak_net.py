@@ -1,7 +1,8 @@
-"""The streak surfaces' control nets stay on the smoke (issue 14: smoke_surfaces.txt §3.3 as a
+"""The streak surfaces' control nets stay on the smoke (smoke_surfaces.txt §3.3 as a
 least-squares fit instead of an interpolation of every particle slot).
 
-Three bakes: the Figure 1 example itself (examples/incense.py's make_source and make_domain:
+Three bakes: the Figure 1 example itself (make_source and make_domain of
+examples/streak_surfaces/incense.py:
 50³, one tip cell with 20 point sources, its 120 frames, the Most Surfaces threshold), where the
 top of the plume scatters late in the shot and the nets drop to order 2 along the streaklines;
 the same set-up reduced to 40 frames; and a 2 m domain at 40³ with a UV-sphere Source of radius
@@ -26,7 +27,7 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-sys.path.insert(0, os.path.join(os.path.dirname(HERE), "examples"))
+sys.path.insert(0, os.path.join(os.path.dirname(HERE), "examples", "streak_surfaces"))  # incense
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -126,7 +127,8 @@ class StreakNetTest(unittest.TestCase):
         return fig
 
     def incense(self, frames):
-        """The set-up of examples/incense.py (its own functions) over `frames` frames."""
+        """The set-up of examples/streak_surfaces/incense.py (its own functions) over `frames`
+        frames."""
         import incense
         incense.make_source(frames)
         dom = incense.make_domain(frames)

@@ -6,14 +6,14 @@ inside the cell; on a disc of cells the ring lies RADIUS of the way out, one poi
 of its length, each inside a source cell; a flow along x puts the ring across x; a hollow source
 keeps every point in a source cell; arcs are consecutive candidate groups of about ARC_POINTS.
 
-The issue's scene (a 2 m domain at 40³, a UV sphere of radius 0.25 m as the Source, 60 frames,
-every default) rendered at frame 60 by Fast Sheet Render, alpha kept (film transparent), seen
-from the front: the sheets cover the column, and they are translucent with the paper's contour
-(§3.4: p = d e^(−|n·v|), brighter where the sheet turns away): across the middle of the column
-the alpha at its centre is below 0.8 and the brightest alpha of the row is above it. The same
-scene with Placement Cells (256 random streaklines, all in one sheet folded across the column)
-is rendered too: its centre alpha is printed, and must be above the rim's (the picture the rim
-replaces: a solid white column).
+The newcomer's sphere scene (a 2 m domain at 40³, a UV sphere of radius 0.25 m as the Source, 60
+frames, every default) rendered at frame 60 by Fast Sheet Render, alpha kept (film transparent),
+seen from the front: the sheets cover the column, and they are translucent with the paper's contour
+(§3.4: p = d e^(−|n·v|), brighter where the sheet turns away): across the middle of the column the
+alpha at its centre is below 0.8 and the brightest alpha of the row is above it. The same scene with
+Placement Cells (256 random streaklines, all in one sheet folded across the column) is rendered too:
+its centre alpha is printed, and must be above the rim's (the picture the rim replaces: a solid
+white column).
 
 Run: blender_tests/run.py --blender {3.4,4.5,5.0} test_streak_rim.py
 """
@@ -124,8 +124,9 @@ class PointRimTest(unittest.TestCase):
         self.assertEqual(pr.arc_count(6, 64), 3)  # two streaklines an arc at least
 
     def render_alpha(self, placement):
-        """Bake + Build Surfaces of the issue's scene with `placement`, Fast Sheet Render of
-        frame 60 from the front, film transparent: alpha (HEIGHT, WIDTH), rows bottom up."""
+        """Bake + Build Surfaces of the newcomer's sphere scene with `placement`, Fast Sheet
+        Render of frame 60 from the front, film transparent: alpha (HEIGHT, WIDTH), rows bottom
+        up."""
         reset_scene()
         src = add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35))
         src.plume.source.point_placement = placement

@@ -68,7 +68,8 @@ def manifest(folder):
 
 def key_source(src, keys):
     """CONSTANT keys (frame, on) on the source's density (1 or 0) and emit_particles, as in
-    Figure 10, written as F-curves of a new action (examples/sphere_collision.py keys them with
+    Figure 10, written as F-curves of a new action (examples/streak_surfaces/sphere_collision.py
+    keys them with
     keyframe_insert)."""
     action = bpy.data.actions.new("SourceKeys")
     src.animation_data_create().action = action

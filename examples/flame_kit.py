@@ -1,9 +1,10 @@
-"""Shared pieces of the structural-flames examples (structural_flames.txt, issue 7), run inside
+"""Shared pieces of the structural-flames examples (structural_flames.txt), run inside
 Blender: a Flame Source made through the operators an artist clicks, simple solid materials,
 the bake (plume.flames_bake) with its per-frame figures, and the render of a few frames into a
-strip. Builds on scene_kit.
+strip. Builds on scene_kit. Imported by the examples in examples/flames/::
 
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    HERE = os.path.dirname(os.path.abspath(__file__))
+    sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/
     import flame_kit
 """
 

@@ -1,10 +1,13 @@
 """Shared pieces of the example scripts (run inside Blender): arguments, an empty scene with the
 add-on enabled, a dark studio (camera, sun, world), Cycles CPU settings, and a strip image of
-several rendered frames for the README.
+several rendered frames for the manuals.
 
-Import from an example run as ``blender -b --python examples/NAME.py``::
+The examples sit in one folder per pipeline (examples/<pipeline>/NAME.py, beside that
+pipeline's manual, README.md); this module and the other kits stay in examples/ so that every
+example imports them the same way, as its first lines after the standard imports::
 
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    HERE = os.path.dirname(os.path.abspath(__file__))
+    sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/
     import scene_kit
 """
 
@@ -434,7 +437,7 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     cycles(scene, 400, 220, 64, os.path.join(out_dir, tag + "_"))
     plain_world(scene, (0.002, 0.002, 0.003))
     # Filmic in every Blender (3.4's default; 4.x/5.x default to AgX, which renders the blackbody
-    # fire salmon-pink instead of orange-yellow): the README's strips are reproducible in each.
+    # fire salmon-pink instead of orange-yellow): the manuals' strips are reproducible in each.
     scene.view_settings.view_transform = 'Filmic'
     keys = [(max(1, round(f * frames)), state) for f, state in targets]
     scene.frame_start, scene.frame_end = 1, frames

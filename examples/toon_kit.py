@@ -1,9 +1,10 @@
 """Shared pieces of the toon-smoke examples (cartoon_smoke.txt), run inside Blender: the flat
 toon look in Cycles, Sources that blow a burst, the toon settings the examples share (puffs),
 the bake and Build Toon Smoke through the artist's operators, and the render of a few frames
-into a strip with the times. Builds on scene_kit.
+into a strip with the times. Builds on scene_kit. Imported by the examples in examples/toon/::
 
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    HERE = os.path.dirname(os.path.abspath(__file__))
+    sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/
     import toon_kit
 """
 

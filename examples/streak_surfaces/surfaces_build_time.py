@@ -1,12 +1,12 @@
-"""Build Surfaces on the issue's scene, timed through the add-on's own operator: a 2 m domain at
-40³, a UV sphere of radius 0.25 m as the Source, Streak Surfaces on, every other setting at its
-default, 60 frames; Max Streaklines set to each COUNT in turn (default 256, 1024 and 4096; 256 is
-the add-on's default). Prints, per count, the bake and Build Surfaces times, the surfaces built,
-the forecast the operator said before it started (surfaces_forecast.py) and the ratio of the
-time to the forecast.
+"""Build Surfaces on the newcomer's sphere scene, timed through the add-on's own operator: a 2 m
+domain at 40³, a UV sphere of radius 0.25 m as the Source, Streak Surfaces on, every other setting
+at its default, 60 frames; Max Streaklines set to each COUNT in turn (default 256, 1024 and
+4096; 256 is the add-on's default). Prints, per count, the bake and Build Surfaces times, the
+surfaces built, the forecast the operator said before it started (surfaces_forecast.py) and the
+ratio of the time to the forecast.
 
-    blender -b --factory-startup --python examples/surfaces_build_time.py -- OUT_DIR [COUNT...]
-    blender_tests/run.py --blender 4.5 --script examples/surfaces_build_time.py -- OUT_DIR
+    blender -b --factory-startup --python examples/streak_surfaces/surfaces_build_time.py -- OUT_DIR [COUNT...]
+    blender_tests/run.py --blender 4.5 --script examples/streak_surfaces/surfaces_build_time.py -- OUT_DIR
 """
 
 import os
@@ -15,11 +15,12 @@ import time
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 
-USAGE = ("usage: blender -b --factory-startup --python examples/surfaces_build_time.py -- OUT_DIR "
-         "[COUNT...]")
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/streak_surfaces/surfaces_build_time.py -- OUT_DIR [COUNT...]")
 FRAMES = 60
 
 

@@ -1,6 +1,6 @@
 """Toon smoke rushing up into a ceiling: Figure 7 of cartoon_smoke.txt.
 
-    blender -b --factory-startup --python examples/toon_ceiling.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/toon/toon_ceiling.py -- OUT_DIR [FRAMES]
 
 The paper's grid, 40 x 40 x 80 cells (its 40x80x40 with y up) over a 1 x 1 x 2 m room (closed
 walls and ceiling); a source at the floor emits hot smoke upwards at 2.5 m/s. The smoke hits the
@@ -14,7 +14,7 @@ give the big puffy shapes, where a particle born in every dense cell (the paper'
 
 Writes OUT_DIR/toon_ceiling.blend (cache in OUT_DIR/plume_cache), toon_ceiling_speed_####.png
 and toon_ceiling_white_####.png for a few frames and toon_ceiling_strip.png (the two rows, the
-README's image); prints the bake, build and render times. Needs the Plume add-on (README).
+manual's image); prints the bake, build and render times. Needs the Plume add-on (README).
 """
 
 import os
@@ -22,12 +22,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 import toon_kit  # noqa: E402
 
 TAG = "toon_ceiling"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/toon/{TAG}.py -- OUT_DIR [FRAMES]"
 RESOLUTION = 80            # cells on the longest (vertical) axis: 40 x 40 x 80
 DEFAULT_FRAMES = 60
 SHOW = (0.3, 0.5, 0.75, 1.0)  # rendered frames, as fractions of the shot

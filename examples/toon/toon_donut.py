@@ -1,6 +1,6 @@
 """Two puffs of smoke propelled at each other form a donut: Figure 5 of cartoon_smoke.txt.
 
-    blender -b --factory-startup --python examples/toon_donut.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/toon/toon_donut.py -- OUT_DIR [FRAMES]
 
 Two spherical Sources face each other across a 1.2 m domain (64³, open on every side, no
 buoyancy) and blow smoke at each other at 3 m/s for the first 5 frames only (their density and
@@ -11,19 +11,20 @@ is denser than 0.3, 0.8 stencil sizes apart, so the ring stays whole as it sprea
 topology change; the camera looks at the ring's plane at an angle, so the hole shows.
 
 Writes OUT_DIR/toon_donut.blend (cache in OUT_DIR/plume_cache), toon_donut_####.png for a few
-frames and toon_donut_strip.png (the README's image); prints the bake, build and render times.
+frames and toon_donut_strip.png (the manual's image); prints the bake, build and render times.
 Needs the Plume add-on (README).
 """
 
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 import toon_kit  # noqa: E402
 
 TAG = "toon_donut"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/toon/{TAG}.py -- OUT_DIR [FRAMES]"
 RESOLUTION = 64
 DEFAULT_FRAMES = 40
 BURST_FRAMES = 5           # frames the sources blow

@@ -1,6 +1,6 @@
 """A burning torch waved through the air: Figure 1 of structural_flames.txt.
 
-    blender -b --factory-startup --python examples/torch_swing.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flames/torch_swing.py -- OUT_DIR [FRAMES]
 
 A torch (a wooden handle under a 4 cm head) is keyed to swing left, right and back along a
 low arc, about 1.5 m/s at the bottom of the swing. Its head is the Flame Source: 5 flames of
@@ -11,7 +11,7 @@ flames trail behind the torch and swap sides when it turns back. Buoyancy and Ko
 act on the control points as in Figure 1.
 
 Writes OUT_DIR/torch_swing.blend (flames cache in OUT_DIR/plume_cache/flames),
-torch_swing_####.png for a few frames and torch_swing_strip.png (the README's image); prints the
+torch_swing_####.png for a few frames and torch_swing_strip.png (the manual's image); prints the
 bake time per frame, the flames and particles per frame and the render time. Needs the Plume
 add-on (README).
 """
@@ -21,12 +21,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import flame_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "torch_swing"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py -- OUT_DIR [FRAMES]"
 DEFAULT_FRAMES = 40
 SHOW = (0.3, 0.5, 0.65, 0.9)
 HEAD_Z = 1.0            # m, height of the torch head at the ends of the swing

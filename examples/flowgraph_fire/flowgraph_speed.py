@@ -1,11 +1,11 @@
-"""Synthesis against simulation, per frame, at the campfire's 128 x 64 x 64 grid (issue 6,
-Performance: "synthesizing a frame is >= 100x cheaper than simulating it"; the paper's Table 1
-and Figure 7 found ~12x).
+"""Synthesis against simulation, per frame, at the campfire's 128 x 64 x 64 grid (the target:
+synthesizing a frame is at least 100x cheaper than simulating it; the paper's Table 1 and
+Figure 7 found ~12x).
 
-    blender -b --factory-startup --python examples/flowgraph_speed.py -- CAMPFIRE_DIR [REPEATS]
+    blender -b --factory-startup --python examples/flowgraph_fire/flowgraph_speed.py -- CAMPFIRE_DIR [REPEATS]
 
-Opens CAMPFIRE_DIR/campfire.blend (run examples/campfire.py first) and, REPEATS times (default
-2), best of each:
+Opens CAMPFIRE_DIR/campfire.blend (run examples/flowgraph_fire/campfire.py first) and, REPEATS
+times (default 2), best of each:
 - synthesis: Synthesize Fire again with the saved settings (same seed and keys: the same
   frames are written again), without the group cache, then with it (2 GB) cold and warm (the
   add-on keeps a graph's prepared groups for the session, so synthesizing again reads none),
@@ -21,12 +21,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import campfire  # noqa: E402
 import scene_kit  # noqa: E402
 
-USAGE = ("usage: blender -b --factory-startup --python examples/flowgraph_speed.py -- "
-         "CAMPFIRE_DIR [REPEATS]")
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/flowgraph_fire/flowgraph_speed.py -- CAMPFIRE_DIR [REPEATS]")
 
 
 def synthesis_runs(keeper, runs, group_cache_mb):

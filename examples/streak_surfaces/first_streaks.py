@@ -1,8 +1,8 @@
 """A newcomer's first Streak Surfaces, every setting at its default: a 2 m domain at 40³, a UV
 sphere of radius 0.25 m as the Source, 60 frames; Bake, Build Surfaces, Fast Sheet Render.
 
-    blender -b --factory-startup --python examples/first_streaks.py -- OUT_DIR
-    blender_tests/run.py --blender 4.5 --script examples/first_streaks.py -- OUT_DIR
+    blender -b --factory-startup --python examples/streak_surfaces/first_streaks.py -- OUT_DIR
+    blender_tests/run.py --blender 4.5 --script examples/streak_surfaces/first_streaks.py -- OUT_DIR
 
 Renders frame 60 three ways from the same bake, side by side in OUT_DIR/first_streaks_strip.png:
 - the defaults: point sources on a rim around the Source (addon/point_rim.py), a few sheets;
@@ -18,10 +18,12 @@ import time
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 
-USAGE = "usage: blender -b --factory-startup --python examples/first_streaks.py -- OUT_DIR"
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/streak_surfaces/first_streaks.py -- OUT_DIR")
 WIDTH, HEIGHT = 240, 320
 FRAMES, SHOWN = 60, 60
 

@@ -1,7 +1,7 @@
 """One candle flame in a dark room (structural_flames.txt §4.3-4.4, the CANDLE profile of
 Figure 3).
 
-    blender -b --factory-startup --python examples/candle.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flames/candle.py -- OUT_DIR [FRAMES]
 
 A wax cylinder (2.4 cm across) stands on a table in front of a wall; its wick is the Flame
 Source: one flame of source radius r = 5 mm, CANDLE profile. A real candle flame is steady: it
@@ -12,7 +12,7 @@ steadily), and a separated tip lives at most A = 1/12 s. The flame's light (§5.
 of radius h/3) is the only light of the room.
 
 Writes OUT_DIR/candle.blend (flames cache in OUT_DIR/plume_cache/flames), candle_####.png for a
-few frames and candle_strip.png (the README's image); prints the bake time per frame, the flames
+few frames and candle_strip.png (the manual's image); prints the bake time per frame, the flames
 and particles per frame and the render time. Needs the Plume add-on (README).
 """
 
@@ -21,12 +21,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import flame_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "candle"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py -- OUT_DIR [FRAMES]"
 DEFAULT_FRAMES = 48
 SHOW = (0.25, 0.5, 0.75, 1.0)
 WAX_RADIUS, WAX_HEIGHT = 0.012, 0.08   # m

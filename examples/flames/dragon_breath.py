@@ -1,6 +1,6 @@
 """Dragon's breath: Figure 5 of structural_flames.txt, five flames splitting into dozens.
 
-    blender -b --factory-startup --python examples/dragon_breath.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flames/dragon_breath.py -- OUT_DIR [FRAMES]
 
 A dark dragon's head (a cone) breathes from its mouth, a small sphere that is the Flame Source:
 5 flames of source radius r = 8 cm, TORCH profile. As in §7, the flames leave the mouth with a
@@ -13,7 +13,7 @@ breakaway frequency is raised to 20 Hz (the automatic 0.50 (g/2r)^½ is 3.9 Hz) 
 stylized, fast-shredding breath.
 
 Writes OUT_DIR/dragon_breath.blend (flames cache in OUT_DIR/plume_cache/flames),
-dragon_breath_####.png for a few frames and dragon_breath_strip.png (the README's image);
+dragon_breath_####.png for a few frames and dragon_breath_strip.png (the manual's image);
 prints the bake time per frame, the flame count per frame (Figure 5: 5 -> 80+), the particles
 per frame and the render time. Needs the Plume add-on (README).
 """
@@ -24,12 +24,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import flame_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "dragon_breath"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py -- OUT_DIR [FRAMES]"
 DEFAULT_FRAMES = 60
 SHOW = (0.25, 0.5, 0.75, 1.0)
 MOUTH = (-1.2, 0.0, 1.0)

@@ -1,7 +1,7 @@
-"""Render time of one toon smoke frame at 640x480 with and without the outlines (issue 5; the
+"""Render time of one toon smoke frame at 640x480 with and without the outlines (the
 paper: about 1 s per 640x480 frame for its renderer, after 3 s of simulation per frame).
 
-    blender -b --factory-startup --python examples/toon_render_time.py -- BLEND [FRAME] [REPEATS]
+    blender -b --factory-startup --python examples/toon/toon_render_time.py -- BLEND [FRAME] [REPEATS]
 
 BLEND is a .blend written by one of the toon examples (toon_ceiling.py, toon_donut.py,
 toon_explosion.py) after its bake and Build Toon Smoke. Renders FRAME (default: the scene's
@@ -19,7 +19,7 @@ import time
 import addon_utils
 import bpy
 
-USAGE = ("usage: blender -b --factory-startup --python examples/toon_render_time.py -- BLEND "
+USAGE = ("usage: blender -b --factory-startup --python examples/toon/toon_render_time.py -- BLEND "
          "[FRAME] [REPEATS]")
 
 

@@ -1,6 +1,6 @@
 """Incense smoke as streak surfaces: the setup of Figure 1 of smoke_surfaces.txt.
 
-    blender -b --factory-startup --python examples/incense.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/streak_surfaces/incense.py -- OUT_DIR [FRAMES]
 
 A 50³ domain (1 m cube on the floor, 2 cm cells), a glowing incense tip as the source: one source
 cell holding 20 random point sources (the paper's "twenty point sources"), one particle per
@@ -14,7 +14,7 @@ them in Cycles (the add-on's Fast Sheet Render) with the density opacity map p =
 (§3.4).
 
 Writes OUT_DIR/incense.blend, the cache in OUT_DIR/plume_cache, incense_####.png for a few frames
-and incense_strip.png (those frames side by side, the README's image). Prints the bake, build and
+and incense_strip.png (those frames side by side, the manual's image). Prints the bake, build and
 render times and the surfaces found. Needs the Plume add-on installed (README).
 """
 
@@ -25,10 +25,12 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 
-USAGE = "usage: blender -b --factory-startup --python examples/incense.py -- OUT_DIR [FRAMES]"
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/streak_surfaces/incense.py -- OUT_DIR [FRAMES]")
 RESOLUTION = 50            # the paper's 50³ grid
 POINT_SOURCES = 20         # in the one source cell (§3.2: 10-20 per source cell)
 DEFAULT_FRAMES = 120
@@ -100,7 +102,7 @@ def main():
 
     bake_s, build_s, h0, surfaces = scene_kit.bake_surfaces(dom, "incense")
     # The sheets shade themselves (§3.4): 16 samples and no light bounces give the same picture
-    # as 64 samples with bounces, several times faster (examples/sheet_render_time.py).
+    # as 64 samples with bounces, several times faster (sheet_render_time.py beside this file).
     assert bpy.ops.plume.surfaces_fast_render() == {'FINISHED'}
     shown = sorted({max(1, min(frames, round(f * frames))) for f in SHOW})
     render_s, strip = scene_kit.render_strip(scene, shown, out_dir, "incense")

@@ -1,8 +1,9 @@
-"""How long a streak-sheet frame takes to render: the incense of Figure 1 (examples/incense.py,
-its 120 frames) at 640 x 480, frame 84, in three set-ups, with the difference from the first.
+"""How long a streak-sheet frame takes to render: the incense of Figure 1 (incense.py beside this
+file, its 120 frames) at 640 x 480, frame 84, in three set-ups, with the difference from the
+first.
 
-    blender -b --factory-startup --python examples/sheet_render_time.py -- OUT_DIR [FRAMES]
-    blender_tests/run.py --blender 4.5 --script examples/sheet_render_time.py -- OUT_DIR
+    blender -b --factory-startup --python examples/streak_surfaces/sheet_render_time.py -- OUT_DIR [FRAMES]
+    blender_tests/run.py --blender 4.5 --script examples/streak_surfaces/sheet_render_time.py -- OUT_DIR
 
 - Cycles as the example rendered before: 64 samples, Blender's default light bounces, 64
   transparent bounces;
@@ -24,12 +25,13 @@ import time
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import incense  # noqa: E402
 import scene_kit  # noqa: E402
 
-USAGE = ("usage: blender -b --factory-startup --python examples/sheet_render_time.py -- OUT_DIR "
-         "[FRAMES]")
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/streak_surfaces/sheet_render_time.py -- OUT_DIR [FRAMES]")
 WIDTH, HEIGHT = 640, 480
 FRAME_SHARE = 0.7  # frame 84 of 120
 

@@ -1,7 +1,7 @@
 """The three stencils of Figure 3 of cartoon_smoke.txt: circle, puffy cloud and hairy cloud, and
 the same puff of smoke drawn with each.
 
-    blender -b --factory-startup --python examples/toon_stencils.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/toon/toon_stencils.py -- OUT_DIR [FRAMES]
 
 A spherical Source at the bottom of a 1.2 m domain (48³, open on every side but the floor)
 blows hot smoke upwards at 2 m/s for its first 8 frames (density, temperature and velocity
@@ -13,7 +13,7 @@ stencil, and the middle frame of the shot is rendered with each. The strip's top
 puff drawn with it.
 
 Writes OUT_DIR/toon_stencils.blend (cache in OUT_DIR/plume_cache), toon_stencils_<kind>_####.png,
-stencil_<kind>.png and toon_stencils_strip.png (the README's image); prints the bake, build and
+stencil_<kind>.png and toon_stencils_strip.png (the manual's image); prints the bake, build and
 render times. Needs the Plume add-on (README).
 """
 
@@ -23,12 +23,13 @@ import sys
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 import toon_kit  # noqa: E402
 
 TAG = "toon_stencils"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/toon/{TAG}.py -- OUT_DIR [FRAMES]"
 RESOLUTION = 48
 DEFAULT_FRAMES = 20
 BURST_FRAMES = 10

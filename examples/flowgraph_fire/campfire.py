@@ -1,7 +1,7 @@
 """A campfire in three wind strengths, synthesized for as long as you like: the campfire of
 graph_fire_synthesis.txt (Table 1, Figure 1).
 
-    blender -b --factory-startup --python examples/campfire.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flowgraph_fire/campfire.py -- OUT_DIR [FRAMES]
 
 Three fire domains on the same 2 x 1 x 1 m box at 128 x 64 x 64 (Table 1's grid) are the three
 states, in name order: "State0 Calm" (no wind), "State1 Breeze" and "State2 Gale" (the air is
@@ -19,10 +19,11 @@ with Plume's fire material plays.
 
 Writes OUT_DIR/campfire.blend, the caches in OUT_DIR/plume_cache (the graph and the synthesized
 fire/fire_####.vdb with state 0), campfire_cost.png (the cost matrix), campfire_####.png for a
-few frames and campfire_strip.png (the README's images). Prints the bake time per state and per
+few frames and campfire_strip.png (the manual's images). Prints the bake time per state and per
 frame, the pathline files (size, bytes per node, RAM of the graph build), the graph build time,
 the synthesis and render times. Needs the Plume add-on installed (README). The synthesis cost
-split and its ratio to the simulation: examples/flowgraph_speed.py OUT_DIR after this.
+split and its ratio to the simulation: examples/flowgraph_fire/flowgraph_speed.py OUT_DIR after
+this.
 """
 
 import math
@@ -31,11 +32,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 
 TAG = "campfire"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = (f"usage: blender -b --factory-startup --python examples/flowgraph_fire/{TAG}.py -- "
+         "OUT_DIR [FRAMES]")
 RESOLUTION = 128               # cells along x: 128 x 64 x 64 (Table 1)
 BOX = (2.0, 1.0, 1.0)          # m; the floor at z = 0
 CENTRE = (0.0, 0.0, 0.5)

@@ -1,7 +1,7 @@
 """An explosion that propels smoke sideways until it cools and falls: Figure 6 of
 cartoon_smoke.txt, darkness from speed.
 
-    blender -b --factory-startup --python examples/toon_explosion.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/toon/toon_explosion.py -- OUT_DIR [FRAMES]
 
 A 2.4 x 1.2 x 1.6 m domain (64 x 32 x 43 cells, open on every side but the floor). A Source
 at the left end blows hot smoke sideways at 6 m/s for the first 4 frames only (its density,
@@ -16,19 +16,20 @@ where the smoke is denser than 0.3, 0.8 stencil sizes apart, which keeps the slu
 whole. The floor is drawn as a flat box.
 
 Writes OUT_DIR/toon_explosion.blend (cache in OUT_DIR/plume_cache), toon_explosion_####.png for
-a few frames and toon_explosion_strip.png (the README's image); prints the bake, build and
+a few frames and toon_explosion_strip.png (the manual's image); prints the bake, build and
 render times. Needs the Plume add-on (README).
 """
 
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 import toon_kit  # noqa: E402
 
 TAG = "toon_explosion"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/toon/{TAG}.py -- OUT_DIR [FRAMES]"
 RESOLUTION = 64            # cells on the longest axis: 64 x 32 x 32
 DEFAULT_FRAMES = 48
 BURST_FRAMES = 4           # frames the source blows

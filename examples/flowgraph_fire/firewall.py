@@ -1,7 +1,7 @@
 """A wall of fire going from low to high turbulence: the fire wall of graph_fire_synthesis.txt
 (§5.4, Table 1), synthesized from two short bakes.
 
-    blender -b --factory-startup --python examples/firewall.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flowgraph_fire/firewall.py -- OUT_DIR [FRAMES]
 
 A long, thin line of fuel (1.6 m x 2.5 cm on the floor: eight Sources, each with its own feed
 repeating every 8 frames) burns in a 2 x 0.5 x 1 m box at 128 x 32 x 64. Two fire domains on
@@ -13,7 +13,7 @@ graph for FRAMES frames (default 400), keyed to stay in the low state for the fi
 shot and then steered into the high one (§5.1).
 
 Writes OUT_DIR/firewall.blend, the caches in OUT_DIR/plume_cache, firewall_cost.png,
-firewall_####.png for a few frames and firewall_strip.png (the README's images); prints the
+firewall_####.png for a few frames and firewall_strip.png (the manual's images); prints the
 bake, graph, synthesis and render times. Needs the Plume add-on installed (README).
 """
 
@@ -22,11 +22,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 
 TAG = "firewall"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = (f"usage: blender -b --factory-startup --python examples/flowgraph_fire/{TAG}.py -- "
+         "OUT_DIR [FRAMES]")
 RESOLUTION = 128               # cells along x: 128 x 32 x 64
 BOX = (2.0, 0.5, 1.0)          # m; the floor at z = 0
 CENTRE = (0.0, 0.0, 0.5)

@@ -1,6 +1,6 @@
 """Rising smoke hits a sphere: Figure 10 of smoke_surfaces.txt as streak surfaces.
 
-    blender -b --factory-startup --python examples/sphere_collision.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/streak_surfaces/sphere_collision.py -- OUT_DIR [FRAMES]
 
 The paper's setup: four source cells holding thirty random point sources (here a point-source
 mesh of 30 seeded random vertices inside the four cells), a static no-slip sphere above them,
@@ -21,10 +21,12 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 
-USAGE = "usage: blender -b --factory-startup --python examples/sphere_collision.py -- OUT_DIR [FRAMES]"
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/streak_surfaces/sphere_collision.py -- OUT_DIR [FRAMES]")
 RESOLUTION = 50
 CELL = 1.0 / RESOLUTION
 DEFAULT_FRAMES = 260

@@ -1,9 +1,9 @@
 """The three clusterings of Figure 3 of smoke_surfaces.txt, on the incense set-up of Figure 1.
 
-    blender -b --factory-startup --python examples/figure3_clustering.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/streak_surfaces/figure3_clustering.py -- OUT_DIR [FRAMES]
 
-One incense tip (examples/incense.py) whose 16 point sources are the vertices of a Point Source
-Mesh, baked and built three ways, the same frame rendered each time:
+One incense tip (incense.py beside this file) whose 16 point sources are the vertices of a Point
+Source Mesh, baked and built three ways, the same frame rendered each time:
   (a) no clustering: every streakline in one surface (threshold h0 above every h);
   (b) manual: the vertices split by hand into four vertex groups (the quadrants around the tip,
       a "naive manual clustering"), one surface per group (§3.3: hand-made candidate groups);
@@ -12,7 +12,7 @@ Mesh, baked and built three ways, the same frame rendered each time:
 The paper: (a) "too opaque and thick", (b) better but "unpredictable depending on the user
 skill", (c) a consistent semi-transparent look.
 
-Writes OUT_DIR/figure3.blend, figure3_{a,b,c}.png and figure3_strip.png (the README's image), and
+Writes OUT_DIR/figure3.blend, figure3_{a,b,c}.png and figure3_strip.png (the manual's image), and
 prints the surfaces and times of each. Needs the Plume add-on installed (README).
 """
 
@@ -22,12 +22,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import incense  # noqa: E402
 import scene_kit  # noqa: E402
 
-USAGE = ("usage: blender -b --factory-startup --python examples/figure3_clustering.py -- OUT_DIR "
-         "[FRAMES]")
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/streak_surfaces/figure3_clustering.py -- OUT_DIR [FRAMES]")
 DEFAULT_FRAMES = 120
 VERTEX_SOURCES = 16
 HAND_GROUPS = 4   # Figure 3(b): "manually selected four surfaces"

@@ -1,7 +1,7 @@
 """Bake time of Mantaflow vs Plume on the same smoke scene, in one Blender process.
 
-    blender -b --factory-startup --python examples/compare_mantaflow.py -- RES FRAMES
-    blender_tests/run.py --blender 4.5 --script examples/compare_mantaflow.py -- RES FRAMES
+    blender -b --factory-startup --python examples/smoke/compare_mantaflow.py -- RES FRAMES
+    blender_tests/run.py --blender 4.5 --script examples/smoke/compare_mantaflow.py -- RES FRAMES
 
 Scene (built twice): a 2 m cube domain standing on the floor (z 0..2), a UV sphere of radius
 0.16 m at (0, 0, 0.3) emitting smoke (density 1, temperature 1), RES cells along every axis,
@@ -56,7 +56,8 @@ import traceback
 import addon_utils
 import bpy
 
-USAGE = ("usage: blender -b --factory-startup --python examples/compare_mantaflow.py -- RES FRAMES\n"
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/smoke/compare_mantaflow.py -- RES FRAMES\n"
          "  RES     cells along each axis of the 2 m cube domain, integer in [8, 1024]\n"
          "  FRAMES  frames to bake (1..FRAMES), integer >= 1")
 

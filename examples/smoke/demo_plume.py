@@ -1,6 +1,6 @@
 """Plume demo: a smoke plume rising from a small sphere, baked and rendered headless.
 
-    blender -b --factory-startup --python examples/demo_plume.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/smoke/demo_plume.py -- OUT_DIR [FRAMES]
 
 Builds the scene (domain cube, sphere source near the floor, camera, sun, dark world), saves it as
 OUT_DIR/demo_plume.blend (so the cache path is '//'-relative), bakes a 50^3 plume (BFECC,
@@ -17,7 +17,8 @@ import time
 import addon_utils
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
 
 RESOLUTION = 50
@@ -29,7 +30,7 @@ SAMPLES = 16
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     if not argv:
-        sys.exit("usage: blender -b --factory-startup --python examples/demo_plume.py -- "
+        sys.exit("usage: blender -b --factory-startup --python examples/smoke/demo_plume.py -- "
                  "OUT_DIR [FRAMES]")
     out_dir = os.path.abspath(argv[0])
     frames = int(argv[1]) if len(argv) > 1 else DEFAULT_FRAMES

@@ -1,6 +1,6 @@
 """Flames spreading over a board from a greyscale activation map: §6.2 of structural_flames.txt.
 
-    blender -b --factory-startup --python examples/flame_spread.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flames/flame_spread.py -- OUT_DIR [FRAMES]
 
 A wooden board (1.2 x 0.5 m) lies on the ground; it is a Flame Source of 48 flames (TORCH
 profile, r = 2.5 cm) with Spread = Maps. Its Activation Map, made here with numpy and saved as
@@ -11,7 +11,7 @@ fire runs along the board from left to right, leaving it burnt out behind.
 
 Writes OUT_DIR/flame_spread.blend (flames cache in OUT_DIR/plume_cache/flames), the maps
 OUT_DIR/flame_spread_activation.png and _duration.png, flame_spread_####.png for a few frames
-and flame_spread_strip.png (the README's image); prints the bake time per frame, the burning
+and flame_spread_strip.png (the manual's image); prints the bake time per frame, the burning
 flames per frame (they rise as the front spreads, then fall as it burns out) and the render
 time. Needs the Plume add-on (README).
 """
@@ -22,12 +22,13 @@ import sys
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import flame_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "flame_spread"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py -- OUT_DIR [FRAMES]"
 DEFAULT_FRAMES = 60
 SHOW = (0.2, 0.45, 0.7, 0.95)
 MAP_SIZE = 64           # texels per side of the generated maps

@@ -1,6 +1,6 @@
 """A campfire of structural flames (structural_flames.txt, the CAMPFIRE profile of Figure 3).
 
-    blender -b --factory-startup --python examples/campfire_flames.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flames/campfire_flames.py -- OUT_DIR [FRAMES]
 
 Four logs lie crossed in a ring of stones; each log is a Flame Source with 4 flames of source
 radius r = 4 cm (CAMPFIRE profile) spread over its upper side. The flames break often (the
@@ -9,7 +9,7 @@ A = 0.5 s, rising as loose tongues of fire; merging (§4.5) is on, so neighbouri
 into one body. A light breeze from a Blender Wind force field leans the fire.
 
 Writes OUT_DIR/campfire_flames.blend (flames cache in OUT_DIR/plume_cache/flames),
-campfire_flames_####.png for a few frames and campfire_flames_strip.png (the README's image);
+campfire_flames_####.png for a few frames and campfire_flames_strip.png (the manual's image);
 prints the bake time per frame, the flames and particles per frame and the render time. Needs
 the Plume add-on (README).
 """
@@ -20,12 +20,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import flame_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "campfire_flames"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py -- OUT_DIR [FRAMES]"
 DEFAULT_FRAMES = 32
 SHOW = (0.4, 0.6, 0.8, 1.0)
 LOG_RADIUS, LOG_LENGTH = 0.05, 0.55

@@ -1,12 +1,12 @@
 """Figure 9 of smoke_surfaces.txt: the same incense smoke shown five ways, side by side.
 
-    blender -b --factory-startup --python examples/compare_representations.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/streak_surfaces/compare_representations.py -- OUT_DIR [FRAMES]
 
 (a) the density field of a 50³ bake rendered as a volume, (b) the same scene at 150³ as a volume,
 (c) the 20 streaklines' particles of the 50³ bake, (d) 100 point sources' particles at 150³,
 (e) Plume's streak surfaces from the 50³ bake (20 point sources). The scene is
-examples/incense.py's; every panel shows the last frame. The paper's point, which the strip
-shows: neither a finer grid nor more particles gives the thin sheet-like look the surfaces give
+that of incense.py beside this file; every panel shows the last frame. The paper's point, which
+the strip shows: neither a finer grid nor more particles gives the thin sheet-like look the surfaces give
 from the coarse bake, at 1/27 of the fine grid's cells.
 
 Writes OUT_DIR/compare_50.blend and compare_150.blend (caches beside them), one PNG per panel
@@ -19,12 +19,13 @@ import time
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import incense  # noqa: E402
 import scene_kit  # noqa: E402
 
-USAGE = ("usage: blender -b --factory-startup --python examples/compare_representations.py -- "
-         "OUT_DIR [FRAMES]")
+USAGE = ("usage: blender -b --factory-startup --python "
+         "examples/streak_surfaces/compare_representations.py -- OUT_DIR [FRAMES]")
 DEFAULT_FRAMES = 84
 WIDTH, HEIGHT, SAMPLES = 200, 320, 32
 PARTICLE_RADIUS = 0.0025  # m

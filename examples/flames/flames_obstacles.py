@@ -1,6 +1,6 @@
 """Flames around a simple obstacle: Figure 7 of structural_flames.txt (§6.1).
 
-    blender -b --factory-startup --python examples/flames_obstacles.py -- OUT_DIR [FRAMES]
+    blender -b --factory-startup --python examples/flames/flames_obstacles.py -- OUT_DIR [FRAMES]
 
 A ball hangs over a burner. The ball is an Obstacle: the Plume solver computes the flow of hot
 gas around it on a 40³ grid (the paper's resolution), rising from a hot Source disc that covers
@@ -15,7 +15,7 @@ that carries the flames is then smoke-filled, and the flames read its velocity; 
 Volume is hidden from renders.
 
 Writes OUT_DIR/flames_obstacles.blend (caches in OUT_DIR/plume_cache), flames_obstacles_####.png
-for a few frames and flames_obstacles_strip.png (the README's image); prints the solver bake,
+for a few frames and flames_obstacles_strip.png (the manual's image); prints the solver bake,
 the flames bake time per frame, the flames and particles per frame and the render time. Needs
 the Plume add-on (README).
 """
@@ -25,12 +25,13 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import flame_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "flames_obstacles"
-USAGE = f"usage: blender -b --factory-startup --python examples/{TAG}.py -- OUT_DIR [FRAMES]"
+USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py -- OUT_DIR [FRAMES]"
 DEFAULT_FRAMES = 36
 SHOW = (0.4, 0.6, 0.8, 1.0)
 RESOLUTION = 40          # the paper's 40 x 40 x 40 wind field
