@@ -4,7 +4,7 @@
 /// sides) in two configurations: Plume's defaults (BFECC + monotonic cubic, midpoint traces,
 /// pressure tolerance 1e-4) and Mantaflow's (MacCormack + trilinear, first-order Euler traces
 /// from the grid-point velocity, tolerance 1e-3; the "Comparable" benchmarks, see
-/// examples/compare_mantaflow.py). Not a test: run build/native/plume_bench by hand.
+/// examples/smoke/compare_mantaflow.py). Not a test: run build/native/plume_bench by hand.
 ///
 /// Memory: peak_rss_MB is the peak of the whole process so far, so it includes every solver an
 /// earlier benchmark of the same run built (they are cached). For the peak of one solver, run one
