@@ -30,12 +30,24 @@ def active_domain(context):
     return obj
 
 
+def absolute_folder(path):
+    """An absolute folder of a path setting: "//" is relative to the saved .blend; in an unsaved
+    file it is relative to the working directory, as Blender does."""
+    base = bpy.path.abspath(path)
+    if base.startswith("//"):
+        base = base[2:]
+    return os.path.abspath(base or ".")
+
+
 def cache_folder_of(domain):
     """Absolute cache folder of a domain: abspath(cache_directory)/<domain name>/."""
-    base = bpy.path.abspath(domain.plume.domain.cache_directory or "//plume_cache/")
-    if base.startswith("//"):  # unsaved file: relative to the working directory
-        base = base[2:]
-    return cache.cache_folder(os.path.abspath(base or "."), domain.name)
+    base = absolute_folder(domain.plume.domain.cache_directory or "//plume_cache/")
+    return cache.cache_folder(base, domain.name)
+
+
+def flames_cache_folder(scene):
+    """Absolute folder of the flames bake (scene.plume_flames.cache_directory)."""
+    return absolute_folder(scene.plume_flames.cache_directory or "//plume_cache/flames/")
 
 
 def domain_bbox(domain, depsgraph):
@@ -224,11 +236,8 @@ def mantaflow_source(domain, scene):
     ds = mod.domain_settings if mod is not None and mod.fluid_type == 'DOMAIN' else None
     if ds is None or ds.domain_type != 'GAS':
         return source
-    base = bpy.path.abspath(ds.cache_directory)
-    if base.startswith("//"):  # unsaved file: relative to the working directory, as Blender does
-        base = base[2:]
     return dataclasses.replace(
-        source, is_gas_domain=True, cache_directory=os.path.abspath(base or "."),
+        source, is_gas_domain=True, cache_directory=absolute_folder(ds.cache_directory),
         cache_data_format=ds.cache_data_format, cache_frame_start=int(ds.cache_frame_start),
         cache_frame_end=int(ds.cache_frame_end), use_adaptive_domain=bool(ds.use_adaptive_domain),
         borders_closed=tuple(bool(getattr(ds, n)) for n in BORDER_SETTINGS),
@@ -279,7 +288,6 @@ def flame_smoke_settings(domain, scene):
         raise BakeError(f"Plume: domain '{domain.name}': Flame Smoke feeds the Plume solver: set "
                         "Motion to Plume Simulation or turn Flame Smoke off")
     from .flame_smoke import FlameSmokeSettings
-    from .flame_snapshot import cache_folder as flames_folder  # imports this module
     return FlameSmokeSettings(enabled=True, smoke_yield=float(d.flame_smoke_yield),
                               temperature=float(d.flame_smoke_temperature),
-                              folder=flames_folder(scene))
+                              folder=flames_cache_folder(scene))

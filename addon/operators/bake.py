@@ -7,17 +7,13 @@ later bake with the same settings resumes from them) and builds the Volume over 
 import bpy
 
 from .. import bake_runner, cache
-from .. import _native
+from ..native import _native
 from ..build import volume
 from ..jobs import JobOperator, JobRunner, registry
 from ..mantaflow_trace import MantaflowTraceRunner
 from ..settings import BakeError
+from ..version import VERSION
 from ..snapshot import NOT_A_DOMAIN, active_domain, cache_folder_of, take_snapshot
-
-
-def _addon_version():
-    from .. import VERSION
-    return VERSION
 
 
 def domain_key(name):
@@ -34,7 +30,7 @@ class BakeJob(JobRunner):
 
     def prepare(self, context):
         """Snapshot + validation; BakeError on bad input, nothing written."""
-        snap = take_snapshot(context, addon_version=_addon_version())
+        snap = take_snapshot(context, addon_version=VERSION)
         self.domain_name = snap.domain_name
         self.objects = (snap.domain_name,)
         self.claim(domain_key(snap.domain_name))

@@ -11,7 +11,8 @@ import time
 import bpy
 import numpy as np
 
-from .. import _native, cache, flowgraph
+from .. import cache, flowgraph
+from ..native import _native
 from ..build import fire_points, fire_volume
 from ..jobs import JobOperator, JobProgress, JobRunner
 from ..settings import BakeError

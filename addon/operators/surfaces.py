@@ -11,7 +11,8 @@ import time
 import bpy
 import numpy as np
 
-from .. import _native, cache
+from .. import cache
+from ..native import _native
 from .. import streak_surfaces as ss
 from .. import sheet_render, surfaces_forecast
 from ..build import surfaces as build

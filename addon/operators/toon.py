@@ -9,7 +9,8 @@ import time
 
 import bpy
 
-from .. import _native, toon
+from .. import toon
+from ..native import _native
 from ..build import toon_compositor, toon_nodes, toon_points
 from ..jobs import JobOperator, JobRunner
 from ..settings import BakeError

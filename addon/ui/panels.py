@@ -3,7 +3,8 @@ Mantaflow's): role buttons, then the settings of the object's role."""
 
 import bpy
 
-from .. import _native, streak_count
+from .. import streak_count
+from ..native import _native
 from ..operators.bake import cache_status, is_baking, is_busy
 from ..operators.surfaces import live_summary
 from ..properties import ROLE_ITEMS
