@@ -13,8 +13,6 @@ and the lights (§5.2) go to an .npz. Files are written to a temporary name and 
 cancelled or killed bake never leaves a half file.
 """
 
-import io
-import json
 import math
 import os
 import time
@@ -24,6 +22,7 @@ from typing import Callable, List, Optional, Tuple
 
 import numpy as np
 
+from . import files
 from .settings import BakeError
 
 PROFILES = ('CANDLE', 'TORCH', 'CAMPFIRE', 'CUSTOM')
@@ -469,24 +468,12 @@ def write_manifest(snap, result):
             "settings": asdict(snap.settings[0]),
             # per baked frame: live flames and rendered particles (for scripts and the UI)
             "flames": list(result.flames), "particles": list(result.particles)}
-    _write_atomic(os.path.join(snap.folder, MANIFEST_NAME), json.dumps(data, indent=1).encode())
+    files.write_manifest(snap.folder, data, MANIFEST_NAME)
 
 
 def read_manifest(folder):
     """The manifest dict, or None when missing or unreadable."""
-    try:
-        with open(os.path.join(folder, MANIFEST_NAME), "rb") as f:
-            data = json.loads(f.read().decode())
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) and data.get("kind") == "flames" else None
-
-
-def _write_atomic(path, data: bytes):
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "wb") as f:
-        f.write(data)
-    os.replace(tmp, path)
+    return files.read_manifest(folder, "flames", MANIFEST_NAME)
 
 
 SPINE_ARRAYS = ("ids", "sources", "separated", "counts", "points", "light_ids", "light_centres",
@@ -510,21 +497,21 @@ def write_spines(path, flames, lights, params):
     (eq. 5 × intensity) and colour."""
     pts = [np.asarray(f["points"], np.float32).reshape(-1, 3) for f in flames]
     vel = [np.asarray(f["velocities"], np.float32).reshape(-1, 3) for f in flames]
-    buf = io.BytesIO()
-    np.savez(buf, ids=np.asarray([f["id"] for f in flames], np.uint32),
-             sources=np.asarray([f["source"] for f in flames], np.int32),
-             separated=np.asarray([f["separated"] for f in flames], bool),
-             counts=np.asarray([len(p) for p in pts], np.int32),
-             points=(np.concatenate(pts) if pts else np.zeros((0, 3), np.float32)),
-             velocities=(np.concatenate(vel) if vel else np.zeros((0, 3), np.float32)),
-             radii=np.asarray([f["radius"] for f in flames], np.float32),
-             lifts=np.asarray([buoyancy_lift(f, params) for f in flames], np.float32),
-             light_ids=np.asarray([li["flame_id"] for li in lights], np.uint32),
-             light_centres=np.asarray([li["centre"] for li in lights], np.float32).reshape(-1, 3),
-             light_radii=np.asarray([li["radius"] for li in lights], np.float32),
-             light_energy=np.asarray([li["energy"] for li in lights], np.float32),
-             light_colors=np.asarray([li["color"] for li in lights], np.float32).reshape(-1, 3))
-    _write_atomic(path, buf.getvalue())
+    files.save_npz(path, ids=np.asarray([f["id"] for f in flames], np.uint32),
+                   sources=np.asarray([f["source"] for f in flames], np.int32),
+                   separated=np.asarray([f["separated"] for f in flames], bool),
+                   counts=np.asarray([len(p) for p in pts], np.int32),
+                   points=(np.concatenate(pts) if pts else np.zeros((0, 3), np.float32)),
+                   velocities=(np.concatenate(vel) if vel else np.zeros((0, 3), np.float32)),
+                   radii=np.asarray([f["radius"] for f in flames], np.float32),
+                   lifts=np.asarray([buoyancy_lift(f, params) for f in flames], np.float32),
+                   light_ids=np.asarray([li["flame_id"] for li in lights], np.uint32),
+                   light_centres=np.asarray([li["centre"] for li in lights],
+                                            np.float32).reshape(-1, 3),
+                   light_radii=np.asarray([li["radius"] for li in lights], np.float32),
+                   light_energy=np.asarray([li["energy"] for li in lights], np.float32),
+                   light_colors=np.asarray([li["color"] for li in lights],
+                                           np.float32).reshape(-1, 3))
 
 
 def read_spines(path):

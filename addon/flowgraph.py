@@ -9,7 +9,6 @@ The graph's nodes are the pathline groups of every state, state by state in file
 n of the graph is group node_steps[n] of state node_states[n]'s pathline file.
 """
 
-import io
 import math
 import os
 import time
@@ -20,7 +19,7 @@ from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import cache
+from . import cache, files
 from .settings import BakeError
 
 GRAPH_NAME = "flowgraph.npz"
@@ -63,12 +62,10 @@ def write_points(path, particles, cap):
     name + rename): positions (M, 3), temperature and density (M,) float32 and live (the number
     of live particles it was thinned from)."""
     keep = preview_indices(len(particles["temperature"]), cap)
-    buf = io.BytesIO()
-    np.savez(buf, positions=np.asarray(particles["positions"], np.float32)[keep],
-             temperature=np.asarray(particles["temperature"], np.float32)[keep],
-             density=np.asarray(particles["density"], np.float32)[keep],
-             live=np.int64(len(particles["temperature"])))
-    _write_atomic(path, buf.getvalue())
+    files.save_npz(path, positions=np.asarray(particles["positions"], np.float32)[keep],
+                   temperature=np.asarray(particles["temperature"], np.float32)[keep],
+                   density=np.asarray(particles["density"], np.float32)[keep],
+                   live=np.int64(len(particles["temperature"])))
 
 
 def read_points(path):
@@ -309,12 +306,13 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
                "pruned": [int(v) for v in graph.pruned_per_state],
                "nodes": [int(v) for v in counts]}
     os.makedirs(out_folder, exist_ok=True)
-    _save_npz(graph_path(out_folder), cost=cost, state_node_counts=np.asarray(counts, np.int64),
-              state_names=np.asarray([st.name for st in states]),
-              state_folders=np.asarray([st.folder for st in states]),
-              settings=np.asarray([s.block_size, s.min_node_gap, s.epsilon, alpha, beta],
-                                  np.float64))
-    _write_atomic(image_path(out_folder), png_rgb(np.asarray(image)))
+    files.save_npz(graph_path(out_folder), compressed=True, cost=cost,
+                   state_node_counts=np.asarray(counts, np.int64),
+                   state_names=np.asarray([st.name for st in states]),
+                   state_folders=np.asarray([st.folder for st in states]),
+                   settings=np.asarray([s.block_size, s.min_node_gap, s.epsilon, alpha, beta],
+                                       np.float64))
+    files.write_bytes(image_path(out_folder), png_rgb(np.asarray(image)))
     if progress is not None:
         progress(1.0)
     return {"graph": graph, "cost": cost, "summary": summary, "params": params}
@@ -329,21 +327,6 @@ def _candidate_range(native, cost, counts, params):
         return ""
     return (f" (the candidate transition costs span [a, b] = [{t['a']:.4g}, {t['b']:.4g}]: an "
             "ε nearer b keeps more transitions)")
-
-
-def _write_atomic(path, data: bytes):
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
-def _save_npz(path, **arrays):
-    tmp = f"{path}.{os.getpid()}.tmp.npz"
-    np.savez_compressed(tmp, **arrays)
-    os.replace(tmp, path)
 
 
 def png_rgb(rgb):

@@ -39,6 +39,17 @@ def absolute_folder(path):
     return os.path.abspath(base or ".")
 
 
+def blend_relative(path):
+    """`path` as objects store it: "//"-relative when the .blend is saved (a render farm sees the
+    same paths), else absolute."""
+    if bpy.data.is_saved:
+        try:
+            return bpy.path.relpath(path)
+        except ValueError:  # another drive
+            return path
+    return path
+
+
 def cache_folder_of(domain):
     """Absolute cache folder of a domain: abspath(cache_directory)/<domain name>/."""
     base = absolute_folder(domain.plume.domain.cache_directory or "//plume_cache/")

@@ -11,7 +11,7 @@ import time
 import bpy
 import numpy as np
 
-from .. import cache
+from .. import cache, files
 from ..native import _native
 from .. import streak_surfaces as ss
 from .. import sheet_render, surfaces_forecast
@@ -146,9 +146,9 @@ class SurfacesJob(JobRunner):
         staged = self.stage(folder)
         for i, anim in enumerate(anims):
             self.check_cancel()
-            np.savez(cache.surface_path(staged, i), control_points=anim.control_points,
-                     frame_start=frame_start, nu=anim.nu, nv=anim.nv, order_u=anim.order_u,
-                     order_v=anim.order_v)
+            files.save_npz(cache.surface_path(staged, i), control_points=anim.control_points,
+                           frame_start=frame_start, nu=anim.nu, nv=anim.nv, order_u=anim.order_u,
+                           order_v=anim.order_v)
 
     def _density_maps(self, folder, m, anims, settings):
         """§3.4 density map of every surface at every frame (from the VDB density grids)."""
