@@ -1,7 +1,7 @@
-"""The manifest of a cache folder (manifest.json; flames_manifest.json for a flames bake) (DESIGN.md "Cache folder"): the one reader and writer of every
-pipeline's manifest. Each manifest says its "kind" ("smoke" for a domain bake, "flames" for a
-flames bake) and "format_version"; a manifest of another kind or version reads as missing, so the
-bake starts over instead of mixing in files it does not understand."""
+"""The manifest of a cache folder (DESIGN.md "Cache folder"): manifest.json of a domain's bake,
+flames_manifest.json of a flames bake; the one reader and writer of both. Each says its "kind"
+("smoke" or "flames") and "format_version"; a manifest of another kind or version reads as
+missing, so the bake starts over instead of mixing in files it does not understand."""
 
 import json
 import os

@@ -14,8 +14,8 @@ import bpy
 from .. import flames
 from ..native import _native
 from ..build import flame_spine_keys, flame_spines, flames_volume
-from ..flame_snapshot import flames_snapshot
 from ..snapshot import flames_cache_folder
+from ..snapshot.flames import flames_snapshot
 from ..jobs import JobOperator, JobRunner, registry
 
 #: The registry key of the scene's flames bake (one at a time).

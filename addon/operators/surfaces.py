@@ -19,6 +19,7 @@ from ..build import surfaces as build
 from ..jobs import Forecast, JobOperator, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
+from ..snapshot.streaks import sheet_settings
 from .bake import domain_key
 
 #: h per candidate group, cached in memory for the panel's live count (never computed in draw):
@@ -67,17 +68,6 @@ def compute_distances(domain):
     return folder, m, frames, groups
 
 
-def _settings_of(d):
-    for name in ("density_k_u", "density_k_v"):
-        k = getattr(d, name)
-        if k < 0:
-            raise BakeError(f"Plume: {name} must be >= 0 (samples between particles, §3.4; "
-                            f"got {k})")
-    return {"k_u": int(d.density_k_u), "k_v": int(d.density_k_v), "falloff": d.sheet_falloff,
-            "color": tuple(d.sheet_color), "brightness": float(d.sheet_brightness),
-            "opacity": float(d.sheet_opacity)}
-
-
 class SurfacesJob(JobRunner):
     """Build Surfaces as a job: prepare() checks the settings and the bake's manifest, run()
     computes h, the clusters, the NURBS animations and the density maps and stages the
@@ -109,7 +99,7 @@ class SurfacesJob(JobRunner):
         domain = active_domain(context)
         d = domain.plume.domain
         self.domain_name = domain.name
-        self.settings = _settings_of(d)
+        self.settings = sheet_settings(d)
         ss.check_threshold(d.streak_threshold, domain.name)
         self.h0 = d.streak_threshold
         self.folder = cache_folder_of(domain)

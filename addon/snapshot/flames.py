@@ -8,10 +8,10 @@ import os
 import bpy
 import numpy as np
 
-from . import flame_placement as place
-from . import flames
-from .settings import BakeError
-from .snapshot import cache_folder_of, flames_cache_folder, mesh_arrays
+from .. import flame_placement as place
+from .. import flames
+from ..settings import BakeError
+from .scene import cache_folder_of, flames_cache_folder, mesh_arrays
 
 
 def flame_sources(scene):
