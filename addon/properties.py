@@ -1,7 +1,7 @@
 """Object properties: ``obj.plume`` with ``role``, ``domain``, ``source`` and ``obstacle``.
 
 Numbers carry soft limits only: a script may set any value, and the bake validates it with a
-message naming the setting (ADDON.md) instead of Blender clamping it silently."""
+message naming the setting instead of Blender clamping it silently."""
 
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,

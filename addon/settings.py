@@ -294,7 +294,7 @@ class BakeSnapshot:
 
 
 def domain_grid(bbox_min, bbox_max, resolution):
-    """Cells per axis, cell size and origin of a domain box (ADDON.md "Domain geometry"): the
+    """Cells per axis, cell size and origin of a domain box: the
     longest axis gets `resolution` cells, the others round(dim / cell_size), at least 2."""
     dims = [float(b) - float(a) for a, b in zip(bbox_min, bbox_max)]
     longest = max(dims)

@@ -112,7 +112,7 @@ def unregister():
 
 # --------------------------------------------------------------------------- objects
 def surface_object(name, collection, nu, nv, view_layer):
-    """SURFACE object with an nu x nv NURBS net (BLENDER_NOTES §2 recipe). make_segment merges
+    """SURFACE object with an nu x nv NURBS net built from 1-D NURBS rows. make_segment merges
     the 1-D rows and transposes them; with 2 rows it leaves them unmerged in 3.4.1, so one u row
     is extruded once instead (blender_tests/test_nurbs_tessellation.py)."""
     cu = bpy.data.curves.new(name, 'SURFACE')
