@@ -9,6 +9,7 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
+from .ranges import RANGES
 from .settings import BakeError
 
 PROFILES = ('CANDLE', 'TORCH', 'CAMPFIRE', 'CUSTOM')
@@ -17,9 +18,9 @@ MANIFEST_NAME = "flames_manifest.json"
 OBSTACLE_VOXEL = 0.005
 OBSTACLE_PADDING = 0.05
 FORMAT_VERSION = 1
-POINTS_RANGE = (2, 256)
-FLAMES_PER_SOURCE_RANGE = (1, 1024)
-SUBSTEPS_RANGE = (1, 64)
+POINTS_RANGE = RANGES["flames.points"]
+FLAMES_PER_SOURCE_RANGE = RANGES["flames.flames_per_source"]
+SUBSTEPS_RANGE = RANGES["flames.substeps"]
 #: Samples per flame when the scene has no camera (no projected area to size them from).
 FIXED_PARTICLES = 4000
 NO_SOURCE = ("Plume: the scene has no Flame Source (make a mesh one with "

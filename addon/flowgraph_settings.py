@@ -5,11 +5,12 @@ import math
 from dataclasses import dataclass, field
 from typing import List, Tuple
 
+from .ranges import RANGES
 from .settings import BakeError
 
 TRAVERSALS = ('UNIFORM', 'BIASED')
 #: Range of SynthesisSettings.preview_points (points per frame of the preview).
-PREVIEW_POINTS_RANGE = (100, 1_000_000)
+PREVIEW_POINTS_RANGE = RANGES["flowgraph.preview_points"]
 
 
 @dataclass
@@ -85,6 +86,7 @@ def validate_synthesis(s: SynthesisSettings, state_count, owner):
     if s.point_preview and not (lo <= s.preview_points <= hi):
         raise BakeError(f"Plume: {owner}: preview_points must be in [{lo}, {hi}] "
                         f"(got {s.preview_points})")
-    if not (0 <= s.group_cache_mb <= 65536):
-        raise BakeError(f"Plume: {owner}: group_cache must be in [0, 65536] MB "
+    lo, hi = RANGES["flowgraph.group_cache"]
+    if not (lo <= s.group_cache_mb <= hi):
+        raise BakeError(f"Plume: {owner}: group_cache must be in [{lo}, {hi}] MB "
                         f"(got {s.group_cache_mb})")
