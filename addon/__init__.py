@@ -29,7 +29,7 @@ if tuple(bpy.app.version) < (3, 4, 0):
                       "tested in 3.4.1, 4.5 LTS and 5.0", name=__name__)
 
 from . import native  # noqa: E402,F401  (fails here, with a clear message)
-from . import jobs, operators, properties, ui  # noqa: E402
+from . import cache_state, jobs, operators, properties, ui  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
 from .build import toon_points as _toon_points  # noqa: E402
 from .build import fire_points as _fire_points  # noqa: E402
@@ -47,9 +47,11 @@ def register():
     _fire_points.register()  # persistent frame_change_pre handler of the fire point preview
     _flame_spines.register()  # persistent frame_change_pre handler of flame spines and lights
     jobs.register()  # persistent load_pre + atexit: loading a file or quitting cancels the jobs
+    cache_state.register()  # the panels' cache state: read when a job ends or a file loads
 
 
 def unregister():
+    cache_state.unregister()
     jobs.unregister()  # running jobs are cancelled first, their temporaries removed
     _flame_spines.unregister()
     _fire_points.unregister()

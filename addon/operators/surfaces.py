@@ -33,21 +33,23 @@ def _cache_key(folder, manifest):
             run.get("seconds"))
 
 
-def cached_distances(domain):
-    """The h matrices of the domain's last computation if they match its cache, else None."""
+def cached_distances(domain, manifest=None):
+    """The h matrices of the domain's last computation if they match its cache (its manifest:
+    `manifest` when given, else read from the disk), else None."""
     hit = _distances.get(domain.name)
     if hit is None:
         return None
     folder = cache_folder_of(domain)
-    m = cache.read_manifest(folder)
+    m = manifest if manifest is not None else cache.read_manifest(folder)
     if m is None or _cache_key(folder, m) != hit[0]:
         return None
     return hit[1]
 
 
-def live_summary(domain):
-    """(surfaces, streaklines) for the domain's current h0 from cached h, or None."""
-    groups = cached_distances(domain)
+def live_summary(domain, manifest=None):
+    """(surfaces, streaklines) for the domain's current h0 from cached h, or None (`manifest` as
+    in cached_distances)."""
+    groups = cached_distances(domain, manifest)
     h0 = domain.plume.domain.streak_threshold
     if groups is None or not np.isfinite(h0) or h0 < 0:
         return None
