@@ -51,6 +51,8 @@ def cache_status(domain):
 
 
 def _request(name):
+    if bpy.app.background:
+        return  # no window shows the panels (and a pending timer would outlive the bpy module)
     if name in _pending:
         return
     _pending.add(name)
