@@ -15,8 +15,6 @@ bl_info = {
                    "and structural flames",
     "category": "Physics",
 }
-#: "0.1.0": kept apart from bl_info, which Blender 4.2+ deletes from an extension's module.
-VERSION = ".".join(str(v) for v in bl_info["version"])
 
 if sys.version_info[:2] != (3, 11):
     raise ImportError(
@@ -30,25 +28,8 @@ if tuple(bpy.app.version) < (3, 4, 0):
     raise ImportError(f"Plume needs Blender 3.4 or newer (this is {bpy.app.version_string}); "
                       "tested in 3.4.1, 4.5 LTS and 5.0", name=__name__)
 
-try:
-    from . import _native  # noqa: F401  (fail here, with a clear message)
-except ImportError as e:
-    import glob
-    import os
-    _here = os.path.dirname(os.path.abspath(__file__))
-    _why = (f"cannot be loaded ({e})" if glob.glob(os.path.join(_here, "_native*.so"))
-            else f"is missing (no _native*.so in {_here})")
-    if os.path.isdir(os.path.join(_here, "lib")):  # installed from the zip, libraries bundled
-        _fix = ("A library bundled with Plume is missing or damaged (named above): install "
-                "plume-<version>-linux-x64.zip again")
-    else:
-        _fix = ("Build it with: cmake -S . -B build -DPython_EXECUTABLE=/usr/bin/python3 && "
-                "cmake --build build -j2 --target _native, then copy build/native/_native*.so "
-                "next to the add-on's __init__.py (the README's install command does both)")
-    # name=: Blender 4.2+ reports an ImportError by its module name (without one it fails itself)
-    raise ImportError(f"Plume: the native module _native {_why}. {_fix}", name=__name__) from e
-
-from . import jobs, operators, properties, ui  # noqa: E402
+from . import native  # noqa: E402,F401  (fails here, with a clear message)
+from . import cache_state, jobs, operators, properties, ui  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
 from .build import toon_points as _toon_points  # noqa: E402
 from .build import fire_points as _fire_points  # noqa: E402
@@ -66,9 +47,11 @@ def register():
     _fire_points.register()  # persistent frame_change_pre handler of the fire point preview
     _flame_spines.register()  # persistent frame_change_pre handler of flame spines and lights
     jobs.register()  # persistent load_pre + atexit: loading a file or quitting cancels the jobs
+    cache_state.register()  # the panels' cache state: read when a job ends or a file loads
 
 
 def unregister():
+    cache_state.unregister()
     jobs.unregister()  # running jobs are cancelled first, their temporaries removed
     _flame_spines.unregister()
     _fire_points.unregister()

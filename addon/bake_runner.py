@@ -84,8 +84,8 @@ class BakeRunner:
 
     # ---------------------------------------------------------------- validation
     def prepare(self):
-        """Checks everything that can be wrong with the input, in the order of ADDON.md, and
-        decides between a fresh bake and a resume. Raises BakeError; nothing is written."""
+        """Checks everything that can be wrong with the input and decides between a fresh bake
+        and a resume. Raises BakeError; nothing is written."""
         snap = self.snapshot
         validate_python_side(snap.domain_name, snap.resolution, snap.frame_start,
                              snap.frame_end, snap.solver)

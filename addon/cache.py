@@ -10,17 +10,18 @@
                                     toon_<frame:04d>.bin, stencil_<kind>.png   (plume.toon_build)
 """
 
-import json
 import os
 import re
 import uuid
 
-MANIFEST_NAME = "manifest.json"
+from . import files
+from .files import MANIFEST_NAME, manifest_path  # noqa: F401  (cache.manifest_path)
+from .files.manifest import FORMAT_VERSION  # noqa: F401
+
 STATE_NAME = "state.bin"
 TRACER_STATE_NAME = "tracer_state.bin"
 #: Pathline groups of a fire bake (graph_fire_synthesis.txt §4.2); ".partial" while recording.
 PATHLINES_NAME = "pathlines.bin"
-FORMAT_VERSION = 1
 KIND = "smoke"
 
 _VOLUME_RE = re.compile(r"^volume_(-?\d+)\.vdb$")
@@ -81,10 +82,6 @@ def streak_frames(folder):
     return sorted(int(m.group(1)) for m in map(_STREAK_RE.match, names) if m)
 
 
-def manifest_path(folder):
-    return os.path.join(folder, MANIFEST_NAME)
-
-
 def state_path(folder):
     return os.path.join(folder, STATE_NAME)
 
@@ -95,28 +92,13 @@ def tracer_state_path(folder):
 
 
 def read_manifest(folder):
-    """The manifest as a dict, or None when missing or unreadable (then the bake starts over)."""
-    try:
-        with open(manifest_path(folder), "r", encoding="utf-8") as f:
-            data = json.load(f)
-    except (OSError, ValueError):
-        return None
-    if not isinstance(data, dict) or data.get("format_version") != FORMAT_VERSION:
-        return None
-    if data.get("kind") != KIND:
-        return None
-    return data
+    """The smoke bake's manifest as a dict, or None when missing or unreadable (then the bake
+    starts over)."""
+    return files.read_manifest(folder, KIND)
 
 
 def write_manifest(folder, data):
-    """Atomic write: temporary name in the same folder, then os.replace."""
-    path = manifest_path(folder)
-    tmp = f"{path}.{uuid.uuid4().hex[:8]}.tmp"
-    with open(tmp, "w", encoding="utf-8") as f:
-        json.dump(data, f, indent=1, sort_keys=True)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    files.write_manifest(folder, data)
 
 
 def volume_frames(folder):

@@ -1,7 +1,7 @@
-"""Structural flames bake, no ``bpy`` (structural_flames.txt): the settings snapshot of a scene's
-Flame Sources, its validation and the bake loop.
+"""Structural flames bake, no ``bpy`` (structural_flames.txt): the bake loop over a scene's
+Flame Sources (settings and validation in flame_settings, cache files in flame_files).
 
-    snap = snapshot.flames_snapshot(context)          # bpy side: FlameBakeSnapshot
+    snap = snapshot.flames.flames_snapshot(context)          # bpy side: FlameBakeSnapshot
     runner = FlameBakeRunner(native, snap)            # BakeError on bad input, nothing written
     result = runner.run()                             # <folder>/flames_####.vdb, spines_####.npz
 
@@ -13,208 +13,32 @@ and the lights (§5.2) go to an .npz. Files are written to a temporary name and 
 cancelled or killed bake never leaves a half file.
 """
 
-import io
-import json
-import math
 import os
 import time
-import zipfile
-from dataclasses import asdict, dataclass, field
-from typing import Callable, List, Optional, Tuple
+from dataclasses import dataclass, field
+from typing import Callable, List, Optional
 
 import numpy as np
 
 from .settings import BakeError
+# The settings, validation and files of a flames bake, also reachable as flames.<name>.
+from .flame_files import (SMOKE_ARRAYS, SPINE_ARRAYS, buoyancy_lift, clear_folder,
+                          read_manifest, read_spines, write_manifest, write_spines)
+from .flame_settings import (FIXED_PARTICLES, FLAMES_PER_SOURCE_RANGE, FORMAT_VERSION,
+                             MANIFEST_NAME, NO_SOURCE, OBSTACLE_PADDING, OBSTACLE_VOXEL,
+                             POINTS_RANGE, PROFILES, SUBSTEPS_RANGE, CameraInput,
+                             FlameBakeSnapshot, FlameSettings, FlameSourceInput, ObstacleInput,
+                             WindInput, spines_path, validate_settings, validate_snapshot,
+                             validate_source_values, volume_path)
 
-PROFILES = ('CANDLE', 'TORCH', 'CAMPFIRE', 'CUSTOM')
-MANIFEST_NAME = "flames_manifest.json"
-#: §6.1 obstacles: voxel size (m) of their signed distance and the band around them.
-OBSTACLE_VOXEL = 0.005
-OBSTACLE_PADDING = 0.05
-FORMAT_VERSION = 1
-POINTS_RANGE = (2, 256)
-FLAMES_PER_SOURCE_RANGE = (1, 1024)
-SUBSTEPS_RANGE = (1, 64)
-#: Samples per flame when the scene has no camera (no projected area to size them from).
-FIXED_PARTICLES = 4000
-NO_SOURCE = ("Plume: the scene has no Flame Source (make a mesh one with "
-             "plume.role_set(role='FLAME_SOURCE'))")
-
-
-def volume_path(folder, frame):
-    return os.path.join(folder, f"flames_{frame:04d}.vdb")
-
-
-def spines_path(folder, frame):
-    return os.path.join(folder, f"spines_{frame:04d}.npz")
-
-
-@dataclass
-class FlameSettings:
-    """Scene-level settings at one frame (scene.plume_flames), the paper's symbols in comments."""
-
-    points: int = 16                   # n (§4.1)
-    height_persistent: float = 0.03    # H_p (§4.3)
-    height_intermittent: float = 0.06  # H_i
-    height_max: float = 0.12           # H_max
-    lifespan_scale: float = 0.25       # A (s)
-    breakaway_frequency: float = 0.0   # f (Hz), 0 = 0.50 (g/2r)^½
-    buoyancy: float = 0.5              # β of eq. 2
-    diffusion: float = 1e-4            # d(T_p) of eq. 1, m²/s
-    particles_per_pixel: float = 10.0  # §5.3
-    max_particles: int = 50000
-    merging: bool = True               # §4.5
-    flow_noise: float = 0.15           # §4.5 buoyancy noise (widest radii)
-    kolmogorov: float = 0.003          # §4.5 Kolmogorov noise (m RMS)
-    voxel_size: float = 0.002
-    temperature_scale: float = 1500.0
-    heat_of_combustion: float = 15.0   # H_c, MJ/kg (eq. 5)
-
-
-@dataclass
-class WindInput:
-    """One field of w (eq. 1) at one frame: kind UNIFORM (vector), VORTEX (centre, axis,
-    strength), TURBULENCE (strength, size, flow, seed)."""
-
-    kind: str
-    vector: Tuple[float, float, float] = (0.0, 0.0, 0.0)
-    centre: Tuple[float, float, float] = (0.0, 0.0, 0.0)
-    strength: float = 0.0
-    size: float = 1.0
-    flow: float = 0.0
-    seed: int = 0
-
-
-@dataclass
-class CameraInput:
-    """The scene camera at one frame (FlameCamera); None in the snapshot: no camera."""
-
-    position: Tuple[float, float, float]
-    focal_length: float
-    sensor_width: float
-    width: int
-    height: int
-
-
-@dataclass
-class FlameSourceInput:
-    """One Flame Source object: its flames' places and spread values (fixed), and its keyable
-    values and world positions per frame."""
-
-    name: str
-    profile: str
-    #: CUSTOM: (k, 2) points (radius, height) of the profile curve, base first.
-    profile_points: Optional[np.ndarray] = None
-    #: §5.1 reference image, (h, w, 3) float32 rows from the bottom; None: white.
-    color_image: Optional[np.ndarray] = None
-    local_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))   # (k, 3)
-    local_normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (k, 3)
-    start_times: np.ndarray = field(default_factory=lambda: np.zeros(0))         # s
-    end_times: np.ndarray = field(default_factory=lambda: np.zeros(0))           # s (inf)
-    intensity_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    diameter_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    height_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    #: 4x4 world matrices at frames frame_start - 1 .. frame_end.
-    matrices: List[np.ndarray] = field(default_factory=list)
-    #: (radius r, intensity I, temperature T_p) at frames frame_start .. frame_end.
-    values: List[Tuple[float, float, float]] = field(default_factory=list)
-
-    @property
-    def count(self):
-        return len(self.local_points)
-
-
-@dataclass
-class ObstacleInput:
-    name: str
-    vertices: np.ndarray  # world, float32 (N, 3)
-    triangles: np.ndarray  # int (M, 3)
-
-
-@dataclass
-class FlameBakeSnapshot:
-    folder: str
-    frame_start: int
-    frame_end: int
-    fps: float
-    seed: int
-    substeps: int
-    sources: List[FlameSourceInput]
-    #: per frame frame_start .. frame_end
-    settings: List[FlameSettings]
-    winds: List[List[WindInput]]
-    cameras: List[Optional[CameraInput]]
-    obstacles: List[ObstacleInput] = field(default_factory=list)
-    #: §6.1: (domain name, its cache folder) whose volume_####.vdb velocity adds to w
-    wind_domain: Optional[Tuple[str, str]] = None
-
-    @property
-    def frame_count(self):
-        return self.frame_end - self.frame_start + 1
-
-
-def _check(ok, message):
-    if not ok:
-        raise BakeError("Plume: " + message)
-
-
-def _finite(*values):
-    return all(math.isfinite(v) for v in values)
-
-
-def validate_settings(s: FlameSettings, frame):
-    """BakeError naming the setting (the panel's name and the paper's symbol) and its range."""
-    at = f"Flames (frame {frame}):"
-    lo, hi = POINTS_RANGE
-    _check(lo <= s.points <= hi, f"{at} Control Points (n) must be in [{lo}, {hi}] "
-                                 f"(got {s.points})")
-    hp, hi_, hmax = s.height_persistent, s.height_intermittent, s.height_max
-    _check(_finite(hp, hi_, hmax) and hp >= 0.0,
-           f"{at} Persistent Height (H_p) must be >= 0 (got {hp})")
-    _check(hp < hi_, f"{at} Persistent Height (H_p = {hp:g}) must be below Intermittent Height "
-                     f"(H_i = {hi_:g}): the intermittent region is [H_p, H_i] (§4.3)")
-    _check(hmax >= hi_, f"{at} Max Height (H_max = {hmax:g}) must be >= Intermittent Height "
-                        f"(H_i = {hi_:g})")
-    _check(_finite(s.lifespan_scale) and 1.0 / 24.0 - 1e-9 <= s.lifespan_scale <= 2.0,
-           f"{at} Lifespan Scale (A) must be in [1/24, 2] s (got {s.lifespan_scale})")
-    _check(_finite(s.breakaway_frequency) and 0.0 <= s.breakaway_frequency <= 1000.0,
-           f"{at} Breakaway Frequency (f) must be in [0, 1000] Hz, 0 = automatic "
-           f"(got {s.breakaway_frequency})")
-    _check(_finite(s.buoyancy) and 0.0 <= s.buoyancy <= 100.0,
-           f"{at} Buoyancy (β) must be in [0, 100] (got {s.buoyancy})")
-    _check(_finite(s.diffusion) and 0.0 <= s.diffusion <= 10.0,
-           f"{at} Diffusion must be in [0, 10] m²/s (got {s.diffusion})")
-    _check(_finite(s.particles_per_pixel) and s.particles_per_pixel > 0.0,
-           f"{at} Particles per Pixel must be > 0 (got {s.particles_per_pixel})")
-    _check(64 <= s.max_particles <= 10_000_000,
-           f"{at} Max Particles must be in [64, 10000000] (got {s.max_particles})")
-    _check(_finite(s.voxel_size) and s.voxel_size > 0.0,
-           f"{at} Voxel Size must be > 0 (got {s.voxel_size})")
-    _check(_finite(s.flow_noise, s.kolmogorov) and s.flow_noise >= 0.0 and s.kolmogorov >= 0.0,
-           f"{at} Flow Noise and Kolmogorov Noise must be >= 0")
-
-
-def validate_source_values(src: FlameSourceInput):
-    for i, (r, intensity, temp) in enumerate(src.values):
-        at = f"Flame Source '{src.name}'"
-        _check(_finite(r) and r > 0.0, f"{at}: Radius (r) must be > 0 (got {r})")
-        _check(_finite(intensity) and intensity >= 0.0,
-               f"{at}: Intensity (I) must be >= 0 (got {intensity})")
-        _check(_finite(temp) and temp >= 0.0,
-               f"{at}: Temperature (T_p) must be >= 0 (got {temp})")
-
-
-def validate_snapshot(snap: FlameBakeSnapshot):
-    _check(bool(snap.sources), NO_SOURCE[len("Plume: "):])
-    _check(snap.frame_end >= snap.frame_start, f"Flames: End ({snap.frame_end}) must be >= "
-                                               f"Start ({snap.frame_start})")
-    lo, hi = SUBSTEPS_RANGE
-    _check(lo <= snap.substeps <= hi, f"Flames: Substeps must be in [{lo}, {hi}] "
-                                      f"(got {snap.substeps})")
-    for i, s in enumerate(snap.settings):
-        validate_settings(s, snap.frame_start + i)
-    for src in snap.sources:
-        validate_source_values(src)
+__all__ = ["SMOKE_ARRAYS", "SPINE_ARRAYS", "buoyancy_lift", "clear_folder", "read_manifest",
+           "read_spines", "write_manifest", "write_spines", "FIXED_PARTICLES",
+           "FLAMES_PER_SOURCE_RANGE", "FORMAT_VERSION", "MANIFEST_NAME", "NO_SOURCE",
+           "OBSTACLE_PADDING", "OBSTACLE_VOXEL", "POINTS_RANGE", "PROFILES", "SUBSTEPS_RANGE",
+           "CameraInput", "FlameBakeSnapshot", "FlameSettings", "FlameSourceInput",
+           "ObstacleInput", "WindInput", "spines_path", "validate_settings", "validate_snapshot",
+           "validate_source_values", "volume_path", "FlameNative", "shape_key", "FlameBakeResult",
+           "FlameBakeRunner"]
 
 
 class FlameNative:
@@ -450,100 +274,3 @@ class FlameBakeRunner:
             if self.progress is not None:
                 self.progress(i + 1, total)
         return result
-
-
-def clear_folder(folder):
-    """Removes the frames of an older bake (they would mix in) and its manifest."""
-    for name in os.listdir(folder):
-        if ((name.startswith("flames_") and name.endswith(".vdb"))
-                or (name.startswith("spines_") and name.endswith(".npz"))
-                or name == MANIFEST_NAME or name.endswith(".tmp")):
-            os.remove(os.path.join(folder, name))
-
-
-def write_manifest(snap, result):
-    data = {"format_version": FORMAT_VERSION, "kind": "flames",
-            "frame_start": snap.frame_start, "frame_end": snap.frame_end,
-            "last_complete_frame": result.last_frame, "seed": snap.seed,
-            "substeps": snap.substeps, "sources": [s.name for s in snap.sources],
-            "settings": asdict(snap.settings[0]),
-            # per baked frame: live flames and rendered particles (for scripts and the UI)
-            "flames": list(result.flames), "particles": list(result.particles)}
-    _write_atomic(os.path.join(snap.folder, MANIFEST_NAME), json.dumps(data, indent=1).encode())
-
-
-def read_manifest(folder):
-    """The manifest dict, or None when missing or unreadable."""
-    try:
-        with open(os.path.join(folder, MANIFEST_NAME), "rb") as f:
-            data = json.loads(f.read().decode())
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) and data.get("kind") == "flames" else None
-
-
-def _write_atomic(path, data: bytes):
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "wb") as f:
-        f.write(data)
-    os.replace(tmp, path)
-
-
-SPINE_ARRAYS = ("ids", "sources", "separated", "counts", "points", "light_ids", "light_centres",
-                "light_radii", "light_energy", "light_colors")
-#: What the smoke of §6.3 needs besides (flame_smoke.py); absent from caches of older versions:
-#: the points' velocities (Σ counts, 3), each flame's radius r and its buoyancy lift (eq. 2).
-SMOKE_ARRAYS = ("velocities", "radii", "lifts")
-
-
-def buoyancy_lift(flame, params):
-    """The upward acceleration of eq. 2 for a flame, m/s²: β |g| (T_p − T_0), the reading of
-    evolution.h (the velocity c = β |g| (T_p − T_0) t_p grows at this rate)."""
-    g = float(np.linalg.norm(params.gravity))
-    return params.buoyancy * g * (flame["temperature"] - params.ambient_temperature)
-
-
-def write_spines(path, flames, lights, params):
-    """spines_####.npz: per flame its id, source, separated flag and point count, the points
-    (Σ counts, 3) float32 base to tip and their velocities, its radius r and the lift of eq. 2
-    under FlameParams `params`; per light (§5.2) its flame id, centre, radius h/3, energy
-    (eq. 5 × intensity) and colour."""
-    pts = [np.asarray(f["points"], np.float32).reshape(-1, 3) for f in flames]
-    vel = [np.asarray(f["velocities"], np.float32).reshape(-1, 3) for f in flames]
-    buf = io.BytesIO()
-    np.savez(buf, ids=np.asarray([f["id"] for f in flames], np.uint32),
-             sources=np.asarray([f["source"] for f in flames], np.int32),
-             separated=np.asarray([f["separated"] for f in flames], bool),
-             counts=np.asarray([len(p) for p in pts], np.int32),
-             points=(np.concatenate(pts) if pts else np.zeros((0, 3), np.float32)),
-             velocities=(np.concatenate(vel) if vel else np.zeros((0, 3), np.float32)),
-             radii=np.asarray([f["radius"] for f in flames], np.float32),
-             lifts=np.asarray([buoyancy_lift(f, params) for f in flames], np.float32),
-             light_ids=np.asarray([li["flame_id"] for li in lights], np.uint32),
-             light_centres=np.asarray([li["centre"] for li in lights], np.float32).reshape(-1, 3),
-             light_radii=np.asarray([li["radius"] for li in lights], np.float32),
-             light_energy=np.asarray([li["energy"] for li in lights], np.float32),
-             light_colors=np.asarray([li["color"] for li in lights], np.float32).reshape(-1, 3))
-    _write_atomic(path, buf.getvalue())
-
-
-def read_spines(path):
-    """The arrays of a spines file (SMOKE_ARRAYS too when present); OSError or ValueError when it
-    cannot be read or its sizes disagree (checked, never trusted)."""
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            d = {k: np.array(data[k]) for k in SPINE_ARRAYS}
-            d.update({k: np.array(data[k]) for k in SMOKE_ARRAYS if k in data.files})
-    except KeyError as e:
-        raise ValueError(f"{path}: no {e} array") from None
-    except zipfile.BadZipFile as e:
-        raise ValueError(f"{path}: {e}") from None
-    k, m = len(d["ids"]), len(d["light_ids"])
-    if (any(len(d[a]) != k for a in ("sources", "separated", "counts"))
-            or d["points"].shape != (int(d["counts"].sum()), 3) or np.any(d["counts"] < 0)
-            or d["light_centres"].shape != (m, 3) or d["light_colors"].shape != (m, 3)
-            or len(d["light_radii"]) != m or len(d["light_energy"]) != m
-            or ("velocities" in d and d["velocities"].shape != d["points"].shape)
-            or any(a in d and d[a].shape != (k,) for a in ("radii", "lifts"))):
-        raise ValueError(f"{path}: arrays of mismatched sizes")
-    return d

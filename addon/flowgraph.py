@@ -9,7 +9,6 @@ The graph's nodes are the pathline groups of every state, state by state in file
 n of the graph is group node_steps[n] of state node_states[n]'s pathline file.
 """
 
-import io
 import math
 import os
 import time
@@ -20,13 +19,18 @@ from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import cache
+from . import cache, files
 from .settings import BakeError
+# Build Flow Graph's and Synthesize Fire's settings, also reachable as flowgraph.<name>.
+from .flowgraph_settings import (PREVIEW_POINTS_RANGE, TRAVERSALS, FlowGraphSettings,
+                                 SynthesisSettings, validate_graph_settings, validate_synthesis)
+
+__all__ = ["PREVIEW_POINTS_RANGE", "TRAVERSALS", "FlowGraphSettings", "SynthesisSettings",
+           "validate_graph_settings", "validate_synthesis"]
 
 GRAPH_NAME = "flowgraph.npz"
 IMAGE_NAME = "flowgraph_cost.png"
 FIRE_FOLDER = "fire"
-TRAVERSALS = ('UNIFORM', 'BIASED')
 
 
 def graph_path(folder):
@@ -46,9 +50,6 @@ def points_path(folder, frame):
     return os.path.join(folder, FIRE_FOLDER, f"points_{frame:04d}.npz")
 
 
-#: Range of SynthesisSettings.preview_points (points per frame of the preview).
-PREVIEW_POINTS_RANGE = (100, 1_000_000)
-
 
 def preview_indices(count, cap):
     """Indices of the particles kept in the point preview: all when count <= cap, else exactly
@@ -63,12 +64,10 @@ def write_points(path, particles, cap):
     name + rename): positions (M, 3), temperature and density (M,) float32 and live (the number
     of live particles it was thinned from)."""
     keep = preview_indices(len(particles["temperature"]), cap)
-    buf = io.BytesIO()
-    np.savez(buf, positions=np.asarray(particles["positions"], np.float32)[keep],
-             temperature=np.asarray(particles["temperature"], np.float32)[keep],
-             density=np.asarray(particles["density"], np.float32)[keep],
-             live=np.int64(len(particles["temperature"])))
-    _write_atomic(path, buf.getvalue())
+    files.save_npz(path, positions=np.asarray(particles["positions"], np.float32)[keep],
+                   temperature=np.asarray(particles["temperature"], np.float32)[keep],
+                   density=np.asarray(particles["density"], np.float32)[keep],
+                   live=np.int64(len(particles["temperature"])))
 
 
 def read_points(path):
@@ -88,43 +87,6 @@ def read_points(path):
                                          for k in ("positions", "temperature", "density"))):
         raise ValueError(f"{path}: arrays of mismatched sizes or types")
     return p
-
-
-@dataclass
-class FlowGraphSettings:
-    """§4.3: weights of eq. 9, the block size B and ε of eq. 11."""
-
-    block_size: int = 32        # B
-    epsilon: float = 0.0        # ε; 0 = (2a + b) / 3
-    auto_weights: bool = True   # α, β bringing the three terms to one order of magnitude
-    alpha: float = 1.0          # α (density) when not automatic
-    beta: float = 1.0           # β (temperature) when not automatic
-    min_node_gap: int = 8       # transitions between nodes this close in one state are dropped
-
-
-@dataclass
-class SynthesisSettings:
-    """§5: the random walk and what the synthesized particles feel. targets[f] and winds[f] are
-    the keyed target state (-1: none) and uniform wind (m/s) of frame frame_start + f."""
-
-    frame_start: int = 1
-    frame_end: int = 200
-    seed: int = 0
-    traversal: str = 'BIASED'   # UNIFORM: p = 1/d(V_i); BIASED: eq. 12 with γ
-    gamma: float = 0.875        # γ of eq. 12
-    start_state: int = 0
-    targets: List[int] = field(default_factory=list)
-    winds: List[Tuple[float, float, float]] = field(default_factory=list)
-    ignition_temperature: float = 1.0
-    max_temperature: float = 4.0
-    #: turbulence[f]: the Turbulence force fields of frame f as (strength, size, seed) each
-    turbulence: List[List[Tuple[float, float, int]]] = field(default_factory=list)
-    #: also write fire/points_<frame>.npz: at most preview_points live particles per frame
-    point_preview: bool = False
-    preview_points: int = 20000
-    #: MB of prepared pathline groups the native Synthesizer keeps between visits of the walk
-    #: (least recently used out); 0 reads every visit from its file
-    group_cache_mb: int = 2048
 
 
 #: Fourier modes of the turbulence velocity (enough for an irregular, smooth field).
@@ -167,47 +129,6 @@ class State:
     name: str
     folder: str
     file: object  # _native.PathlineFile
-
-
-def validate_graph_settings(s: FlowGraphSettings, owner):
-    if s.block_size < 1:
-        raise BakeError(f"Plume: {owner}: block_size (B) must be >= 1 (got {s.block_size})")
-    if s.min_node_gap < 0:
-        raise BakeError(f"Plume: {owner}: min_node_gap must be >= 0 (got {s.min_node_gap})")
-    if not (math.isfinite(s.epsilon) and s.epsilon >= 0.0):
-        raise BakeError(f"Plume: {owner}: epsilon (ε) must be 0 (automatic: (2a+b)/3) or a "
-                        f"cost in [a, b] (got {s.epsilon})")
-    for name in ("alpha", "beta"):
-        v = getattr(s, name)
-        if not s.auto_weights and not (math.isfinite(v) and v >= 0.0):
-            raise BakeError(f"Plume: {owner}: {name} must be >= 0 (got {v})")
-
-
-def validate_synthesis(s: SynthesisSettings, state_count, owner):
-    if s.frame_end < s.frame_start:
-        raise BakeError(f"Plume: {owner}: synthesis frame_end must be >= frame_start "
-                        f"(got {s.frame_start}..{s.frame_end})")
-    if s.traversal not in TRAVERSALS:
-        raise BakeError(f"Plume: {owner}: traversal must be one of {', '.join(TRAVERSALS)}")
-    if not (0.0 < s.gamma < 1.0):
-        raise BakeError(f"Plume: {owner}: gamma (γ) must be in (0, 1) (got {s.gamma})")
-    if not (0 <= s.start_state < state_count):
-        raise BakeError(f"Plume: {owner}: start_state must be in [0, {state_count - 1}] "
-                        f"(got {s.start_state})")
-    bad = [t for t in s.targets if not (-1 <= t < state_count)]
-    if bad:
-        raise BakeError(f"Plume: {owner}: target_state must be -1 (none) or in [0, "
-                        f"{state_count - 1}] (got {bad[0]})")
-    if not (0.0 <= s.ignition_temperature < s.max_temperature):
-        raise BakeError(f"Plume: {owner}: the fire needs 0 <= ignition temperature < max "
-                        f"temperature (got {s.ignition_temperature}, {s.max_temperature})")
-    lo, hi = PREVIEW_POINTS_RANGE
-    if s.point_preview and not (lo <= s.preview_points <= hi):
-        raise BakeError(f"Plume: {owner}: preview_points must be in [{lo}, {hi}] "
-                        f"(got {s.preview_points})")
-    if not (0 <= s.group_cache_mb <= 65536):
-        raise BakeError(f"Plume: {owner}: group_cache must be in [0, 65536] MB "
-                        f"(got {s.group_cache_mb})")
 
 
 def open_states(native, named_folders: Sequence[Tuple[str, str]]) -> List[State]:
@@ -309,12 +230,13 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
                "pruned": [int(v) for v in graph.pruned_per_state],
                "nodes": [int(v) for v in counts]}
     os.makedirs(out_folder, exist_ok=True)
-    _save_npz(graph_path(out_folder), cost=cost, state_node_counts=np.asarray(counts, np.int64),
-              state_names=np.asarray([st.name for st in states]),
-              state_folders=np.asarray([st.folder for st in states]),
-              settings=np.asarray([s.block_size, s.min_node_gap, s.epsilon, alpha, beta],
-                                  np.float64))
-    _write_atomic(image_path(out_folder), png_rgb(np.asarray(image)))
+    files.save_npz(graph_path(out_folder), compressed=True, cost=cost,
+                   state_node_counts=np.asarray(counts, np.int64),
+                   state_names=np.asarray([st.name for st in states]),
+                   state_folders=np.asarray([st.folder for st in states]),
+                   settings=np.asarray([s.block_size, s.min_node_gap, s.epsilon, alpha, beta],
+                                       np.float64))
+    files.write_bytes(image_path(out_folder), png_rgb(np.asarray(image)))
     if progress is not None:
         progress(1.0)
     return {"graph": graph, "cost": cost, "summary": summary, "params": params}
@@ -329,21 +251,6 @@ def _candidate_range(native, cost, counts, params):
         return ""
     return (f" (the candidate transition costs span [a, b] = [{t['a']:.4g}, {t['b']:.4g}]: an "
             "ε nearer b keeps more transitions)")
-
-
-def _write_atomic(path, data: bytes):
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
-def _save_npz(path, **arrays):
-    tmp = f"{path}.{os.getpid()}.tmp.npz"
-    np.savez_compressed(tmp, **arrays)
-    os.replace(tmp, path)
 
 
 def png_rgb(rgb):

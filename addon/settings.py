@@ -10,9 +10,11 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
+from .ranges import RANGES
+
 #: Accepted range of the domain's resolution (cells along the longest axis); the native
 #: SmokeParams.validate() applies the same bound per axis.
-RESOLUTION_RANGE = (2, 1024)
+RESOLUTION_RANGE = RANGES["resolution"]
 
 #: Order of the six boundary sides, as in SmokeParams.boundaries.
 BOUNDARY_SIDES = ("neg_x", "pos_x", "neg_y", "pos_y", "neg_z", "pos_z")
@@ -185,13 +187,11 @@ class EmitterSnapshot:
         return data
 
 
-#: Accepted range of the streak settings (the native StreakParams / random_points_in_cells bounds).
-EMISSION_PERIOD_RANGE = (1, 100000)
-#: Accepted max_streaklines: 0 (keep every point source) or at least the 2 a surface needs.
-MAX_STREAKLINES_RANGE = (0, 1000000)
-POINT_SOURCES_RANGE = (1, 10000)
-#: Accepted range of a source's candidate_split (§3.3).
-CANDIDATE_SPLIT_RANGE = (1, 64)
+#: Accepted ranges of the streak settings (ranges.py).
+EMISSION_PERIOD_RANGE = RANGES["emission_period"]
+MAX_STREAKLINES_RANGE = RANGES["max_streaklines"]
+POINT_SOURCES_RANGE = RANGES["point_sources"]
+CANDIDATE_SPLIT_RANGE = RANGES["candidate_split"]
 
 
 @dataclass
@@ -204,8 +204,8 @@ class StreakSettings:
     max_streaklines: int = 256
 
 
-#: Accepted range of the pathline settings (the native PathlineParams bounds).
-NODES_PER_FRAME_RANGE = (1, 64)
+#: Accepted range of the pathline settings (ranges.py).
+NODES_PER_FRAME_RANGE = RANGES["pathline_nodes_per_frame"]
 
 
 @dataclass
@@ -294,7 +294,7 @@ class BakeSnapshot:
 
 
 def domain_grid(bbox_min, bbox_max, resolution):
-    """Cells per axis, cell size and origin of a domain box (ADDON.md "Domain geometry"): the
+    """Cells per axis, cell size and origin of a domain box: the
     longest axis gets `resolution` cells, the others round(dim / cell_size), at least 2."""
     dims = [float(b) - float(a) for a, b in zip(bbox_min, bbox_max)]
     longest = max(dims)

@@ -8,10 +8,11 @@ a small deterministic encoder, so two builds give byte-identical files.
 
 import os
 import struct
-import uuid
 import zlib
 
 import numpy as np
+
+from . import files
 
 #: Stencil kinds Plume generates (the UI's IMAGE kind uses the artist's file instead).
 KINDS = ('CIRCLE', 'PUFFY', 'HAIRY')
@@ -92,13 +93,6 @@ def png_bytes(rgba):
 
 
 def write_stencil(folder, kind, size=SIZE):
-    """Writes <folder>/stencil_<kind>.png atomically (temporary name, then rename); its path."""
+    """Writes <folder>/stencil_<kind>.png atomically (files.write_bytes); its path."""
     path = os.path.join(folder, stencil_name(kind))
-    data = png_bytes(stencil_rgba(kind, size))
-    tmp = f"{path}.{uuid.uuid4().hex[:8]}.tmp"
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-    return path
+    return files.write_bytes(path, png_bytes(stencil_rgba(kind, size)))

@@ -8,6 +8,7 @@ import bpy
 
 from . import datablocks, volume
 from .. import flames
+from ..snapshot import blend_relative
 
 OBJECT_NAME = "Plume Flames"
 MATERIAL = "Plume Flames"
@@ -68,7 +69,7 @@ def build(scene, folder, frame_start, frames, emission):
         # the (nearly transparent, §5.3) volume to its own lights cost most of the render time.
         ob.visible_diffuse = False
         ob.visible_shadow = False
-    volume.play_sequence(ob, volume._file_path(flames.volume_path(folder, frame_start)),
+    volume.play_sequence(ob, blend_relative(flames.volume_path(folder, frame_start)),
                          frame_start, frames, flames_material(emission))
     if ob.data.materials[0] is None:
         ob.data.materials[0] = flames_material(emission)

@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from . import datablocks
-from .surfaces import _file_path  # //-relative when the .blend is saved
+from ..snapshot import blend_relative
 
 
 class LastFile:
@@ -83,7 +83,7 @@ def cached_frames(ob, folder_key, range_key):
 
 
 def stored_path(folder):
-    return _file_path(folder)
+    return blend_relative(folder)
 
 
 def remove_object(name):

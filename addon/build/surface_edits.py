@@ -24,7 +24,7 @@ plume.surface_edits_store operator (which also loads edit-mode data first).
 import bpy
 import numpy as np
 
-from .. import _native
+from ..native import _native
 from .. import blender_compat as compat
 
 #: Offsets (float64, nu * nv * 3) of the hand edits in each control point's (t, b, n) frame.

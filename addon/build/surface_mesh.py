@@ -9,7 +9,8 @@ import re
 import bpy
 import numpy as np
 
-from .. import _native, cache
+from .. import cache
+from ..native import _native
 from ..settings import BakeError
 from . import surface_edits
 from .surfaces import CACHE_KEY, cache_of

@@ -12,6 +12,7 @@ import numpy as np
 
 from . import frame_handlers, surface_edits
 from .. import blender_compat as compat
+from ..snapshot import blend_relative
 
 #: Custom properties of a surface object: its control-point cache and the domain it came from.
 CACHE_KEY = "plume_surface_cache"
@@ -37,15 +38,6 @@ last_update_seconds = []
 
 def collection_name(domain):
     return f"{domain.name}_surfaces"
-
-
-def _file_path(path):
-    if bpy.data.is_saved:
-        try:
-            return bpy.path.relpath(path)
-        except ValueError:
-            return path
-    return path
 
 
 # --------------------------------------------------------------------------- frame handler
@@ -120,7 +112,7 @@ def unregister():
 
 # --------------------------------------------------------------------------- objects
 def surface_object(name, collection, nu, nv, view_layer):
-    """SURFACE object with an nu x nv NURBS net (BLENDER_NOTES §2 recipe). make_segment merges
+    """SURFACE object with an nu x nv NURBS net built from 1-D NURBS rows. make_segment merges
     the 1-D rows and transposes them; with 2 rows it leaves them unmerged in 3.4.1, so one u row
     is extruded once instead (blender_tests/test_nurbs_tessellation.py)."""
     cu = bpy.data.curves.new(name, 'SURFACE')
@@ -199,7 +191,7 @@ def build_surfaces(context, domain, folder, frame_start, anims, sheets, settings
             sp.order_u, sp.order_v = anim.order_u, anim.order_v
             sp.use_endpoint_u = sp.use_endpoint_v = True
             sp.resolution_u, sp.resolution_v = resolution_u(anim.order_u), RESOLUTION_V
-            ob[CACHE_KEY] = _file_path(cache.surface_path(folder, i))
+            ob[CACHE_KEY] = blend_relative(cache.surface_path(folder, i))
             _control_points(cache.surface_path(folder, i))  # loaded now, not on the first frame
             ob[DOMAIN_KEY] = domain.name
             path, width, height, frames = sheets[i]

@@ -10,6 +10,7 @@ import bpy
 import numpy as np
 
 from . import frame_handlers, point_frames
+from ..native import _native
 from .toon_nodes import (COLOR_ATTRIBUTE, VELOCITY_ATTRIBUTE, billboard_modifier,
                          set_camera)
 
@@ -30,18 +31,13 @@ def object_name(domain):
     return f"{domain.name}_toon"
 
 
-def _native():
-    from .. import _native
-    return _native
-
-
 def _toon_path(folder, frame):
     from ..toon import toon_path
     return toon_path(folder, frame)
 
 
 #: The toon file of the last frame read (one kept: frames are read in order).
-_files = point_frames.LastFile(lambda path: _native().read_toon_file(path), RuntimeError)
+_files = point_frames.LastFile(lambda path: _native.read_toon_file(path), RuntimeError)
 
 
 def write_points(mesh, snap):

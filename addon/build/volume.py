@@ -3,7 +3,9 @@ Renders without the add-on (Blender reads the VDB files itself)."""
 
 import bpy
 
+from . import datablocks
 from .. import cache
+from ..snapshot import blend_relative
 
 SMOKE_MATERIAL = "Plume Smoke"
 FIRE_MATERIAL = "Plume Fire"
@@ -22,22 +24,7 @@ def volume_name(domain):
     return f"{domain.name}_smoke"
 
 
-def _file_path(path):
-    """'//'-relative when the .blend is saved (render farms see the same path), else absolute."""
-    if bpy.data.is_saved:
-        try:
-            return bpy.path.relpath(path)
-        except ValueError:  # another drive
-            return path
-    return path
-
-
-def _setup_material(mat, combustion, max_temperature):
-    mat.use_nodes = True
-    nt = mat.node_tree
-    nt.nodes.clear()
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    out.location = (300, 0)
+def _setup_material(nt, out, combustion, max_temperature):
     pv = nt.nodes.new("ShaderNodeVolumePrincipled")
     pv.location = (0, 0)
     pv.inputs["Density"].default_value = SMOKE_DENSITY
@@ -80,8 +67,8 @@ def material(combustion, max_temperature=4.0):
     name = FIRE_MATERIAL if combustion else SMOKE_MATERIAL
     mat = bpy.data.materials.get(name)
     if mat is None:
-        mat = bpy.data.materials.new(name)
-        _setup_material(mat, combustion, max_temperature)
+        mat, nt, out = datablocks.node_material(name)
+        _setup_material(nt, out, combustion, max_temperature)
     return mat
 
 
@@ -100,14 +87,10 @@ def build_volume(domain, folder, frame_start, frames_done, combustion=False, max
         remove_volume(domain)  # nothing baked (e.g. cancelled in frame 1): old frames are gone
         return None
     ob = find_volume_object(domain)
-    path = _file_path(cache.volume_path(folder, frame_start))
+    path = blend_relative(cache.volume_path(folder, frame_start))
     if ob is None:
-        vol = bpy.data.volumes.new(volume_name(domain))
-        ob = bpy.data.objects.new(volume_name(domain), vol)
-        for coll in domain.users_collection:
-            coll.objects.link(ob)
-        if not ob.users_collection:
-            bpy.context.scene.collection.objects.link(ob)
+        ob = datablocks.typed_object(bpy.context.scene, volume_name(domain), 'VOLUME',
+                                     bpy.data.volumes.new, domain.users_collection)
     play_sequence(ob, path, frame_start, frames_done, material(combustion, max_temperature))
     domain.plume.domain.volume_object = ob.name
     domain.plume.domain.frames_baked = frames_done

@@ -1,4 +1,4 @@
-"""The operator mixin of every job (BLENDER_NOTES §5): one shape for Bake, Bake Flames, Build
+"""The operator mixin of every job (DESIGN.md "Layers"): one shape for Bake, Bake Flames, Build
 Surfaces, Build Toon Smoke, Build Flow Graph, Synthesize Fire and Export Mesh.
 
     class PLUME_OT_x(JobOperator, bpy.types.Operator):

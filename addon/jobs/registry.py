@@ -5,10 +5,16 @@ toon smoke, flow graph and synthesis, ("flames",) for the scene's flames bake. A
 held key is refused with the holder's busy_text(); Free Bake and the panels ask busy().
 abort_all() stops every job for a file load or quit: cancel, wait for the worker, discard."""
 
+import traceback
+
 from ..settings import BakeError
 
 #: key -> the JobRunner holding it
 _held = {}
+
+#: Called as listener(runner) each time release() runs, i.e. whenever a job ends (finished,
+#: failed, refused, cancelled or aborted): the panels' cache state is read again from there.
+ended = []
 
 #: Seconds abort_all() waits for a cancelled worker (cancel acts within one unit of work).
 ABORT_WAIT_S = 30.0
@@ -30,6 +36,11 @@ def release(runner):
     for key in list(runner.keys):
         if _held.get(key) is runner:
             del _held[key]
+    for listener in list(ended):
+        try:
+            listener(runner)
+        except Exception:  # a listener never stops a job from ending
+            traceback.print_exc()
 
 
 def holder(key):

@@ -11,6 +11,8 @@ import os
 import shutil
 import uuid
 
+from ..files import sync_folder
+
 PREFIX = ".plume_job_"
 
 
@@ -76,7 +78,8 @@ class Staging:
     def commit(self, replaced=()):
         """Moves every staged file into the cache folder (atomic rename each), then deletes the
         files of `replaced` (the previous result) that no staged file replaced; removes the
-        staging folder. Returns the final paths."""
+        staging folder. Returns the final paths. Staged files are written with files.write_bytes
+        (fsynced); the cache folder is fsynced after the renames."""
         moved = []
         for rel in self.staged_files():
             if rel.endswith(".tmp"):
@@ -85,6 +88,8 @@ class Staging:
             os.makedirs(os.path.dirname(dest), exist_ok=True)
             os.replace(os.path.join(self.path, rel), dest)
             moved.append(os.path.abspath(dest))
+        for folder in sorted({os.path.dirname(path) for path in moved}):
+            sync_folder(folder)  # the renames are durable before the old result is deleted
         for path in replaced:
             if os.path.abspath(path) not in moved:
                 try:

@@ -6,18 +6,14 @@ later bake with the same settings resumes from them) and builds the Volume over 
 
 import bpy
 
-from .. import bake_runner, cache
-from .. import _native
+from .. import bake_runner, cache, cache_state
+from ..native import _native
 from ..build import volume
 from ..jobs import JobOperator, JobRunner, registry
 from ..mantaflow_trace import MantaflowTraceRunner
 from ..settings import BakeError
+from ..version import VERSION
 from ..snapshot import NOT_A_DOMAIN, active_domain, cache_folder_of, take_snapshot
-
-
-def _addon_version():
-    from .. import VERSION
-    return VERSION
 
 
 def domain_key(name):
@@ -34,7 +30,7 @@ class BakeJob(JobRunner):
 
     def prepare(self, context):
         """Snapshot + validation; BakeError on bad input, nothing written."""
-        snap = take_snapshot(context, addon_version=_addon_version())
+        snap = take_snapshot(context, addon_version=VERSION)
         self.domain_name = snap.domain_name
         self.objects = (snap.domain_name,)
         self.claim(domain_key(snap.domain_name))
@@ -109,20 +105,10 @@ class PLUME_OT_cache_free(bpy.types.Operator):
             return {'CANCELLED'}
         folder = cache_folder_of(domain)
         count = cache.delete_plume_files(folder)
+        cache_state.refresh(domain)
         volume.remove_volume(domain)
         self.report({'INFO'}, f"Plume: freed '{domain.name}' ({count} files deleted)")
         return {'FINISHED'}
-
-
-def cache_status(domain):
-    """(frames done, frames total) of the domain's cache, read from its manifest."""
-    d = domain.plume.domain
-    total = max(0, d.frame_end - d.frame_start + 1)
-    m = cache.read_manifest(cache_folder_of(domain))
-    if m is None or m.get("frame_start") != d.frame_start:
-        return 0, total
-    done = min(m.get("last_complete_frame", 0), d.frame_end) - d.frame_start + 1
-    return max(0, done), total
 
 
 def is_baking(domain):

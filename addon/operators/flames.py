@@ -11,9 +11,11 @@ import time
 
 import bpy
 
-from .. import _native, flames
+from .. import flames
+from ..native import _native
 from ..build import flame_spine_keys, flame_spines, flames_volume
-from ..flame_snapshot import cache_folder, flames_snapshot
+from ..snapshot import flames_cache_folder
+from ..snapshot.flames import flames_snapshot
 from ..jobs import JobOperator, JobRunner, registry
 
 #: The registry key of the scene's flames bake (one at a time).
@@ -98,7 +100,7 @@ class PLUME_OT_flames_free(bpy.types.Operator):
             self.report({'ERROR'}, "Plume: flames are baking; cancel the bake first")
             return {'CANCELLED'}
         scene = context.scene
-        folder = cache_folder(scene)
+        folder = flames_cache_folder(scene)
         count = 0
         if os.path.isdir(folder):
             before = len(os.listdir(folder))
@@ -133,7 +135,7 @@ class PLUME_OT_flames_bake_spines_keyframes(bpy.types.Operator):
             return {'CANCELLED'}
         first = int(f.frame_start)
         try:
-            objects, keys = flame_spine_keys.bake(scene, cache_folder(scene), first,
+            objects, keys = flame_spine_keys.bake(scene, flames_cache_folder(scene), first,
                                                   first + int(f.frames_baked) - 1)
         except (OSError, ValueError) as e:
             self.report({'ERROR'}, f"Plume: the flames cache cannot be read: {e}")

@@ -9,31 +9,19 @@ import os
 import time
 
 import bpy
-import numpy as np
 
-from .. import _native, cache, flowgraph
+from .. import cache, flowgraph
+from ..native import _native
 from ..build import fire_points, fire_volume
 from ..jobs import JobOperator, JobProgress, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
+from ..snapshot.flowgraph import (frame_inputs, graph_settings,  # noqa: F401  (scripts)
+                                 state_domains, synthesis_settings)
 from .bake import domain_key
 
 #: Image datablock showing the cost matrix (Figure 4) in the panel.
 IMAGE_PREFIX = "Plume Flow Graph "
-
-
-def state_domains(context, active):
-    """The selected Plume domains (the active one included), ordered by name: state 0, 1, ..."""
-    chosen = {o.name: o for o in context.selected_objects
-              if getattr(o, "plume", None) is not None and o.plume.role == 'DOMAIN'}
-    chosen[active.name] = active
-    return [chosen[name] for name in sorted(chosen)]
-
-
-def graph_settings(g):
-    return flowgraph.FlowGraphSettings(
-        block_size=int(g.block_size), epsilon=float(g.epsilon), auto_weights=bool(g.auto_weights),
-        alpha=float(g.alpha), beta=float(g.beta), min_node_gap=int(g.min_node_gap))
 
 
 def show_cost_image(domain, folder):
@@ -121,37 +109,6 @@ class PLUME_OT_flowgraph_build(JobOperator, bpy.types.Operator):
         return FlowGraphJob()
 
 
-def frame_inputs(context, domain, frame_start, frame_end):
-    """(targets, winds, turbulence) per frame: the keyed target_state, the uniform wind plus the
-    scene's Wind force fields (Strength m/s along their Z axis) and the Turbulence force fields
-    as (strength, size, seed) (flowgraph.turbulence_velocity), evaluated frame by frame (the
-    current frame is restored)."""
-    scene = context.scene
-    g = domain.plume.domain.flowgraph
-    current, subframe = scene.frame_current, scene.frame_subframe
-    targets, winds, turbulence = [], [], []
-    try:
-        for f in range(frame_start, frame_end + 1):
-            scene.frame_set(f)
-            wind = np.array(g.wind, dtype=np.float64)
-            turb = []
-            for ob in scene.objects if g.use_force_fields else ():
-                fld = ob.field
-                if fld is None or ob.hide_render:
-                    continue
-                if fld.type == 'WIND':
-                    axis = np.array(ob.matrix_world.to_3x3().col[2], dtype=np.float64)
-                    wind += fld.strength * axis / max(np.linalg.norm(axis), 1e-12)
-                elif fld.type == 'TURBULENCE':
-                    turb.append((float(fld.strength), float(fld.size), int(fld.seed)))
-            targets.append(int(g.target_state))
-            winds.append(tuple(float(v) for v in wind))
-            turbulence.append(turb)
-    finally:
-        scene.frame_set(current, subframe=subframe)
-    return targets, winds, turbulence
-
-
 #: The registry key of fire synthesis: one at a time (the session's prepared-group cache).
 SYNTHESIS_KEY = ("fire synthesis",)
 
@@ -168,19 +125,12 @@ class SynthesisJob(JobRunner):
         self.t0 = time.perf_counter()
         domain = active_domain(context)
         self.domain_name = domain.name
-        g = domain.plume.domain.flowgraph
         owner = f"domain '{domain.name}'"
         self.folder = folder = cache_folder_of(domain)
         self.objects = (domain.name,)
         self.claim(domain_key(domain.name), SYNTHESIS_KEY)
         graph, states = flowgraph.load_graph(_native, folder, owner)
-        d = domain.plume.domain
-        settings = flowgraph.SynthesisSettings(
-            frame_start=int(g.frame_start), frame_end=int(g.frame_end), seed=int(g.seed),
-            traversal=g.traversal, gamma=float(g.gamma), start_state=int(g.start_state),
-            max_temperature=float(d.max_temperature),
-            point_preview=bool(g.point_preview), preview_points=int(g.preview_points),
-            group_cache_mb=int(g.group_cache))
+        settings = synthesis_settings(domain)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)
         settings.targets, settings.winds, settings.turbulence = frame_inputs(
             context, domain, settings.frame_start, settings.frame_end)

@@ -11,13 +11,15 @@ import time
 import bpy
 import numpy as np
 
-from .. import _native, cache
+from .. import cache, files
+from ..native import _native
 from .. import streak_surfaces as ss
 from .. import sheet_render, surfaces_forecast
 from ..build import surfaces as build
 from ..jobs import Forecast, JobOperator, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
+from ..snapshot.streaks import sheet_settings
 from .bake import domain_key
 
 #: h per candidate group, cached in memory for the panel's live count (never computed in draw):
@@ -31,21 +33,23 @@ def _cache_key(folder, manifest):
             run.get("seconds"))
 
 
-def cached_distances(domain):
-    """The h matrices of the domain's last computation if they match its cache, else None."""
+def cached_distances(domain, manifest=None):
+    """The h matrices of the domain's last computation if they match its cache (its manifest:
+    `manifest` when given, else read from the disk), else None."""
     hit = _distances.get(domain.name)
     if hit is None:
         return None
     folder = cache_folder_of(domain)
-    m = cache.read_manifest(folder)
+    m = manifest if manifest is not None else cache.read_manifest(folder)
     if m is None or _cache_key(folder, m) != hit[0]:
         return None
     return hit[1]
 
 
-def live_summary(domain):
-    """(surfaces, streaklines) for the domain's current h0 from cached h, or None."""
-    groups = cached_distances(domain)
+def live_summary(domain, manifest=None):
+    """(surfaces, streaklines) for the domain's current h0 from cached h, or None (`manifest` as
+    in cached_distances)."""
+    groups = cached_distances(domain, manifest)
     h0 = domain.plume.domain.streak_threshold
     if groups is None or not np.isfinite(h0) or h0 < 0:
         return None
@@ -64,17 +68,6 @@ def compute_distances(domain):
     groups = ss.group_distances(_native, frames)
     _distances[domain.name] = (_cache_key(folder, m), groups)
     return folder, m, frames, groups
-
-
-def _settings_of(d):
-    for name in ("density_k_u", "density_k_v"):
-        k = getattr(d, name)
-        if k < 0:
-            raise BakeError(f"Plume: {name} must be >= 0 (samples between particles, §3.4; "
-                            f"got {k})")
-    return {"k_u": int(d.density_k_u), "k_v": int(d.density_k_v), "falloff": d.sheet_falloff,
-            "color": tuple(d.sheet_color), "brightness": float(d.sheet_brightness),
-            "opacity": float(d.sheet_opacity)}
 
 
 class SurfacesJob(JobRunner):
@@ -108,7 +101,7 @@ class SurfacesJob(JobRunner):
         domain = active_domain(context)
         d = domain.plume.domain
         self.domain_name = domain.name
-        self.settings = _settings_of(d)
+        self.settings = sheet_settings(d)
         ss.check_threshold(d.streak_threshold, domain.name)
         self.h0 = d.streak_threshold
         self.folder = cache_folder_of(domain)
@@ -145,9 +138,9 @@ class SurfacesJob(JobRunner):
         staged = self.stage(folder)
         for i, anim in enumerate(anims):
             self.check_cancel()
-            np.savez(cache.surface_path(staged, i), control_points=anim.control_points,
-                     frame_start=frame_start, nu=anim.nu, nv=anim.nv, order_u=anim.order_u,
-                     order_v=anim.order_v)
+            files.save_npz(cache.surface_path(staged, i), control_points=anim.control_points,
+                           frame_start=frame_start, nu=anim.nu, nv=anim.nv, order_u=anim.order_u,
+                           order_v=anim.order_v)
 
     def _density_maps(self, folder, m, anims, settings):
         """§3.4 density map of every surface at every frame (from the VDB density grids)."""

@@ -9,26 +9,16 @@ import time
 
 import bpy
 
-from .. import _native, toon
+from .. import toon
+from ..native import _native
 from ..build import toon_compositor, toon_nodes, toon_points
 from ..jobs import JobOperator, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of, emitter_snapshots
+from ..snapshot.toon import toon_settings
 from ..toon_sources import ToonSourceCells
 from ..toon_stencils import write_stencil
 from .bake import domain_key
-
-
-def toon_settings(d):
-    """toon.ToonSettings of a domain's obj.plume.domain.toon (image path made absolute)."""
-    t = d.toon
-    s = toon.ToonSettings()
-    for name in toon.PARAM_FIELDS + ('depth_threshold', 'stencil', 'ignore_background'):
-        if name != 'threads':
-            setattr(s, name, type(getattr(s, name))(getattr(t, name)))
-    s.threads = int(d.threads)  # the domain's worker threads (results do not depend on it)
-    s.stencil_image = bpy.path.abspath(t.stencil_image) if t.stencil_image else ""
-    return s
 
 
 class ToonJob(JobRunner):

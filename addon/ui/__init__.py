@@ -1,4 +1,4 @@
-"""Panels of the Physics tab."""
+"""Panels of the Physics tab (draw() never reads the disk: cache_state holds what they show)."""
 
 from . import flame_panels, panels
 

@@ -3,9 +3,11 @@ Mantaflow's): role buttons, then the settings of the object's role."""
 
 import bpy
 
-from .. import _native, streak_count
-from ..operators.bake import cache_status, is_baking, is_busy
-from ..operators.surfaces import live_summary
+from .. import streak_count
+from ..native import _native
+from ..operators.bake import is_baking, is_busy
+from .. import cache_state
+from ..operators import surfaces
 from ..properties import ROLE_ITEMS
 
 
@@ -186,7 +188,7 @@ class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
         row.enabled = not is_busy(ob)
         row.operator("plume.bake", icon='PHYSICS')
         row.operator("plume.cache_free", icon='TRASH')
-        done, total = cache_status(ob)
+        done, total = cache_state.cache_status(ob)
         state = "baking" if baking else ("complete" if total and done >= total else "")
         layout.label(text=f"Frames: {done} / {total} {state}".rstrip(), icon='INFO')
         if d.volume_object:
@@ -215,7 +217,8 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         row.prop(d, "streak_threshold")
         row.operator("plume.surfaces_pick_threshold", text="", icon='SORTSIZE')
         # Live count from the h cached by the last build (never computed here, §3.3 Figure 4).
-        counts = live_summary(ob)
+        m = cache_state.manifest(ob)
+        counts = None if m is None else surfaces.live_summary(ob, m)
         if counts is not None:
             col.label(text=f"{counts[0]} surfaces from {counts[1]} streaklines", icon='INFO')
         else:

@@ -23,7 +23,7 @@ COLOR_DRIVER_ITEMS = (
 
 def _look_changed(self, context):
     """A look setting changed: update the built toon smoke now (no rebuild needed)."""
-    from .build.toon_look import apply_look
+    from ..build.toon_look import apply_look
     if isinstance(self.id_data, bpy.types.Object):
         apply_look(context.scene if context else None, self.id_data)
 

@@ -8,22 +8,14 @@ import os
 import bpy
 import numpy as np
 
-from . import flame_placement as place
-from . import flames
-from .settings import BakeError
-from .snapshot import cache_folder_of, mesh_arrays
+from .. import flame_placement as place
+from .. import flames
+from ..settings import BakeError
+from .scene import cache_folder_of, flames_cache_folder, mesh_arrays
 
 
 def flame_sources(scene):
     return [o for o in scene.objects if o.type == 'MESH' and o.plume.role == 'FLAME_SOURCE']
-
-
-def cache_folder(scene):
-    """Absolute folder of the flames bake (scene.plume_flames.cache_directory)."""
-    base = bpy.path.abspath(scene.plume_flames.cache_directory or "//plume_cache/flames/")
-    if base.startswith("//"):  # unsaved file: relative to the working directory
-        base = base[2:]
-    return os.path.abspath(base or ".")
 
 
 def settings_now(f):
@@ -241,7 +233,8 @@ def flames_snapshot(context):
     finally:
         scene.frame_set(current, subframe=subframe)
     return flames.FlameBakeSnapshot(
-        folder=cache_folder(scene), frame_start=int(f.frame_start), frame_end=int(f.frame_end),
+        folder=flames_cache_folder(scene), frame_start=int(f.frame_start),
+        frame_end=int(f.frame_end),
         fps=float(fps), seed=int(f.seed), substeps=int(f.substeps), sources=sources,
         settings=settings, winds=winds, cameras=cameras, obstacles=obstacles,
         wind_domain=wind_domain)

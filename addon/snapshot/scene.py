@@ -1,4 +1,6 @@
-"""Scene -> BakeSnapshot (bpy side). Runs on the main thread before a bake starts."""
+"""Scene reading that every pipeline's snapshot shares (bpy side, main thread): the active
+domain, "//" paths and cache folders, evaluated mesh arrays, the Sources and Obstacles over a
+frame range, and same-named properties copied into a settings dataclass."""
 
 import dataclasses
 import os
@@ -7,11 +9,9 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from . import blender_compat as compat
-from . import cache
-from .mantaflow_cache import BORDER_SETTINGS, MantaflowSource
-from .settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, EmitterSnapshot,
-                       PathlineSettings, SolverSettings, SourceParams, StreakSettings, domain_grid)
+from .. import blender_compat as compat
+from .. import cache
+from ..settings import BakeError, EmitterSnapshot, SourceParams
 
 NOT_A_DOMAIN = ("Plume: the active object is not a Plume domain "
                 "(set one with plume.role_set(role='DOMAIN'))")
@@ -30,12 +30,35 @@ def active_domain(context):
     return obj
 
 
+def absolute_folder(path):
+    """An absolute folder of a path setting: "//" is relative to the saved .blend; in an unsaved
+    file it is relative to the working directory, as Blender does."""
+    base = bpy.path.abspath(path)
+    if base.startswith("//"):
+        base = base[2:]
+    return os.path.abspath(base or ".")
+
+
+def blend_relative(path):
+    """`path` as objects store it: "//"-relative when the .blend is saved (a render farm sees the
+    same paths), else absolute."""
+    if bpy.data.is_saved:
+        try:
+            return bpy.path.relpath(path)
+        except ValueError:  # another drive
+            return path
+    return path
+
+
 def cache_folder_of(domain):
     """Absolute cache folder of a domain: abspath(cache_directory)/<domain name>/."""
-    base = bpy.path.abspath(domain.plume.domain.cache_directory or "//plume_cache/")
-    if base.startswith("//"):  # unsaved file: relative to the working directory
-        base = base[2:]
-    return cache.cache_folder(os.path.abspath(base or "."), domain.name)
+    base = absolute_folder(domain.plume.domain.cache_directory or "//plume_cache/")
+    return cache.cache_folder(base, domain.name)
+
+
+def flames_cache_folder(scene):
+    """Absolute folder of the flames bake (scene.plume_flames.cache_directory)."""
+    return absolute_folder(scene.plume_flames.cache_directory or "//plume_cache/flames/")
 
 
 def domain_bbox(domain, depsgraph):
@@ -45,27 +68,6 @@ def domain_bbox(domain, depsgraph):
     lo = tuple(min(c[a] for c in corners) for a in range(3))
     hi = tuple(max(c[a] for c in corners) for a in range(3))
     return lo, hi
-
-
-def solver_settings(domain, scene, cells, cell_size, origin):
-    d = domain.plume.domain
-    fps = scene.render.fps / scene.render.fps_base
-    return SolverSettings(
-        resolution=tuple(cells), cell_size=float(cell_size), origin=tuple(origin),
-        boundaries=tuple(getattr(d, "boundary_" + side) for side in BOUNDARY_SIDES),
-        frame_dt=float(d.time_scale) / fps, substeps=int(d.substeps), use_cfl=bool(d.use_cfl),
-        cfl=float(d.cfl), advection=d.advection, interpolation=d.interpolation, trace=d.trace,
-        conserve_mass=bool(d.conserve_mass),
-        gravity=tuple(float(v) for v in d.gravity), alpha=float(d.alpha), beta=float(d.beta),
-        ambient_temperature=float(d.ambient_temperature), wind=tuple(float(v) for v in d.wind),
-        wind_strength=float(d.wind_strength), vorticity=float(d.vorticity),
-        density_dissipation=float(d.density_dissipation),
-        pressure_tolerance=float(d.pressure_tolerance),
-        max_pressure_iterations=int(d.max_pressure_iterations), combustion=bool(d.combustion),
-        burn_rate=float(d.burn_rate), soot_yield=float(d.soot_yield),
-        heat_yield=float(d.heat_yield), conductivity=float(d.conductivity),
-        cooling_rate=float(d.cooling_rate), max_temperature=float(d.max_temperature),
-        expansion=float(d.expansion), seed=int(d.seed), threads=int(d.threads))
 
 
 def _is_animated(obj):
@@ -215,71 +217,17 @@ def point_source_vertices(context, objs, snaps, frame_start):
             scene.frame_set(current, subframe=subframe)
 
 
-def mantaflow_source(domain, scene):
-    """The Mantaflow domain a streak bake traces (motion_source 'MANTAFLOW'), as plain data;
-    mantaflow_cache.check_source() validates it."""
-    ob = domain.plume.domain.mantaflow_domain
-    source = MantaflowSource(domain_name=domain.name, object_name=ob.name if ob else "")
-    mod = next((m for m in ob.modifiers if m.type == 'FLUID'), None) if ob else None
-    ds = mod.domain_settings if mod is not None and mod.fluid_type == 'DOMAIN' else None
-    if ds is None or ds.domain_type != 'GAS':
-        return source
-    base = bpy.path.abspath(ds.cache_directory)
-    if base.startswith("//"):  # unsaved file: relative to the working directory, as Blender does
-        base = base[2:]
-    return dataclasses.replace(
-        source, is_gas_domain=True, cache_directory=os.path.abspath(base or "."),
-        cache_data_format=ds.cache_data_format, cache_frame_start=int(ds.cache_frame_start),
-        cache_frame_end=int(ds.cache_frame_end), use_adaptive_domain=bool(ds.use_adaptive_domain),
-        borders_closed=tuple(bool(getattr(ds, n)) for n in BORDER_SETTINGS),
-        fps=scene.render.fps / scene.render.fps_base, time_scale=float(ds.time_scale))
-
-
-def take_snapshot(context, addon_version="0.1.0"):
-    """Everything the bake needs from the scene; BakeError for problems visible from here."""
-    domain = active_domain(context)
-    d = domain.plume.domain
-    scene = context.scene
-    from .settings import validate_python_side
-    resolution = int(d.resolution)
-    frame_start, frame_end = int(d.frame_start), int(d.frame_end)
-    # Cheap checks first, before the grid size is derived from the resolution.
-    validate_python_side(domain.name, resolution, frame_start, frame_end, SolverSettings())
-    lo, hi = domain_bbox(domain, context.evaluated_depsgraph_get())
-    try:
-        cells, cell_size, origin = domain_grid(lo, hi, resolution)
-    except BakeError as e:
-        raise BakeError(f"{e} (domain '{domain.name}')") from None
-    solver = solver_settings(domain, scene, cells, cell_size, origin)
-    validate_python_side(domain.name, resolution, frame_start, frame_end, solver)
-    smoke = flame_smoke_settings(domain, scene)
-    return BakeSnapshot(
-        domain_name=domain.name, resolution=resolution, frame_start=frame_start,
-        frame_end=frame_end, cache_directory=d.cache_directory,
-        cache_folder=cache_folder_of(domain), solver=solver,
-        emitters=emitter_snapshots(context, domain, frame_start, frame_end),
-        addon_version=addon_version,
-        streaks=StreakSettings(enabled=bool(d.streaks), emission_period=int(d.emission_period),
-                               max_streaklines=int(d.max_streaklines)),
-        mantaflow=mantaflow_source(domain, scene) if d.motion_source == 'MANTAFLOW' else None,
-        pathlines=PathlineSettings(enabled=bool(d.pathlines),
-                                   nodes_per_frame=int(d.pathline_nodes_per_frame),
-                                   lifetime=float(d.pathline_lifetime),
-                                   float16=bool(d.pathline_float16)),
-        flame_smoke=smoke, velocity_everywhere=bool(d.velocity_everywhere))
-
-
-def flame_smoke_settings(domain, scene):
-    """The domain's Flame Smoke settings (structural_flames.txt §6.3) and the scene's flames
-    cache folder; None when off. The flames cache is read by BakeRunner.prepare()."""
-    d = domain.plume.domain
-    if not d.flame_smoke:
-        return None
-    if d.motion_source == 'MANTAFLOW':
-        raise BakeError(f"Plume: domain '{domain.name}': Flame Smoke feeds the Plume solver: set "
-                        "Motion to Plume Simulation or turn Flame Smoke off")
-    from .flame_smoke import FlameSmokeSettings
-    from .flame_snapshot import cache_folder as flames_folder  # imports this module
-    return FlameSmokeSettings(enabled=True, smoke_yield=float(d.flame_smoke_yield),
-                              temperature=float(d.flame_smoke_temperature),
-                              folder=flames_folder(scene))
+def from_properties(cls, props, **values):
+    """An instance of dataclass `cls`: the fields given in `values`, the others read from the
+    same-named properties of `props` (a PropertyGroup), each converted to the type of the field's
+    default (a vector property to a tuple of the default's element type)."""
+    for f in dataclasses.fields(cls):
+        if f.name in values:
+            continue
+        default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+        value = getattr(props, f.name)
+        if isinstance(default, tuple):
+            values[f.name] = tuple(type(d)(v) for d, v in zip(default, value))
+        else:
+            values[f.name] = type(default)(value)
+    return cls(**values)

@@ -7,6 +7,8 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from ..ranges import text
+
 PROFILE_ITEMS = (
     ('CANDLE', "Candle", "Figure 3, left: a slim candle flame"),
     ('TORCH', "Torch", "Figure 3, middle: a torch flame"),
@@ -40,7 +42,8 @@ class PlumeFlameSourceSettings(bpy.types.PropertyGroup):
     flames: IntProperty(
         name="Flames", default=1, soft_min=1, soft_max=64,
         description="Flames on this source: 1 at the centre of its up-facing faces, more spread "
-                    "evenly over them (area-weighted, deterministic); in [1, 1024]")
+                    "evenly over them (area-weighted, deterministic); in "
+                    + text('flames.flames_per_source'))
     radius: FloatProperty(
         name="Radius (r)", default=0.01, soft_min=0.001, soft_max=1.0, unit='LENGTH',
         precision=4, description="r: radius of each flame's source (m): the profile's width and "
@@ -86,10 +89,12 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=0, soft_min=0,
                       description="Seed of every random choice: same seed, same flames")
     substeps: IntProperty(name="Substeps", default=2, soft_min=1, soft_max=16,
-                          description="Steps of eq. 1 per frame (§4.1); in [1, 64]")
+                          description="Steps of eq. 1 per frame (§4.1); in "
+                                      + text('flames.substeps'))
     # --- Structure (§4.1-4.3) ---
     points: IntProperty(name="Control Points (n)", default=16, soft_min=2, soft_max=64,
-                        description="n: points of a flame's spine (§4.1); in [2, 256]")
+                        description="n: points of a flame's spine (§4.1); in "
+                                    + text('flames.points'))
     height_persistent: FloatProperty(
         name="Persistent Height (H_p)", default=0.03, soft_min=0.0, soft_max=10.0,
         unit='LENGTH', description="H_p: top of the continuous region (Figure 2, §4.3); "

@@ -1,23 +1,14 @@
-"""Object properties: ``obj.plume`` with ``role``, ``domain``, ``source`` and ``obstacle``.
-
-Numbers carry soft limits only: a script may set any value, and the bake validates it with a
-message naming the setting (ADDON.md) instead of Blender clamping it silently."""
+"""A domain's properties (``obj.plume.domain``): its grid bake (solver, combustion, cache), the
+streak surfaces it traces and builds (smoke_surfaces.txt), the pathlines it records, and the
+toon and flow-graph settings it holds."""
 
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
-from .flame_properties import PlumeFlameSourceSettings, PlumeFlamesSettings
-from .flowgraph_properties import PlumeFlowGraphSettings
-from .toon_properties import PlumeToonSettings
-
-ROLE_ITEMS = (
-    ('NONE', "None", "Not part of a Plume simulation", 'X', 0),
-    ('DOMAIN', "Domain", "Box holding the smoke simulation grid", 'MESH_CUBE', 1),
-    ('SOURCE', "Source", "Emits smoke (density, heat, fuel) into the domain", 'OUTLINER_OB_FORCE_FIELD', 2),
-    ('OBSTACLE', "Obstacle", "Closed mesh the smoke flows around", 'MOD_PHYSICS', 3),
-    ('FLAME_SOURCE', "Flame Source", "Emits structural flames (flames_bake)", 'LIGHT_SUN', 4),
-)
+from ..ranges import RANGES, text
+from .flowgraph import PlumeFlowGraphSettings
+from .toon import PlumeToonSettings
 
 BOUNDARY_ITEMS = (
     ('OPEN', "Open", "Air: smoke and air flow out freely (p = 0)"),
@@ -42,7 +33,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     resolution: IntProperty(
         name="Resolution", default=32, soft_min=8, soft_max=512,
         description="Cells along the longest axis of the domain (Δx = longest side / resolution); "
-                    "validated at bake time to [2, 1024]")
+                    f"validated at bake time to {text('resolution')}")
     frame_start: IntProperty(name="Start", default=1, description="First frame of the bake")
     frame_end: IntProperty(name="End", default=50, description="Last frame of the bake")
     time_scale: FloatProperty(
@@ -163,7 +154,8 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                     "(graph_fire_synthesis.txt §4.2): particles seeded at Δx/2 in the fuel "
                     "cells every node step, integrated with RK4, sampled over their lifetime")
     pathline_nodes_per_frame: IntProperty(
-        name="Nodes per Frame", default=4, min=1, max=64,
+        name="Nodes per Frame", default=4, min=RANGES["pathline_nodes_per_frame"][0],
+        max=RANGES["pathline_nodes_per_frame"][1],
         description="Node steps per frame (Δt_n = frame / this). The synthesis reproduces the "
                     "bake best when the fastest particles cross about one cell per node step "
                     "(§4.1: Δt = 0.5 Δx / U); memory grows with its square")
@@ -245,96 +237,3 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     toon: PointerProperty(type=PlumeToonSettings, name="Toon Smoke")
     # --- Flow-graph fire (graph_fire_synthesis.txt, plume.flowgraph_build / fire_synthesize) ---
     flowgraph: PointerProperty(type=PlumeFlowGraphSettings, name="Flow-Graph Fire")
-
-
-class PlumeSourceSettings(bpy.types.PropertyGroup):
-    density: FloatProperty(name="Density", default=1.0, soft_min=0.0, soft_max=10.0,
-                           description="ρ set in the source's cells each step")
-    temperature: FloatProperty(name="Temperature", default=1.0, soft_min=-10.0, soft_max=10.0,
-                               description="T - T_amb set in the source's cells each step")
-    fuel: FloatProperty(name="Fuel", default=0.0, soft_min=0.0, soft_max=10.0,
-                        description="F set in the source's cells (combustion domains only)")
-    velocity: FloatVectorProperty(
-        name="Initial Velocity", size=3, default=(0.0, 0.0, 0.0), subtype='VELOCITY', unit='VELOCITY',
-        description="Velocity given to the air in the source's cells, m/s (smoke_surfaces.txt §3.2)")
-    motion_factor: FloatProperty(name="Motion Factor", default=1.0, soft_min=0.0, soft_max=2.0,
-                                 description="Share of the source object's own motion added to its velocity")
-    point_placement: EnumProperty(
-        name="Placement", default='RIM',
-        items=(('RIM', "Rim",
-                "A ring of point sources around the source's outline, across the direction the "
-                "smoke leaves it (its Initial Velocity, else against gravity), one a cell apart, "
-                "cut into arcs of about 8 (each its own candidate group, §3.3): sheets that wrap "
-                "the smoke, a few per source"),
-               ('CELLS', "Cells",
-                "Point Sources random points in every source cell (smoke_surfaces.txt §3.2: "
-                "\"10-20 point sources are placed randomly in a source cell\"): the paper's set-up "
-                "for a source one to four cells wide; a wide source fills the smoke's volume "
-                "with streaklines and its sheets fold many times over")),
-        description="Where this source's point sources are, when it has no Point Source Mesh "
-                    "(smoke_surfaces.txt §3.2)")
-    point_sources: IntProperty(
-        name="Point Sources", default=16, soft_min=1, soft_max=64,
-        description="Tracer point sources per source cell when Placement is Cells (10-20 in "
-                    "smoke_surfaces.txt §3.2)")
-    candidate_group: IntProperty(
-        name="Candidate Group", default=-1, soft_min=-1, soft_max=64,
-        description="Streaklines are clustered only inside a candidate group (-1: the source's own group)")
-    point_source_mesh: PointerProperty(
-        name="Point Source Mesh", type=bpy.types.Object, poll=lambda _self, ob: ob.type == 'MESH',
-        description="Mesh whose vertices (world space, evaluated at the domain's first frame) are "
-                    "this source's point sources, one streakline each, instead of Point Sources "
-                    "random points per cell (smoke_surfaces.txt §3.2); they must lie in the "
-                    "domain. Its vertex groups, if any, are hand-made candidate groups (§3.3): "
-                    "streaklines of different groups never share a surface")
-    emit_particles: BoolProperty(
-        name="Emit Particles", default=True,
-        description="Emit streakline particles from this source's point sources (smoke_surfaces.txt "
-                    "§3.2, Figure 10): keyframe it off to leave a gap in the streaklines. Emission "
-                    "pauses only on frames where no Source with point sources emits (every "
-                    "streakline keeps the same particle count); while another source still emits, "
-                    "this one's particles keep coming and carry the smoke's density there (zero "
-                    "if its Density is keyframed to 0 too). The first particle is always emitted")
-    candidate_split: IntProperty(
-        name="Split Into Groups", default=1, soft_min=1, soft_max=64,
-        description="Splits this source's point sources into this many candidate groups so that "
-                    "streaklines of different parts never share a surface (smoke_surfaces.txt "
-                    "§3.3): a Rim into this many arcs (1: arcs of about 8 point sources), other "
-                    "point sources into groups of equal count along their longest extent (1: no "
-                    "split); more than 1 replaces Candidate Group; validated at bake time to "
-                    "[1, 64]")
-
-
-class PlumeObstacleSettings(bpy.types.PropertyGroup):
-    slip: EnumProperty(
-        name="Slip", default='NO_SLIP',
-        items=(('NO_SLIP', "No Slip", "The air next to the obstacle moves with it"),
-               ('FREE_SLIP', "Free Slip", "Only the normal part of the flow is stopped")))
-
-
-class PlumeObjectSettings(bpy.types.PropertyGroup):
-    role: EnumProperty(name="Role", items=ROLE_ITEMS, default='NONE',
-                       description="What this object is in a Plume simulation")
-    domain: PointerProperty(type=PlumeDomainSettings)
-    source: PointerProperty(type=PlumeSourceSettings)
-    obstacle: PointerProperty(type=PlumeObstacleSettings)
-    flame: PointerProperty(type=PlumeFlameSourceSettings)  # role FLAME_SOURCE
-
-
-classes = (PlumeFlameSourceSettings, PlumeFlamesSettings, PlumeToonSettings,
-           PlumeFlowGraphSettings, PlumeDomainSettings, PlumeSourceSettings,
-           PlumeObstacleSettings, PlumeObjectSettings)
-
-
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
-    bpy.types.Object.plume = PointerProperty(type=PlumeObjectSettings, name="Plume")
-    bpy.types.Scene.plume_flames = PointerProperty(type=PlumeFlamesSettings, name="Plume Flames")
-
-
-def unregister():
-    del bpy.types.Scene.plume_flames
-    del bpy.types.Object.plume
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)

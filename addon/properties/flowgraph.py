@@ -6,6 +6,8 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, StringProperty)
 
+from ..ranges import RANGES
+
 
 class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
     # --- Graph (§4.3) ---
@@ -62,11 +64,13 @@ class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
                     "(fire/points_####.npz) and shows them as the points of a mesh object "
                     "\"<domain>_fire_points\", coloured by temperature")
     preview_points: IntProperty(
-        name="Preview Points", default=20000, min=100, max=1000000,
+        name="Preview Points", default=20000, min=RANGES["flowgraph.preview_points"][0],
+        max=RANGES["flowgraph.preview_points"][1],
         description="At most this many points per frame in the point preview: more live "
                     "particles are thinned evenly (every (live / this)-th); 100 to 1,000,000")
     group_cache: IntProperty(
-        name="Group Cache (MB)", default=2048, min=0, max=65536,
+        name="Group Cache (MB)", default=2048, min=RANGES["flowgraph.group_cache"][0],
+        max=RANGES["flowgraph.group_cache"][1],
         description="Memory kept for prepared pathline groups between visits of the random "
                     "walk and, for the Blender session, between syntheses of the same graph: a "
                     "revisited node is not read from its pathlines.bin again (0: read every "

@@ -1,0 +1,63 @@
+"""The one way the add-on writes a cache file, so a cancelled or killed job never leaves a half
+file (DESIGN.md "Cache folder"): the bytes go to a temporary name in the same folder
+(``<name>.<pid>_<random>.tmp``, which the cache cleaners recognise), are flushed and fsynced,
+renamed over the final name, and the folder is fsynced so the rename itself survives a crash."""
+
+import io
+import os
+import uuid
+
+import numpy as np
+
+#: Ending of every temporary file; cache cleaners and job staging skip or delete these.
+TMP_SUFFIX = ".tmp"
+
+
+def temporary_path(path):
+    """A temporary name next to `path`, unique to this process and call."""
+    return f"{path}.{os.getpid()}_{uuid.uuid4().hex[:8]}{TMP_SUFFIX}"
+
+
+def sync_folder(folder):
+    """fsync of a directory, so renames into it are durable (a no-op where not supported)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def write_bytes(path, data: bytes):
+    """Writes `data` to `path` atomically (temporary name, fsync, rename, folder fsync)."""
+    tmp = temporary_path(path)
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.remove(tmp)
+        except OSError:
+            pass
+        raise
+    sync_folder(os.path.dirname(os.path.abspath(path)))
+    return path
+
+
+def npz_bytes(compressed=False, **arrays):
+    """The bytes of a NumPy .npz archive of `arrays`."""
+    buf = io.BytesIO()
+    (np.savez_compressed if compressed else np.savez)(buf, **arrays)
+    return buf.getvalue()
+
+
+def save_npz(path, compressed=False, **arrays):
+    """np.savez (or savez_compressed) to `path`, atomically."""
+    return write_bytes(path, npz_bytes(compressed, **arrays))

@@ -1,0 +1,203 @@
+"""Structural flames settings, no ``bpy`` (structural_flames.txt): the snapshot of a scene's
+Flame Sources (per-frame settings, wind, camera, sources, obstacles), the cache file names, and
+the validation that runs before anything is written (BakeError naming the setting)."""
+
+import math
+import os
+from dataclasses import dataclass, field
+from typing import List, Optional, Tuple
+
+import numpy as np
+
+from .ranges import RANGES
+from .settings import BakeError
+
+PROFILES = ('CANDLE', 'TORCH', 'CAMPFIRE', 'CUSTOM')
+MANIFEST_NAME = "flames_manifest.json"
+#: §6.1 obstacles: voxel size (m) of their signed distance and the band around them.
+OBSTACLE_VOXEL = 0.005
+OBSTACLE_PADDING = 0.05
+FORMAT_VERSION = 1
+POINTS_RANGE = RANGES["flames.points"]
+FLAMES_PER_SOURCE_RANGE = RANGES["flames.flames_per_source"]
+SUBSTEPS_RANGE = RANGES["flames.substeps"]
+#: Samples per flame when the scene has no camera (no projected area to size them from).
+FIXED_PARTICLES = 4000
+NO_SOURCE = ("Plume: the scene has no Flame Source (make a mesh one with "
+             "plume.role_set(role='FLAME_SOURCE'))")
+
+
+def volume_path(folder, frame):
+    return os.path.join(folder, f"flames_{frame:04d}.vdb")
+
+
+def spines_path(folder, frame):
+    return os.path.join(folder, f"spines_{frame:04d}.npz")
+
+
+@dataclass
+class FlameSettings:
+    """Scene-level settings at one frame (scene.plume_flames), the paper's symbols in comments."""
+
+    points: int = 16                   # n (§4.1)
+    height_persistent: float = 0.03    # H_p (§4.3)
+    height_intermittent: float = 0.06  # H_i
+    height_max: float = 0.12           # H_max
+    lifespan_scale: float = 0.25       # A (s)
+    breakaway_frequency: float = 0.0   # f (Hz), 0 = 0.50 (g/2r)^½
+    buoyancy: float = 0.5              # β of eq. 2
+    diffusion: float = 1e-4            # d(T_p) of eq. 1, m²/s
+    particles_per_pixel: float = 10.0  # §5.3
+    max_particles: int = 50000
+    merging: bool = True               # §4.5
+    flow_noise: float = 0.15           # §4.5 buoyancy noise (widest radii)
+    kolmogorov: float = 0.003          # §4.5 Kolmogorov noise (m RMS)
+    voxel_size: float = 0.002
+    temperature_scale: float = 1500.0
+    heat_of_combustion: float = 15.0   # H_c, MJ/kg (eq. 5)
+
+
+@dataclass
+class WindInput:
+    """One field of w (eq. 1) at one frame: kind UNIFORM (vector), VORTEX (centre, axis,
+    strength), TURBULENCE (strength, size, flow, seed)."""
+
+    kind: str
+    vector: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    centre: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    strength: float = 0.0
+    size: float = 1.0
+    flow: float = 0.0
+    seed: int = 0
+
+
+@dataclass
+class CameraInput:
+    """The scene camera at one frame (FlameCamera); None in the snapshot: no camera."""
+
+    position: Tuple[float, float, float]
+    focal_length: float
+    sensor_width: float
+    width: int
+    height: int
+
+
+@dataclass
+class FlameSourceInput:
+    """One Flame Source object: its flames' places and spread values (fixed), and its keyable
+    values and world positions per frame."""
+
+    name: str
+    profile: str
+    #: CUSTOM: (k, 2) points (radius, height) of the profile curve, base first.
+    profile_points: Optional[np.ndarray] = None
+    #: §5.1 reference image, (h, w, 3) float32 rows from the bottom; None: white.
+    color_image: Optional[np.ndarray] = None
+    local_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))   # (k, 3)
+    local_normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (k, 3)
+    start_times: np.ndarray = field(default_factory=lambda: np.zeros(0))         # s
+    end_times: np.ndarray = field(default_factory=lambda: np.zeros(0))           # s (inf)
+    intensity_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    diameter_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    height_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: 4x4 world matrices at frames frame_start - 1 .. frame_end.
+    matrices: List[np.ndarray] = field(default_factory=list)
+    #: (radius r, intensity I, temperature T_p) at frames frame_start .. frame_end.
+    values: List[Tuple[float, float, float]] = field(default_factory=list)
+
+    @property
+    def count(self):
+        return len(self.local_points)
+
+
+@dataclass
+class ObstacleInput:
+    name: str
+    vertices: np.ndarray  # world, float32 (N, 3)
+    triangles: np.ndarray  # int (M, 3)
+
+
+@dataclass
+class FlameBakeSnapshot:
+    folder: str
+    frame_start: int
+    frame_end: int
+    fps: float
+    seed: int
+    substeps: int
+    sources: List[FlameSourceInput]
+    #: per frame frame_start .. frame_end
+    settings: List[FlameSettings]
+    winds: List[List[WindInput]]
+    cameras: List[Optional[CameraInput]]
+    obstacles: List[ObstacleInput] = field(default_factory=list)
+    #: §6.1: (domain name, its cache folder) whose volume_####.vdb velocity adds to w
+    wind_domain: Optional[Tuple[str, str]] = None
+
+    @property
+    def frame_count(self):
+        return self.frame_end - self.frame_start + 1
+
+
+def _check(ok, message):
+    if not ok:
+        raise BakeError("Plume: " + message)
+
+
+def _finite(*values):
+    return all(math.isfinite(v) for v in values)
+
+
+def validate_settings(s: FlameSettings, frame):
+    """BakeError naming the setting (the panel's name and the paper's symbol) and its range."""
+    at = f"Flames (frame {frame}):"
+    lo, hi = POINTS_RANGE
+    _check(lo <= s.points <= hi, f"{at} Control Points (n) must be in [{lo}, {hi}] "
+                                 f"(got {s.points})")
+    hp, hi_, hmax = s.height_persistent, s.height_intermittent, s.height_max
+    _check(_finite(hp, hi_, hmax) and hp >= 0.0,
+           f"{at} Persistent Height (H_p) must be >= 0 (got {hp})")
+    _check(hp < hi_, f"{at} Persistent Height (H_p = {hp:g}) must be below Intermittent Height "
+                     f"(H_i = {hi_:g}): the intermittent region is [H_p, H_i] (§4.3)")
+    _check(hmax >= hi_, f"{at} Max Height (H_max = {hmax:g}) must be >= Intermittent Height "
+                        f"(H_i = {hi_:g})")
+    _check(_finite(s.lifespan_scale) and 1.0 / 24.0 - 1e-9 <= s.lifespan_scale <= 2.0,
+           f"{at} Lifespan Scale (A) must be in [1/24, 2] s (got {s.lifespan_scale})")
+    _check(_finite(s.breakaway_frequency) and 0.0 <= s.breakaway_frequency <= 1000.0,
+           f"{at} Breakaway Frequency (f) must be in [0, 1000] Hz, 0 = automatic "
+           f"(got {s.breakaway_frequency})")
+    _check(_finite(s.buoyancy) and 0.0 <= s.buoyancy <= 100.0,
+           f"{at} Buoyancy (β) must be in [0, 100] (got {s.buoyancy})")
+    _check(_finite(s.diffusion) and 0.0 <= s.diffusion <= 10.0,
+           f"{at} Diffusion must be in [0, 10] m²/s (got {s.diffusion})")
+    _check(_finite(s.particles_per_pixel) and s.particles_per_pixel > 0.0,
+           f"{at} Particles per Pixel must be > 0 (got {s.particles_per_pixel})")
+    _check(64 <= s.max_particles <= 10_000_000,
+           f"{at} Max Particles must be in [64, 10000000] (got {s.max_particles})")
+    _check(_finite(s.voxel_size) and s.voxel_size > 0.0,
+           f"{at} Voxel Size must be > 0 (got {s.voxel_size})")
+    _check(_finite(s.flow_noise, s.kolmogorov) and s.flow_noise >= 0.0 and s.kolmogorov >= 0.0,
+           f"{at} Flow Noise and Kolmogorov Noise must be >= 0")
+
+
+def validate_source_values(src: FlameSourceInput):
+    for i, (r, intensity, temp) in enumerate(src.values):
+        at = f"Flame Source '{src.name}'"
+        _check(_finite(r) and r > 0.0, f"{at}: Radius (r) must be > 0 (got {r})")
+        _check(_finite(intensity) and intensity >= 0.0,
+               f"{at}: Intensity (I) must be >= 0 (got {intensity})")
+        _check(_finite(temp) and temp >= 0.0,
+               f"{at}: Temperature (T_p) must be >= 0 (got {temp})")
+
+
+def validate_snapshot(snap: FlameBakeSnapshot):
+    _check(bool(snap.sources), NO_SOURCE[len("Plume: "):])
+    _check(snap.frame_end >= snap.frame_start, f"Flames: End ({snap.frame_end}) must be >= "
+                                               f"Start ({snap.frame_start})")
+    lo, hi = SUBSTEPS_RANGE
+    _check(lo <= snap.substeps <= hi, f"Flames: Substeps must be in [{lo}, {hi}] "
+                                      f"(got {snap.substeps})")
+    for i, s in enumerate(snap.settings):
+        validate_settings(s, snap.frame_start + i)
+    for src in snap.sources:
+        validate_source_values(src)

@@ -1,0 +1,92 @@
+"""Flow-graph fire settings, no ``bpy`` (graph_fire_synthesis.txt): Build Flow Graph's (§4.3) and
+Synthesize Fire's (§5), and their validation (BakeError naming the setting)."""
+
+import math
+from dataclasses import dataclass, field
+from typing import List, Tuple
+
+from .ranges import RANGES
+from .settings import BakeError
+
+TRAVERSALS = ('UNIFORM', 'BIASED')
+#: Range of SynthesisSettings.preview_points (points per frame of the preview).
+PREVIEW_POINTS_RANGE = RANGES["flowgraph.preview_points"]
+
+
+@dataclass
+class FlowGraphSettings:
+    """§4.3: weights of eq. 9, the block size B and ε of eq. 11."""
+
+    block_size: int = 32        # B
+    epsilon: float = 0.0        # ε; 0 = (2a + b) / 3
+    auto_weights: bool = True   # α, β bringing the three terms to one order of magnitude
+    alpha: float = 1.0          # α (density) when not automatic
+    beta: float = 1.0           # β (temperature) when not automatic
+    min_node_gap: int = 8       # transitions between nodes this close in one state are dropped
+
+
+@dataclass
+class SynthesisSettings:
+    """§5: the random walk and what the synthesized particles feel. targets[f] and winds[f] are
+    the keyed target state (-1: none) and uniform wind (m/s) of frame frame_start + f."""
+
+    frame_start: int = 1
+    frame_end: int = 200
+    seed: int = 0
+    traversal: str = 'BIASED'   # UNIFORM: p = 1/d(V_i); BIASED: eq. 12 with γ
+    gamma: float = 0.875        # γ of eq. 12
+    start_state: int = 0
+    targets: List[int] = field(default_factory=list)
+    winds: List[Tuple[float, float, float]] = field(default_factory=list)
+    ignition_temperature: float = 1.0
+    max_temperature: float = 4.0
+    #: turbulence[f]: the Turbulence force fields of frame f as (strength, size, seed) each
+    turbulence: List[List[Tuple[float, float, int]]] = field(default_factory=list)
+    #: also write fire/points_<frame>.npz: at most preview_points live particles per frame
+    point_preview: bool = False
+    preview_points: int = 20000
+    #: MB of prepared pathline groups the native Synthesizer keeps between visits of the walk
+    #: (least recently used out); 0 reads every visit from its file
+    group_cache_mb: int = 2048
+
+
+def validate_graph_settings(s: FlowGraphSettings, owner):
+    if s.block_size < 1:
+        raise BakeError(f"Plume: {owner}: block_size (B) must be >= 1 (got {s.block_size})")
+    if s.min_node_gap < 0:
+        raise BakeError(f"Plume: {owner}: min_node_gap must be >= 0 (got {s.min_node_gap})")
+    if not (math.isfinite(s.epsilon) and s.epsilon >= 0.0):
+        raise BakeError(f"Plume: {owner}: epsilon (ε) must be 0 (automatic: (2a+b)/3) or a "
+                        f"cost in [a, b] (got {s.epsilon})")
+    for name in ("alpha", "beta"):
+        v = getattr(s, name)
+        if not s.auto_weights and not (math.isfinite(v) and v >= 0.0):
+            raise BakeError(f"Plume: {owner}: {name} must be >= 0 (got {v})")
+
+
+def validate_synthesis(s: SynthesisSettings, state_count, owner):
+    if s.frame_end < s.frame_start:
+        raise BakeError(f"Plume: {owner}: synthesis frame_end must be >= frame_start "
+                        f"(got {s.frame_start}..{s.frame_end})")
+    if s.traversal not in TRAVERSALS:
+        raise BakeError(f"Plume: {owner}: traversal must be one of {', '.join(TRAVERSALS)}")
+    if not (0.0 < s.gamma < 1.0):
+        raise BakeError(f"Plume: {owner}: gamma (γ) must be in (0, 1) (got {s.gamma})")
+    if not (0 <= s.start_state < state_count):
+        raise BakeError(f"Plume: {owner}: start_state must be in [0, {state_count - 1}] "
+                        f"(got {s.start_state})")
+    bad = [t for t in s.targets if not (-1 <= t < state_count)]
+    if bad:
+        raise BakeError(f"Plume: {owner}: target_state must be -1 (none) or in [0, "
+                        f"{state_count - 1}] (got {bad[0]})")
+    if not (0.0 <= s.ignition_temperature < s.max_temperature):
+        raise BakeError(f"Plume: {owner}: the fire needs 0 <= ignition temperature < max "
+                        f"temperature (got {s.ignition_temperature}, {s.max_temperature})")
+    lo, hi = PREVIEW_POINTS_RANGE
+    if s.point_preview and not (lo <= s.preview_points <= hi):
+        raise BakeError(f"Plume: {owner}: preview_points must be in [{lo}, {hi}] "
+                        f"(got {s.preview_points})")
+    lo, hi = RANGES["flowgraph.group_cache"]
+    if not (lo <= s.group_cache_mb <= hi):
+        raise BakeError(f"Plume: {owner}: group_cache must be in [{lo}, {hi}] MB "
+                        f"(got {s.group_cache_mb})")

@@ -1,0 +1,73 @@
+"""Scene -> flow-graph fire settings (graph_fire_synthesis.txt): the pathlines a fire bake
+records, the states and settings of Build Flow Graph, and the settings and per-frame inputs
+(target states, wind, turbulence force fields) of Synthesize Fire."""
+
+import numpy as np
+
+from .. import flowgraph
+from ..settings import PathlineSettings
+from .scene import from_properties
+
+
+def pathline_settings(d):
+    """PathlineSettings of a domain's obj.plume.domain (Record Pathlines of a fire bake)."""
+    return PathlineSettings(enabled=bool(d.pathlines),
+                            nodes_per_frame=int(d.pathline_nodes_per_frame),
+                            lifetime=float(d.pathline_lifetime),
+                            float16=bool(d.pathline_float16))
+
+
+def state_domains(context, active):
+    """The selected Plume domains (the active one included), ordered by name: state 0, 1, ..."""
+    chosen = {o.name: o for o in context.selected_objects
+              if getattr(o, "plume", None) is not None and o.plume.role == 'DOMAIN'}
+    chosen[active.name] = active
+    return [chosen[name] for name in sorted(chosen)]
+
+
+def graph_settings(g):
+    """flowgraph.FlowGraphSettings of a domain's obj.plume.domain.flowgraph."""
+    return from_properties(flowgraph.FlowGraphSettings, g)
+
+
+def synthesis_settings(domain):
+    """flowgraph.SynthesisSettings of a domain (frame inputs not yet filled: frame_inputs)."""
+    d = domain.plume.domain
+    g = d.flowgraph
+    return flowgraph.SynthesisSettings(
+        frame_start=int(g.frame_start), frame_end=int(g.frame_end), seed=int(g.seed),
+        traversal=g.traversal, gamma=float(g.gamma), start_state=int(g.start_state),
+        max_temperature=float(d.max_temperature),
+        point_preview=bool(g.point_preview), preview_points=int(g.preview_points),
+        group_cache_mb=int(g.group_cache))
+
+
+def frame_inputs(context, domain, frame_start, frame_end):
+    """(targets, winds, turbulence) per frame: the keyed target_state, the uniform wind plus the
+    scene's Wind force fields (Strength m/s along their Z axis) and the Turbulence force fields
+    as (strength, size, seed) (flowgraph.turbulence_velocity), evaluated frame by frame (the
+    current frame is restored)."""
+    scene = context.scene
+    g = domain.plume.domain.flowgraph
+    current, subframe = scene.frame_current, scene.frame_subframe
+    targets, winds, turbulence = [], [], []
+    try:
+        for f in range(frame_start, frame_end + 1):
+            scene.frame_set(f)
+            wind = np.array(g.wind, dtype=np.float64)
+            turb = []
+            for ob in scene.objects if g.use_force_fields else ():
+                fld = ob.field
+                if fld is None or ob.hide_render:
+                    continue
+                if fld.type == 'WIND':
+                    axis = np.array(ob.matrix_world.to_3x3().col[2], dtype=np.float64)
+                    wind += fld.strength * axis / max(np.linalg.norm(axis), 1e-12)
+                elif fld.type == 'TURBULENCE':
+                    turb.append((float(fld.strength), float(fld.size), int(fld.seed)))
+            targets.append(int(g.target_state))
+            winds.append(tuple(float(v) for v in wind))
+            turbulence.append(turb)
+    finally:
+        scene.frame_set(current, subframe=subframe)
+    return targets, winds, turbulence
