@@ -1,17 +1,27 @@
 """The accepted range of every setting that the add-on validates itself, no ``bpy``: one table
 that the properties (their limits and descriptions) and the validation (its bounds and messages)
 both read, so a bound is written once. Ranges are inclusive (lo, hi), keyed by the property's
-name (with its pipeline where two pipelines use one name)."""
+name (with its pipeline where two pipelines use one name). Bounds the native core checks itself
+come from it (``_native.setting_ranges()``, the core's one definition), not written again here."""
+
+from .native import _native
+
+
+def _native_range(name):
+    """(lo, hi) of a setting the core checks, as it defines it, whole numbers."""
+    lo, hi = _native.setting_ranges()[name]
+    return int(lo), int(hi)
+
 
 RANGES = {
     # a domain's grid bake (obj.plume.domain)
-    "resolution": (2, 1024),
-    "emission_period": (1, 100000),  # the native StreakParams bound
+    "resolution": _native_range("resolution"),  # cells along the longest axis
+    "emission_period": _native_range("emission_period"),
     #: 0 (keep every point source) or at least the 2 a surface needs
     "max_streaklines": (0, 1000000),
-    "pathline_nodes_per_frame": (1, 64),  # the native PathlineParams bound
+    "pathline_nodes_per_frame": _native_range("pathline_nodes_per_frame"),
     # a Source (obj.plume.source)
-    "point_sources": (1, 10000),  # the native random_points_in_cells bound
+    "point_sources": _native_range("point_sources"),  # per source cell
     "candidate_split": (1, 64),  # §3.3
     # structural flames (scene.plume_flames, obj.plume.flame)
     "flames.points": (2, 256),

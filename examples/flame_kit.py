@@ -68,7 +68,7 @@ def flames_settings(scene, frames, **values):
 
 def manifest(scene):
     """The bake's manifest (flames_manifest.json): per-frame "flames" and "particles"."""
-    folder = scene_kit.addon_module("flame_snapshot").cache_folder(scene)
+    folder = scene_kit.addon_module("snapshot").flames_cache_folder(scene)
     with open(os.path.join(folder, "flames_manifest.json"), encoding="utf-8") as fh:
         return json.load(fh)
 

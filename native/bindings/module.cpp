@@ -4,7 +4,10 @@
 
 #include "bindings/bindings.h"
 
+#include "flowgraph/pathline_recorder.h"
 #include "solver/smoke_params.h"
+#include "tracers/point_sources.h"
+#include "tracers/streak_tracer.h"
 #include "solver/smoke_solver.h"
 
 namespace py = pybind11;
@@ -16,6 +19,20 @@ PYBIND11_MODULE(_native, m) {
       "Arrays are float32 copies shaped (nx, ny, nz), indexed [i, j, k]; cell (i, j, k) is centred\n"
       "at origin + (i + 0.5, j + 0.5, k + 0.5) * cell_size.";
   m.attr("__version__") = "0.1.0";
+  m.def(
+      "setting_ranges",
+      [] {
+        py::dict d;
+        for (const plume::SettingRange& r : plume::smokeSettingRanges())
+          d[r.name] = py::make_tuple(r.lo, r.hi);
+        d["emission_period"] = py::make_tuple(1, plume::kMaxEmissionPeriod);
+        d["point_sources"] = py::make_tuple(1, plume::kMaxPointsPerCell);
+        d["pathline_nodes_per_frame"] = py::make_tuple(1, plume::kMaxNodesPerFrame);
+        return d;
+      },
+      "{setting: (lo, hi)}: the accepted range of every bounded setting the core checks "
+      "(SmokeParams.ranges(), the streak tracer's emission_period, point sources per cell, "
+      "pathline nodes per frame), the one definition the add-on's properties and messages read.");
 
   py::enum_<plume::Advection>(m, "Advection",
                               "Advection scheme: semi-Lagrangian (Stam 1999), BFECC (Kim et al. "

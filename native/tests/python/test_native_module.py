@@ -125,6 +125,9 @@ def test_params_ranges_are_what_validate_checks():
     accepted, and a step past it is refused with a message naming the setting and that range."""
     ranges = _native.SmokeParams.ranges()
     assert ranges["resolution"] == (2, 1024)
+    every = _native.setting_ranges()  # what the add-on reads: the solver's and the tracers'
+    assert {k: every[k] for k in ranges} == ranges
+    assert every["emission_period"][0] == every["point_sources"][0] == 1
     assert {"cfl", "vorticity", "threads", "substeps", "pressure_tolerance"} <= set(ranges)
     for name, (lo, hi) in ranges.items():
         whole = isinstance(getattr(_native.SmokeParams(), name), (int, tuple))
