@@ -24,7 +24,7 @@ RANGES = {
     "point_sources": _native_range("point_sources"),  # per source cell
     "candidate_split": (1, 64),  # §3.3
     # structural flames (scene.plume_flames, obj.plume.flame)
-    "flames.points": (2, 256),
+    "flames.points": _native_range("flames.points"),
     "flames.flames_per_source": (1, 1024),
     "flames.substeps": (1, 64),
     # flow-graph fire synthesis (obj.plume.domain.flowgraph)

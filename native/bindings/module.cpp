@@ -4,6 +4,7 @@
 
 #include "bindings/bindings.h"
 
+#include "flames/flame_params.h"
 #include "flowgraph/pathline_recorder.h"
 #include "solver/smoke_params.h"
 #include "tracers/point_sources.h"
@@ -28,11 +29,12 @@ PYBIND11_MODULE(_native, m) {
         d["emission_period"] = py::make_tuple(1, plume::kMaxEmissionPeriod);
         d["point_sources"] = py::make_tuple(1, plume::kMaxPointsPerCell);
         d["pathline_nodes_per_frame"] = py::make_tuple(1, plume::kMaxNodesPerFrame);
+        d["flames.points"] = py::make_tuple(plume::kMinSpinePoints, plume::kMaxSpinePoints);
         return d;
       },
       "{setting: (lo, hi)}: the accepted range of every bounded setting the core checks "
       "(SmokeParams.ranges(), the streak tracer's emission_period, point sources per cell, "
-      "pathline nodes per frame), the one definition the add-on's properties and messages read.");
+      "pathline nodes per frame, a flame spine's control points), the one definition the add-on's properties and messages read.");
 
   py::enum_<plume::Advection>(m, "Advection",
                               "Advection scheme: semi-Lagrangian (Stam 1999), BFECC (Kim et al. "

@@ -36,8 +36,9 @@ void requireFinite(const std::string& name, glm::dvec3 v) {
 }  // namespace
 
 void FlameParams::validate() const {
-  if (points < 2 || points > 256)
-    throw std::invalid_argument("points (n) must be in [2, 256] (got " + std::to_string(points) + ")");
+  if (points < kMinSpinePoints || points > kMaxSpinePoints)
+    throw std::invalid_argument("points (n) must be in [" + std::to_string(kMinSpinePoints) + ", " +
+                                std::to_string(kMaxSpinePoints) + "] (got " + std::to_string(points) + ")");
   requirePositive("height_intermittent (H_i)", heightIntermittent, 1000.0, " m");
   if (!(heightPersistent >= 0.0 && heightPersistent < heightIntermittent))
     throw std::invalid_argument("height_persistent (H_p) must be in [0, H_i) = [0, " +

@@ -13,10 +13,15 @@ namespace plume {
 /// How eq. 1 is integrated over a step ("explicit Euler ... Runge-Kutta is sufficient", §4.1).
 enum class FlameIntegrator { Euler, Midpoint, RungeKutta4 };
 
+/// Bounds of a spine's control points n (§4.1): FlameParams::validate() checks them and the
+/// add-on reads them (_native.setting_ranges()["flames.points"]).
+constexpr int kMinSpinePoints = 2;
+constexpr int kMaxSpinePoints = 256;
+
 /// Structure settings shared by every flame of a system (§4.1–4.3). validate() throws
 /// std::invalid_argument naming the setting and the accepted range.
 struct FlameParams {
-  /// n, control points of an attached flame's spine (§4.1), in [2, 256].
+  /// n, control points of an attached flame's spine (§4.1), in [kMinSpinePoints, kMaxSpinePoints].
   int points = 16;
   /// H_p, top of the persistent (continuous) region (m, Figure 2), in [0, H_i).
   double heightPersistent = 0.15;
