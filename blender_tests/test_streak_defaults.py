@@ -47,6 +47,17 @@ class StreakDefaultsTest(unittest.TestCase):
     def tearDown(self):
         rmtree(self.tmp)
 
+    def assert_bake_traces(self, dom, kept):
+        """The bake traces `kept` streaklines, and a second bake from scratch places the same
+        point sources (seeded)."""
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        first = traced(self.tmp)
+        self.assertEqual(len(first["counts"]), kept)
+        bpy.ops.plume.cache_free()
+        select_only(dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        np.testing.assert_array_equal(traced(self.tmp)["positions"], first["positions"])
+
     def test_default_scene_traces_what_the_panel_says(self):
         """Every default: a rim of point sources (point_rim.py), one per cell of its length:
         a few dozen streaklines, the count the panel shows before the bake."""
@@ -62,14 +73,7 @@ class StreakDefaultsTest(unittest.TestCase):
         from plume import streak_count
         self.assertEqual(streak_count.label(native(), bpy.context.scene, dom),
                          f"{kept:,} streaklines")
-        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        first = traced(self.tmp)
-        self.assertEqual(len(first["counts"]), kept)
-        # Seeded: a second bake from scratch places the same point sources.
-        bpy.ops.plume.cache_free()
-        select_only(dom)
-        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        np.testing.assert_array_equal(traced(self.tmp)["positions"], first["positions"])
+        self.assert_bake_traces(dom, kept)
         # A cap below the rim's count places the rim again with fewer points.
         d.max_streaklines = 12
         self.assertEqual(self.count(dom), (12, placed))
@@ -88,13 +92,7 @@ class StreakDefaultsTest(unittest.TestCase):
         self.assertEqual(kept, 256)
         from plume import streak_count
         self.assertIn("256 streaklines (of", streak_count.label(native(), bpy.context.scene, dom))
-        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        first = traced(self.tmp)
-        self.assertEqual(len(first["counts"]), kept)
-        bpy.ops.plume.cache_free()
-        select_only(dom)
-        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        np.testing.assert_array_equal(traced(self.tmp)["positions"], first["positions"])
+        self.assert_bake_traces(dom, kept)
         # 0 keeps every point source; the panel follows the setting at once.
         d.max_streaklines = 0
         self.assertEqual(self.count(dom), (placed, placed))
