@@ -49,8 +49,10 @@ FlameParticles particlesArg(const py::dict& d) {
   vec3s("colors", p.colors);
   floats("density", p.density);
   floats("mass", p.mass);
+  floats("power", p.power);
   const std::size_t n = p.positions.size();
-  if (p.velocities.size() != n || p.colors.size() != n || p.density.size() != n || p.mass.size() != n)
+  if (p.velocities.size() != n || p.colors.size() != n || p.density.size() != n || p.mass.size() != n ||
+      p.power.size() != n)
     throw py::value_error("particle arrays must all have the same length");
   return p;
 }
@@ -96,7 +98,8 @@ void bindFlamesShape(py::module_& m) {
                   double falloff, double cutoff, double ppp, int minCount, int maxCount, int fixedCount,
                   double flowAmplitude, double flowScale, double flowFrequency, double flowRotation,
                   double kAmplitude, double kScale, const py::object& kDrift, double kFrequency, int kResolution,
-                  double energyScale, double heat, double fuelArea, double width, bool merging, int threads) {
+                  double energyScale, double heat, double fuelArea, double width, bool merging, double temperature,
+                  int threads) {
         FlameShapeParams p;
         p.seed = seed;
         p.density.falloff = falloff;
@@ -114,6 +117,7 @@ void bindFlamesShape(py::module_& m) {
         p.incandescence = {energyScale, heat, fuelArea};
         p.width = width;
         p.merging = merging;
+        p.temperature = temperature;
         p.threads = threads;
         std::vector<ColorImage> list;
         if (!images.is_none())
@@ -128,9 +132,11 @@ void bindFlamesShape(py::module_& m) {
       py::arg("kolmogorov_amplitude") = 0.01, py::arg("kolmogorov_scale") = 0.5,
       py::arg("kolmogorov_drift") = py::make_tuple(0.0, 0.0, 0.5), py::arg("kolmogorov_frequency") = 0.5,
       py::arg("kolmogorov_resolution") = 32, py::arg("energy_scale") = 1.0, py::arg("heat_of_combustion") = 15.0e6,
-      py::arg("fuel_area") = 0.0, py::arg("width") = 1.0, py::arg("merging") = true, py::arg("threads") = 0,
+      py::arg("fuel_area") = 0.0, py::arg("width") = 1.0, py::arg("merging") = true, py::arg("temperature") = 1500.0,
+      py::arg("threads") = 0,
       "profiles: flame f uses profiles[min(source, len-1)]; images: None, one, or one per profile, float "
-      "(height, width, 3) row 0 at the bottom. ValueError on bad settings.");
+      "(height, width, 3) row 0 at the bottom, on the profile's side view; a flame without one takes the "
+      "blackbody colour of temperature x d (K). ValueError on bad settings.");
   shaper.def(
       "set_obstacles",
       [](FlameShaper& s, const std::vector<std::shared_ptr<ObstacleSdf>>& obstacles) {
@@ -159,6 +165,7 @@ void bindFlamesShape(py::module_& m) {
         d["density"] = array1D(p.density);
         d["incandescence"] = array1D(p.incandescence);
         d["mass"] = array1D(p.mass);
+        d["power"] = array1D(p.power);
         d["flame"] = array1D(p.flame);
         d["sampled"] = frame.sampled;
         d["energy"] = frame.energy;
@@ -178,15 +185,18 @@ void bindFlamesShape(py::module_& m) {
         return d;
       },
       py::arg("flames"), py::arg("time"), py::arg("camera"),
-      "dict: positions, velocities, colors (N, 3) float32; density (eq. 4), incandescence (eq. 6), mass (N,); "
+      "dict: positions, velocities, colors (N, 3) float32; density (eq. 4), incandescence (eq. 6, W/m² at "
+      "the camera), power (its share of eq. 5's E, W), mass (N,); "
       "flame (N,) input index; sampled, energy (eq. 5) per flame; merged; obstructed (§6.1); lights [dict(flame_id, centre, "
       "radius h/3, energy, color)].");
 
   m.def(
       "write_flames_vdb",
       [](const py::object& path, const py::dict& particles, float voxelSize, const py::object& origin,
-         float temperatureScale, int frame, int threads) {
+         float temperatureScale, float lightUnit, float opacity, int frame, int threads) {
         FlameRasterParams r;
+        r.emissionScale = lightUnit;
+        r.opacity = opacity;
         r.voxelSize = voxelSize;
         r.origin = glm::vec3(dvec3Arg(origin, "origin"));
         r.temperatureScale = temperatureScale;
@@ -200,9 +210,11 @@ void bindFlamesShape(py::module_& m) {
         });
       },
       py::arg("path"), py::arg("particles"), py::arg("voxel_size"), py::arg("origin") = py::make_tuple(0, 0, 0),
-      py::arg("temperature_scale") = 1500.f, py::arg("frame") = 0, py::arg("threads") = 0,
-      "Rasterizes a FlameShaper.shape() result into grids density, temperature, flame, color, velocity and "
-      "writes them atomically; returns the active voxel count.");
+      py::arg("temperature_scale") = 1500.f, py::arg("light_unit") = 1.f, py::arg("opacity") = 1.f,
+      py::arg("frame") = 0, py::arg("threads") = 0,
+      "Rasterizes a FlameShaper.shape() result into grids emission (W/m^3: light_unit x the particles' "
+      "power), color, density (opacity x d^2, §5.3), temperature, flame, velocity and writes them "
+      "atomically; returns the active voxel count of the density grid.");
 }
 
 }  // namespace plume::bindings

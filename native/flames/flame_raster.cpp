@@ -55,6 +55,11 @@ void FlameRasterParams::validate() const {
     throw std::invalid_argument("origin must be finite");
   if (!(temperatureScale > 0.f && temperatureScale <= 1e5f))
     throw std::invalid_argument("temperature_scale must be in (0, 100000] K (got " + std::to_string(temperatureScale) + ")");
+  if (!(emissionScale > 0.f) || !std::isfinite(emissionScale))
+    throw std::invalid_argument("light_unit must be a finite number > 0 W per W of eq. 5 (got " +
+                                std::to_string(emissionScale) + ")");
+  if (!(opacity >= 0.f && opacity <= 1e4f))
+    throw std::invalid_argument("opacity must be in [0, 10000] (got " + std::to_string(opacity) + ")");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all cores)");
 }
 
@@ -62,12 +67,14 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
   params.validate();
   initializeOpenVdb();
   const float h = params.voxelSize, cell = h * h * h;
-  // Scalar grids: mass_i / Δx³ with a particle volume of Δx³ splats mass_i; T_i = T_scale d_i.
+  // Scalar grids, two conserving splats with a particle volume of Δx³: emission U P_i with the
+  // temperatures T_i = T_scale d_i (temperature, flame), then the opacity weight d_i mass_i.
   const std::size_t n = parts.size();
-  std::vector<float> density(n), temperature(n);
+  std::vector<float> emission(n), temperature(n), opacity(n), none(n, 0.f);
   for (std::size_t m = 0; m < n; ++m) {
-    density[m] = parts.mass[m] / cell;
+    emission[m] = params.emissionScale * parts.power[m] / cell;
     temperature[m] = params.temperatureScale * parts.density[m];
+    opacity[m] = params.opacity * parts.density[m] * parts.mass[m] / cell;
   }
   FireRasterParams fire;
   fire.voxelSize = h;
@@ -77,9 +84,12 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
   fire.ignitionTemperature = 0.f;
   fire.maxTemperature = params.temperatureScale;
   fire.threads = params.threads;
-  const FireGrids scalars = rasterizeFire({parts.positions.data(), density.data(), temperature.data(), n}, fire);
+  const FireGrids scalars = rasterizeFire({parts.positions.data(), emission.data(), temperature.data(), n}, fire);
+  const FireGrids opacityGrids = rasterizeFire({parts.positions.data(), opacity.data(), none.data(), n}, fire);
   FlameGrids out;
-  out.density = scalars.density;
+  out.emission = scalars.density;
+  out.emission->setName("emission");
+  out.density = opacityGrids.density;
   out.temperature = scalars.temperature;
   out.flame = scalars.flame;
 
@@ -105,9 +115,9 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
 }
 
 void writeFlameVdb(const std::string& path, const FlameGrids& grids, int frame) {
-  if (!grids.density || !grids.temperature || !grids.flame || !grids.color || !grids.velocity)
+  if (!grids.emission || !grids.density || !grids.temperature || !grids.flame || !grids.color || !grids.velocity)
     throw std::invalid_argument("flame VDB '" + path + "': missing grids");
-  openvdb::GridPtrVec list{grids.density, grids.temperature, grids.flame, grids.color, grids.velocity};
+  openvdb::GridPtrVec list{grids.emission, grids.density, grids.temperature, grids.flame, grids.color, grids.velocity};
   openvdb::MetaMap meta;
   meta.insertMeta("creator", openvdb::StringMetadata("plume"));
   meta.insertMeta("frame", openvdb::Int32Metadata(frame));

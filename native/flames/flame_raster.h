@@ -2,18 +2,23 @@
 /// \file flame_raster.h
 /// Flame particles into the VDB grids of a frame (structural_flames.txt §5.3: "ideally, the
 /// deformed flames should be volume rendered directly"), for Blender's Principled Volume:
-///   density      Σ mass_i w_i(v) / Δx³: the particles' splatted mass (fields/fire_raster's
-///                conserving hat kernel), so the grid approximates eq. 4's d(x) in world space
-///                whatever the particle count
-///   temperature  T_scale · (mean d_i/I of the particles around the voxel): Kelvin for
-///                Principled Volume's blackbody, fading to 0 where less than one particle's
-///                weight is present
-///   flame        temperature / T_scale, clamped to [0, 1]: emission strength
-///   color        mean base colour (§5.1), vec3 (Principled Volume's Color attribute)
-///   velocity     mean particle velocity, vec3, for motion blur (§5.3)
-/// density/temperature/flame come from rasterizeFire() (fields/fire_raster.h), color and
-/// velocity from OpenVDB's points::rasterizeTrilinear on the same voxels (cell-centred,
-/// voxel (i,j,k) centred at origin + (i + ½, j + ½, k + ½) Δx).
+///   emission     Σ U P_i w_i(v) / Δx³, W/m³ in Blender's light units (U = emissionScale, the
+///                light unit): eq. 6's incandescence as power, splatted with fields/fire_raster's
+///                conserving hat kernel, so Σ_v emission Δx³ = U Σ P_i ≈ U E (eq. 5) whatever
+///                the particle count. A volume renderer projects it to the camera itself (eq. 6's
+///                1 / 4π((h/2)² + l²)).
+///   color        mean base colour (§5.1) of the particles around the voxel (luminance ≈ 1),
+///                vec3: emission colour = color · emission
+///   density      opacity · Σ d_i mass_i w_i(v) / Δx³ ≈ opacity · (d/I)²: §5.3's opacity
+///                "proportional to the relative brightness" — of the particle against the
+///                flame's core (d = I), what is behind it being unknown before rendering
+///   temperature  T_scale · (mean d_i/I of the particles around the voxel): Kelvin, fading to 0
+///                where less than one particle's weight is present
+///   flame        temperature / T_scale, clamped to [0, 1]
+///   velocity     mean particle velocity (eq. 1), vec3, m/s: motion blur (§5.3)
+/// The scalar grids come from rasterizeFire() (fields/fire_raster.h), color and velocity from
+/// OpenVDB's points::rasterizeTrilinear on the same voxels (cell-centred, voxel (i,j,k) centred
+/// at origin + (i + ½, j + ½, k + ½) Δx).
 
 #include "flames/flame_shape.h"
 
@@ -30,14 +35,16 @@ struct FlameRasterParams {
   float voxelSize = 0.01f;          ///< Δx, m
   glm::vec3 origin{0.f};            ///< the voxel grid's origin
   float temperatureScale = 1500.f;  ///< K at d = I
+  float emissionScale = 1.f;        ///< U: Blender watts per watt of eq. 5 (the light unit)
+  float opacity = 1.f;              ///< density where d = I (§5.3)
   int threads = 0;                  ///< 0: all cores
   /// Throws std::invalid_argument naming the setting and its accepted range.
   void validate() const;
 };
 
-/// The five grids of a frame.
+/// The six grids of a frame.
 struct FlameGrids {
-  openvdb::FloatGrid::Ptr density, temperature, flame;
+  openvdb::FloatGrid::Ptr emission, density, temperature, flame;
   openvdb::Vec3SGrid::Ptr color, velocity;
 };
 

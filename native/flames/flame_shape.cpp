@@ -6,6 +6,7 @@
 
 #include "core/huge_pages.h"
 #include "core/parallel.h"
+#include "flames/blackbody.h"
 #include "flames/merging.h"
 #include "flames/spine_mapping.h"
 
@@ -17,7 +18,8 @@
 namespace plume {
 namespace {
 
-constexpr int kChunk = 2048;  ///< particles per parallel task
+constexpr int kChunk = 2048;
+constexpr double kPi = 3.14159265358979323846;  ///< particles per parallel task
 
 /// A run of particles of one flame.
 struct Chunk {
@@ -47,6 +49,8 @@ void FlameShapeParams::validate() const {
   incandescence.validate();
   if (!(width > 0.0 && width <= 1000.0))
     throw std::invalid_argument("width must be in (0, 1000] times the source radius (got " + std::to_string(width) + ")");
+  if (!(temperature >= 500.0 && temperature <= 40000.0))
+    throw std::invalid_argument("temperature must be in [500, 40000] K (got " + std::to_string(temperature) + ")");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all cores)");
 }
 
@@ -57,6 +61,7 @@ void FlameParticles::resize(std::size_t n) {
   reserveHugePages(colors, n);
   reserveHugePages(density, n);
   reserveHugePages(incandescence, n);
+  reserveHugePages(power, n);
   reserveHugePages(mass, n);
   reserveHugePages(flame, n);
   positions.resize(n);
@@ -64,6 +69,7 @@ void FlameParticles::resize(std::size_t n) {
   colors.resize(n);
   density.resize(n);
   incandescence.resize(n);
+  power.resize(n);
   mass.resize(n);
   flame.resize(n);
 }
@@ -108,7 +114,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
   out.energy.assign(nf, 0.0);
   out.lights.assign(nf, FlameLight{});
   std::vector<std::unique_ptr<SpineFrame>> spines(nf);
-  std::vector<double> factor(nf), mass(nf);
+  std::vector<double> factor(nf), mass(nf), power(nf);
 
   // Per flame: spine frame, sample count, eq. 5 and the eq. 6 factor, the mass per particle.
   parallelFor(0, count, [&](int f) {
@@ -126,8 +132,9 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     spine->frameAt(0.5, &c, &t, &nn, &b);
     out.sampled[std::size_t(f)] = n;
     out.energy[std::size_t(f)] = energy;
-    factor[std::size_t(f)] = incandescenceFactor(energy, std::size_t(n), density.meanDensity(), length,
-                                                 glm::length(c - camera.position));
+    const double distance = glm::length(c - camera.position);
+    factor[std::size_t(f)] = incandescenceFactor(energy, std::size_t(n), density.meanDensity(), length, distance);
+    power[std::size_t(f)] = factor[std::size_t(f)] * 4.0 * kPi * (0.25 * length * length + distance * distance);
     // Canonical volume (widest radii³) to world: R² across, L / aspect along the spine.
     mass[std::size_t(f)] =
         flame.intensity * density.mass() * radius * radius * length / density.profile().aspect() / double(n);
@@ -149,7 +156,9 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
   FlameParticles& parts = out.particles;
   parts.resize(offset.back());
   std::vector<std::uint8_t> inside(offset.back());
+  // Per chunk: Σ P_i c_i and Σ P_i lum(c_i) (the colour normalization and the light's colour).
   std::vector<glm::dvec3> chunkColor(chunks.size());
+  std::vector<double> chunkLuminance(chunks.size()), chunkPower(chunks.size());
   const ObstacleSet* obstacles = mObstacles && !mObstacles->empty() ? mObstacles.get() : nullptr;
 
   // §4.5 merging: every flame's volume and neighbours, tested in the particle pass below (the
@@ -183,10 +192,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const ColorImage* image = mImages.empty() ? nullptr : &mImages[mImages.size() == 1 ? 0 : std::size_t(pi)];
     const SpineFrame& spine = *spines[std::size_t(chunk.flame)];
     const double aspect = density.profile().aspect(), radius = mParams.width * flame.radius;
-    const double zSpan = density.zMax() - density.zMin();
     const int n = out.sampled[std::size_t(chunk.flame)];
     const std::vector<int>& near = neighbours[std::size_t(chunk.flame)];
     glm::dvec3 colorSum(0.0);
+    double luminanceSum = 0.0, powerSum = 0.0;
     for (int i = chunk.begin; i < chunk.end; ++i) {
       const std::size_t m = offset[std::size_t(chunk.flame)] + std::size_t(i);
       const ProfileSample s = sampleFlame(density, mParams.seed, flame.id, i, n);
@@ -194,8 +203,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       glm::dvec3 velocity;
       double age;
       spine.motionAt(std::clamp(p.z / aspect, 0.0, 1.0), &velocity, &age);
-      const glm::vec3 color = image ? image->sample(0.5 + 0.5 * p.x / density.rhoMax(), (p.z - density.zMin()) / zSpan)
-                                    : glm::vec3(1.f);
+      // §5.1: the image on the profile's side view (u across the widest diameter, v from base
+      // to tip; the glow outside takes the nearest edge's colour), else a blackbody.
+      const glm::vec3 color = image ? image->sample(0.5 + 0.5 * p.x, p.z / aspect)
+                                    : blackbodyColor(mParams.temperature * s.density);
       p += mFlow.displacement(p, time - age, flame.radius);
       glm::dvec3 x = spine.map(p, aspect, radius);
       x += kolmogorov.displacement(x);
@@ -204,24 +215,47 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       parts.colors[m] = color;
       parts.density[m] = float(flame.intensity * s.density);
       parts.incandescence[m] = float(factor[std::size_t(chunk.flame)] * s.density);
+      const double particlePower = power[std::size_t(chunk.flame)] * s.density;
+      parts.power[m] = float(particlePower);
       parts.mass[m] = float(mass[std::size_t(chunk.flame)]);
       parts.flame[m] = std::uint32_t(chunk.flame);
       // 2: dropped (its stored position inside an obstacle, §6.1).
       inside[m] = obstacles && obstacles->distance(glm::dvec3(parts.positions[m])) < 0.0 ? 2 : s.inside ? 1 : 0;
       if (inside[m] == 0 && !near.empty() && mergedAway(volumes, near, glm::dvec3(parts.positions[m]), false))
         inside[m] = 3;  // 3: merged (§4.5)
-      colorSum += glm::dvec3(color);
+      colorSum += particlePower * glm::dvec3(color);
+      luminanceSum += particlePower * double(luminance(color));
+      powerSum += particlePower;
     }
+    chunkPower[std::size_t(c)] = powerSum;
     chunkColor[std::size_t(c)] = colorSum;
+    chunkLuminance[std::size_t(c)] = luminanceSum;
   });
   if (obstacles)
     for (std::size_t m = 0; m < parts.size(); ++m) out.obstructed += inside[m] == 2 ? 1 : 0;
-  // Mean colour per flame, summed in chunk order (deterministic).
+  // Per flame, summed in chunk order (deterministic): its light's colour, the power-weighted
+  // mean colour at luminance 1, and the scale s = Σ P_i / Σ P_i lum(c_i) giving its particles'
+  // colours a power-weighted mean luminance of 1.
   std::vector<glm::dvec3> colorSum(nf, glm::dvec3(0.0));
-  for (std::size_t c = 0; c < chunks.size(); ++c) colorSum[std::size_t(chunks[c].flame)] += chunkColor[c];
-  for (int f = 0; f < count; ++f)
-    if (out.sampled[std::size_t(f)] > 0)
-      out.lights[std::size_t(f)].color = glm::vec3(colorSum[std::size_t(f)] / double(out.sampled[std::size_t(f)]));
+  std::vector<double> luminanceSum(nf, 0.0), powerSum(nf, 0.0);
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    const std::size_t f = std::size_t(chunks[c].flame);
+    colorSum[f] += chunkColor[c];
+    luminanceSum[f] += chunkLuminance[c];
+    powerSum[f] += chunkPower[c];
+  }
+  std::vector<float> colorScale(nf, 1.f);
+  for (std::size_t f = 0; f < nf; ++f)
+    if (luminanceSum[f] > 0.0) {
+      out.lights[f].color = glm::vec3(colorSum[f] / luminanceSum[f]);
+      colorScale[f] = float(powerSum[f] / luminanceSum[f]);
+    }
+  parallelFor(0, int(chunks.size()), [&](int c) {
+    const Chunk& chunk = chunks[std::size_t(c)];
+    const float scale = colorScale[std::size_t(chunk.flame)];
+    const std::size_t first = offset[std::size_t(chunk.flame)];
+    for (int i = chunk.begin; i < chunk.end; ++i) parts.colors[first + std::size_t(i)] *= scale;
+  });
 
   if (obstacles || merging) {
     std::size_t kept = 0;
@@ -233,6 +267,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
         parts.colors[kept] = parts.colors[m];
         parts.density[kept] = parts.density[m];
         parts.incandescence[kept] = parts.incandescence[m];
+        parts.power[kept] = parts.power[m];
         parts.mass[kept] = parts.mass[m];
         parts.flame[kept] = parts.flame[m];
       }

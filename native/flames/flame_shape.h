@@ -33,6 +33,7 @@ struct FlameShapeParams {
   KolmogorovParams kolmogorov;
   IncandescenceParams incandescence;
   double width = 1.0;    ///< the flame's widest radius R = width · Flame::radius
+  double temperature = 1500.0;  ///< K at d = I: the blackbody base colour of a flame without a colour image
   bool merging = true;   ///< §4.5 (the paper switched it off for the dragon)
   std::uint64_t seed = 0;
   int threads = 0;       ///< 0: all cores
@@ -44,9 +45,15 @@ struct FlameShapeParams {
 struct FlameParticles {
   std::vector<glm::vec3> positions;   ///< world, m
   std::vector<glm::vec3> velocities;  ///< m/s, eq. 1 of the nearest spine points (motion blur)
-  std::vector<glm::vec3> colors;      ///< base colour (§5.1)
+  /// Base colour (§5.1) as a chromaticity: the colour image (or blackbody) scaled per flame so
+  /// that the power-weighted mean luminance of its particles is 1 (the image sets the colour and
+  /// the relative brightness across the flame, eq. 5–6 the flame's brightness).
+  std::vector<glm::vec3> colors;
   std::vector<float> density;         ///< d(x_i) = I / (1 + dist²/ℓ²), eq. 4
-  std::vector<float> incandescence;   ///< E_i, eq. 6
+  std::vector<float> incandescence;   ///< E_i, eq. 6: W/m² at the camera
+  /// P_i = E_i · 4π((h/2)² + l²) = E d(x_i) / (n ⟨d⟩), W: the particle's share of eq. 5's E. A
+  /// volume renderer does eq. 6's projection to the camera itself, so the grids hold this.
+  std::vector<float> power;
   std::vector<float> mass;            ///< ∫ d dV of its flame / n (m³): rasterized density ≈ d
   std::vector<std::uint32_t> flame;   ///< index of its flame in the input
   std::size_t size() const { return positions.size(); }

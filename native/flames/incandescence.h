@@ -12,8 +12,9 @@
 namespace plume {
 
 /// A reference image (§5.1): RGB floats, row 0 at the bottom (Blender's pixel order), mapped
-/// on the profile's side view: u across the flame (−ρ_max … ρ_max), v from the bottom of the
-/// sampled shell to its top. Empty: white.
+/// on the profile's side view: u across the flame's widest diameter (−R … R), v from the base
+/// of the profile to its tip; the glow outside the profile takes the nearest edge's colour.
+/// Empty: white.
 struct ColorImage {
   int width = 0, height = 0;
   std::vector<float> rgb;  ///< width · height · 3
@@ -50,7 +51,7 @@ struct FlameLight {
   glm::dvec3 centre{0.0};  ///< the spine point at half the arc length
   double radius = 0.0;     ///< h/3
   double energy = 0.0;     ///< eq. 5 times the flame's intensity
-  glm::vec3 color{1.f};    ///< mean base colour of its particles
+  glm::vec3 color{1.f};    ///< power-weighted mean base colour of its particles, luminance 1
 };
 
 }  // namespace plume

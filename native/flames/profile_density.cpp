@@ -81,8 +81,7 @@ ProfileDensity::ProfileDensity(const FlameProfile& profile, const DensityParams&
     for (int a = 0; a < kQuadrature; ++a)
       for (int b = 0; b < kQuadrature; ++b) {
         const glm::dvec2 p(r0 + (a + 0.5) * h, z0 + (b + 0.5) * h);
-        double dd;
-        closestPoint(p, &dd);
+        const double dd = surfaceDistance(p);
         if (dd > mShell) continue;
         const double d = 1.0 / (1.0 + dd * dd / l2);
         m += 2.0 * kPi * p.x * d * h * h;
@@ -93,8 +92,7 @@ ProfileDensity::ProfileDensity(const FlameProfile& profile, const DensityParams&
     cellMass[std::size_t(c)] = m;
     cellMean[std::size_t(c)] = m > 0.0 ? m2 / m : 0.0;
     // Bound for rejection: the cell is at least (distance at its centre - hd) from the surface.
-    double dc;
-    closestPoint({r0 + 0.5 * mCell, z0 + 0.5 * mCell}, &dc);
+    const double dc = surfaceDistance({r0 + 0.5 * mCell, z0 + 0.5 * mCell});
     const double near = std::max(0.0, dc - hd);
     mCellMaxDensity[std::size_t(c)] = near > mShell ? 0.0 : 1.0 / (1.0 + near * near / l2);
   }
@@ -142,9 +140,15 @@ glm::dvec2 ProfileDensity::closestPoint(glm::dvec2 p, double* distance) const {
   return out;
 }
 
-double ProfileDensity::density(const glm::dvec3& p) const {
+double ProfileDensity::surfaceDistance(glm::dvec2 rhoZ) const {
+  if (inside(rhoZ)) return 0.0;
   double dist;
-  closestPoint({std::hypot(p.x, p.y), p.z}, &dist);
+  closestPoint(rhoZ, &dist);
+  return dist;
+}
+
+double ProfileDensity::density(const glm::dvec3& p) const {
+  const double dist = surfaceDistance({std::hypot(p.x, p.y), p.z});
   return 1.0 / (1.0 + dist * dist / (mParams.falloff * mParams.falloff));
 }
 
@@ -171,18 +175,17 @@ ProfileSample ProfileDensity::sample(double u, Rng& rng) const {
     rho = std::sqrt(r0 * r0 + rng.uniform() * ((r0 + mCell) * (r0 + mCell) - r0 * r0));
     const double z = z0 + rng.uniform() * mCell;
     theta = 2.0 * kPi * rng.uniform();
-    double dist;
-    closestPoint({rho, z}, &dist);
+    const double dist = surfaceDistance({rho, z});
     const double d = 1.0 / (1.0 + dist * dist / l2);
     s.position.z = z;
     s.density = d;
+    s.inside = dist == 0.0;  // surfaceDistance is 0 exactly inside the surface
     if (dist <= mShell && rng.uniform() * bound <= d) break;
   }
   // The angle only places the accepted candidate: its cosine and sine once, in single precision
   // (positions end as floats; θ ∈ [0, 2π) to ~2e-7 rad).
   s.position.x = rho * double(std::cos(float(theta)));
   s.position.y = rho * double(std::sin(float(theta)));
-  s.inside = inside({rho, s.position.z});
   return s;
 }
 

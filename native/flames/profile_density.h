@@ -2,8 +2,14 @@
 /// \file profile_density.h
 /// The light density of a flame (structural_flames.txt §4.4, eq. 4) in canonical profile space
 /// (profile.h), and its Monte-Carlo sampling:
-///   d(x) = I / (1 + |x_f(x) − x|² / ℓ²)
-/// x_f(x) the closest point to x on the surface of revolution of the profile. Eq. 4 as printed
+///   d(x) = I / (1 + |x_f(x) − x|² / ℓ²)   outside the surface,   d(x) = I inside it
+/// x_f(x) the closest point to x on the surface of revolution of the profile. Eq. 4 defines "the
+/// light density of the visible part of the flame" around the surface where I is "the density
+/// of combustion at the surface"; read literally inside too, the density would fall towards the
+/// axis and the flame would render as a hollow shell (a bright rim, a dark core), which no
+/// photograph of a flame shows. The region the profile bounds is the visible flame (§4.4:
+/// "the surface of revolution bounds the visible (oxidization) region"), so it is filled at I
+/// and eq. 4's fall-off is the glow outside it. Eq. 4 as printed
 /// has ℓ = 1 in the paper's (unstated) normalized units; here distances are in units of the
 /// profile's widest radius and ℓ (`falloff`) sets how far the glow reaches, so ℓ = 1 is eq. 4
 /// literally. The density is sampled inside the shell |x_f(x) − x| ≤ cutoff · ℓ (eq. 4 decays as
@@ -48,7 +54,9 @@ class ProfileDensity {
 
   /// The closest point x_f on the meridian polyline to (ρ, z) (ρ ≥ 0), and its distance.
   glm::dvec2 closestPoint(glm::dvec2 rhoZ, double* distance) const;
-  /// d(x)/I (eq. 4 with I = 1) at a canonical position.
+  /// |x_f − x| outside the surface of revolution, 0 inside it.
+  double surfaceDistance(glm::dvec2 rhoZ) const;
+  /// d(x)/I (eq. 4 with I = 1, and 1 inside the surface) at a canonical position.
   double density(const glm::dvec3& p) const;
   /// Whether (ρ, z) is inside the surface of revolution.
   bool inside(glm::dvec2 rhoZ) const;

@@ -71,9 +71,15 @@ TEST(FlamesShape, DensityMatchesBruteForceClosestPointOnSurfaceOfRevolution) {
     for (int n = 0; n < 40; ++n) {
       const glm::dvec3 x(rng.uniform(-1.6, 1.6), rng.uniform(-1.6, 1.6),
                          rng.uniform(-0.8, profile.aspect() + 0.8));
+      const double d = density.density(x);
+      // Inside the surface of revolution the flame is filled: d = I (no hollow shell).
+      const double rho = std::hypot(x.x, x.y), s01 = x.z / profile.aspect();
+      if (s01 >= 0.0 && s01 <= 1.0 && rho <= profile.radius(s01)) {
+        EXPECT_EQ(d, 1.0);
+        continue;
+      }
       double best = 1e30;
       for (const glm::dvec3& s : surface) best = std::min(best, glm::length(s - x));
-      const double d = density.density(x);
       const double dist = std::sqrt(std::max(0.0, (1.0 / d - 1.0)) * params.falloff * params.falloff);
       // The tessellation lies on the surface, so its nearest sample is no closer than x_f; it is
       // at most half a sample gap further: gaps are ≤ 2π/360 · ρ ≤ 0.0175 around and 0.005

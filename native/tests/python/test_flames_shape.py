@@ -38,7 +38,9 @@ def test_shape_energy_lights_and_colors():
     shaper = native.FlameShaper([native.FlameProfile.library("torch")], images=[image], fixed_count=5000, seed=2)
     out = shaper.shape([straight_flame()], 0.5, camera)
     assert out["positions"].shape == (5000, 3) and out["sampled"] == [5000]
-    assert np.allclose(out["colors"], [1.0, 0.0, 0.0])
+    # red, scaled to luminance 1 (the image gives the colour, eq. 5-6 the brightness)
+    assert np.allclose(out["colors"], [1.0 / 0.2126, 0.0, 0.0], rtol=1e-5)
+    assert out["power"].sum() == pytest.approx(out["energy"][0], rel=0.01)  # Σ P_i = E
     h = 0.3
     l = math.dist((0.0, 0.0, 0.15), (0.0, -2.0, 0.3))
     expected = out["energy"][0] / (4 * math.pi * (0.25 * h * h + l * l))
@@ -46,6 +48,7 @@ def test_shape_energy_lights_and_colors():
     light = out["lights"][0]
     assert light["radius"] == pytest.approx(h / 3, rel=1e-3)
     assert light["energy"] == pytest.approx(out["energy"][0])
+    assert np.allclose(light["color"], [1.0 / 0.2126, 0.0, 0.0], rtol=1e-5)
     assert np.all((out["density"] > 0.19) & (out["density"] <= 1.0))  # d ∈ [I/(1+cutoff²), I]
 
 
@@ -69,14 +72,21 @@ def test_write_flames_vdb(tmp_path):
     shaper = native.FlameShaper([native.FlameProfile.library("candle")], fixed_count=20000, seed=1)
     out = shaper.shape([straight_flame(), straight_flame(x=0.2, ident=2)], 0.25, camera)
     path = tmp_path / "flames_0001.vdb"
-    voxels = native.write_flames_vdb(path, out, voxel_size=0.01, frame=1)
+    voxels = native.write_flames_vdb(path, out, voxel_size=0.01, light_unit=3.0, opacity=0.5, frame=1)
     assert voxels > 0 and path.exists()
     names = native.vdb_grid_names(str(path))
-    assert set(names) == {"density", "temperature", "flame", "color", "velocity"}
-    density = native.read_vdb_grid(str(path), "density")
-    # The splatted mass is conserved: Σ ρ Δx³ = Σ mass.
-    total = density["values"].astype(np.float64).sum() * 0.01**3
-    assert total == pytest.approx(out["mass"].astype(np.float64).sum(), rel=1e-3)
+    assert set(names) == {"emission", "density", "temperature", "flame", "color", "velocity"}
+    emission = native.read_vdb_grid(str(path), "emission")
+    # The splatted power is conserved: Σ emission Δx³ = light unit × Σ P_i.
+    total = emission["values"].astype(np.float64).sum() * 0.01**3
+    assert total == pytest.approx(3.0 * out["power"].astype(np.float64).sum(), rel=1e-3)
+    density = native.read_vdb_grid(str(path), "density")  # opacity × Σ d_i m_i / Δx³ (§5.3)
+    weight = (out["density"].astype(np.float64) * out["mass"]).sum()
+    assert density["values"].astype(np.float64).sum() * 0.01**3 == pytest.approx(0.5 * weight, rel=1e-3)
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="light_unit"):
+            native.write_flames_vdb(tmp_path / "bad.vdb", out, voxel_size=0.01, light_unit=bad)
+    assert not (tmp_path / "bad.vdb").exists()
 
 
 def test_obstacles_drop_particles():
