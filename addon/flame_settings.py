@@ -17,7 +17,12 @@ MANIFEST_NAME = "flames_manifest.json"
 #: §6.1 obstacles: voxel size (m) of their signed distance and the band around them.
 OBSTACLE_VOXEL = 0.005
 OBSTACLE_PADDING = 0.05
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: emission grid (eq. 6 power), density = §5.3 opacity
+#: k of eq. 5 (Blender watts per watt of E), calibrated once: the Candle defaults' flame (r = 5
+#: mm, its measured mean |v_c| and h) gives 1 cd = 4π lm = 4π/683 W in Blender's units (683 lm/W,
+#: the convention of Blender's glTF exporter). See README "Structural flames: light units".
+CANDELA_WATTS = 4.0 * math.pi / 683.0
+LIGHT_UNIT = 2.0e6
 POINTS_RANGE = RANGES["flames.points"]
 FLAMES_PER_SOURCE_RANGE = RANGES["flames.flames_per_source"]
 SUBSTEPS_RANGE = RANGES["flames.substeps"]
@@ -53,8 +58,10 @@ class FlameSettings:
     flow_noise: float = 0.15           # §4.5 buoyancy noise (widest radii)
     kolmogorov: float = 0.003          # §4.5 Kolmogorov noise (m RMS)
     voxel_size: float = 0.002
-    temperature_scale: float = 1500.0
+    temperature_scale: float = 1500.0  # K at d = I (temperature grid, blackbody colour)
     heat_of_combustion: float = 15.0   # H_c, MJ/kg (eq. 5)
+    light_unit: float = LIGHT_UNIT     # k of eq. 5: Blender W per W of E
+    opacity: float = 1.0               # §5.3: density where d = I
 
 
 @dataclass
@@ -91,7 +98,9 @@ class FlameSourceInput:
     profile: str
     #: CUSTOM: (k, 2) points (radius, height) of the profile curve, base first.
     profile_points: Optional[np.ndarray] = None
-    #: §5.1 reference image, (h, w, 3) float32 rows from the bottom; None: white.
+    #: §5.1: PROFILE (the profile's palette), IMAGE (color_image) or BLACKBODY.
+    color_source: str = 'PROFILE'
+    #: §5.1 reference image, (h, w, 3) float32 scene-linear, rows from the bottom (IMAGE).
     color_image: Optional[np.ndarray] = None
     local_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))   # (k, 3)
     local_normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (k, 3)
@@ -178,6 +187,13 @@ def validate_settings(s: FlameSettings, frame):
            f"{at} Voxel Size must be > 0 (got {s.voxel_size})")
     _check(_finite(s.flow_noise, s.kolmogorov) and s.flow_noise >= 0.0 and s.kolmogorov >= 0.0,
            f"{at} Flow Noise and Kolmogorov Noise must be >= 0")
+    _check(_finite(s.temperature_scale) and 500.0 <= s.temperature_scale <= 40000.0,
+           f"{at} Temperature must be in [500, 40000] K (got {s.temperature_scale})")
+    _check(_finite(s.light_unit) and s.light_unit > 0.0,
+           f"{at} Light Unit (k of eq. 5) must be > 0 Blender watts per watt of E "
+           f"(got {s.light_unit}; the calibrated default is {LIGHT_UNIT:g})")
+    _check(_finite(s.opacity) and 0.0 <= s.opacity <= 1e4,
+           f"{at} Opacity must be in [0, 10000] (got {s.opacity})")
 
 
 def validate_source_values(src: FlameSourceInput):

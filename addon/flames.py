@@ -20,6 +20,7 @@ from typing import Callable, List, Optional
 
 import numpy as np
 
+from . import flame_palettes
 from .settings import BakeError
 # The settings, validation and files of a flames bake, also reachable as flames.<name>.
 from .flame_files import (SMOKE_ARRAYS, SPINE_ARRAYS, buoyancy_lift, clear_folder,
@@ -68,7 +69,8 @@ class FlameNative:
             particles_per_pixel=float(s.particles_per_pixel), max_particles=int(s.max_particles),
             fixed_count=0 if has_camera else FIXED_PARTICLES,
             flow_noise_amplitude=float(s.flow_noise), kolmogorov_amplitude=float(s.kolmogorov),
-            heat_of_combustion=float(s.heat_of_combustion) * 1e6, merging=bool(s.merging))
+            heat_of_combustion=float(s.heat_of_combustion) * 1e6, merging=bool(s.merging),
+            temperature=float(s.temperature_scale))
 
     def profile(self, src: FlameSourceInput):
         if src.profile == 'CUSTOM':
@@ -77,16 +79,20 @@ class FlameNative:
 
     @staticmethod
     def color_image(src: FlameSourceInput):
-        """(h, w, 3) float32 rows from the bottom; white (1x1) without an image."""
-        if src.color_image is None:
-            return np.ones((1, 1, 3), np.float32)
-        return np.ascontiguousarray(src.color_image[..., :3], np.float32)
+        """§5.1: (h, w, 3) float32 rows from the bottom: the Colour Image, the profile's palette
+        (flame_palettes), or an empty (0, 0, 3) image: the blackbody of each particle's
+        temperature."""
+        if src.color_source == 'IMAGE' and src.color_image is not None:
+            return np.ascontiguousarray(src.color_image[..., :3], np.float32)
+        if src.color_source == 'BLACKBODY':
+            return np.zeros((0, 0, 3), np.float32)
+        return flame_palettes.palette_image(src.profile)
 
 
 def shape_key(s: FlameSettings):
     """The settings the FlameShaper is built from: a change rebuilds it."""
     return (s.particles_per_pixel, s.max_particles, s.merging, s.flow_noise, s.kolmogorov,
-            s.heat_of_combustion)
+            s.heat_of_combustion, s.temperature_scale)
 
 
 @dataclass
@@ -126,8 +132,6 @@ class FlameBakeRunner:
                     raise BakeError(f"Plume: Flame Source '{src.name}': {e}") from None
                 self.profiles += [prof] * src.count
                 self.images += [img] * src.count
-            if not any(src.color_image is not None for src in snap.sources):
-                self.images = None
             for i, s in enumerate(snap.settings):  # every keyed shape setting is valid
                 if i == 0 or shape_key(s) != shape_key(snap.settings[i - 1]):
                     self.build.shaper(s, self.profiles[:1], None, True)
@@ -261,7 +265,9 @@ class FlameBakeRunner:
             t2 = time.perf_counter()
             n.write_flames_vdb(volume_path(snap.folder, frame), shaped,
                                voxel_size=float(s.voxel_size),
-                               temperature_scale=float(s.temperature_scale), frame=frame)
+                               temperature_scale=float(s.temperature_scale),
+                               light_unit=float(s.light_unit), opacity=float(s.opacity),
+                               frame=frame)
             write_spines(spines_path(snap.folder, frame), live, shaped["lights"],
                          self.params[i])
             result.step_seconds += t1 - t0

@@ -24,7 +24,7 @@ from helpers import (OUT_DIR, compat, assert_reports_error, image_pixels, native
                      tree_listing)
 
 FRAMES = 12
-GRIDS = {"density", "temperature", "flame", "color", "velocity"}
+GRIDS = {"emission", "density", "temperature", "flame", "color", "velocity"}
 OBSTACLE_FRAMES = 8
 KEY_FRAMES = 16
 #: (lower, upper) corners of the plate over the candle (m): 2 cm thick, 1 cm above the wick.
@@ -327,9 +327,11 @@ class FlamesTest(unittest.TestCase):
         img = bpy.data.images.new("Gone", 4, 4)
         img.source = 'FILE'
         img.filepath = os.path.join(self.tmp, "no_such_image.png")
+        src.plume.flame.color_source = 'IMAGE'
         src.plume.flame.color_image = img
         assert_reports_error(self, op, r"'Candle'.*Colour Image 'Gone' cannot be read", state)
         src.plume.flame.color_image = None
+        src.plume.flame.color_source = 'PROFILE'
         src.plume.role = 'NONE'
         assert_reports_error(self, op, r"no Flame Source", state)
 

@@ -46,6 +46,21 @@ def solid(ob, color, roughness=0.6, emission=None, name=None):
     return mat
 
 
+def wax(ob, color=(0.9, 0.82, 0.68), depth=0.01, name="Wax"):
+    """A candle-wax material on `ob`: Principled BSDF with subsurface scattering `depth` metres
+    deep (warm), so the wax glows under its flame as real wax does instead of reading black."""
+    mat = solid(ob, color, roughness=0.35, name=name)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    weight = bsdf.inputs.get("Subsurface Weight") or bsdf.inputs["Subsurface"]  # 4.0+ / 3.x
+    weight.default_value = 1.0 if weight.name == "Subsurface Weight" else depth
+    bsdf.inputs["Subsurface Radius"].default_value = (1.0, 0.45, 0.2)
+    if "Subsurface Scale" in bsdf.inputs:
+        bsdf.inputs["Subsurface Scale"].default_value = depth
+    if "Subsurface Color" in bsdf.inputs:  # 3.x: the colour scattered below the surface
+        bsdf.inputs["Subsurface Color"].default_value = (*color, 1.0)
+    return mat
+
+
 def floor(size, z=0.0, color=(0.05, 0.04, 0.035), name="Floor"):
     """A square plane of `size` (m) at height `z`, a dull dark material."""
     bpy.ops.mesh.primitive_plane_add(size=size, location=(0.0, 0.0, z))
@@ -89,15 +104,22 @@ def bake_flames(scene, tag):
     return per, flames, particles
 
 
-def flame_look(scene, tag, out_dir, width=320, height=240, samples=48,
-               world=(0.0015, 0.0015, 0.002)):
-    """Cycles at a small size on a near-black world (the flames and their lights light the
-    scene), Filmic so bright flame cores keep their colour."""
+def flame_look(scene, tag, out_dir, width=640, height=360, samples=64,
+               world=(0.0015, 0.0015, 0.002), exposure=0.0):
+    """Cycles on a near-black world (the flames and their lights light the scene), Filmic so
+    bright flame cores keep their colour, `exposure` stops as a photographer sets it for the
+    scene's light (the flames' light is physical: Light Unit's default), the denoiser where the
+    Blender has one (Debian's 3.4.1 has none)."""
     scene_kit.cycles(scene, width, height, samples, os.path.join(out_dir, tag + "_"))
+    if getattr(bpy.app.build_options, "openimagedenoise", False):
+        scene.cycles.use_denoising = True
+        scene.cycles.denoiser = 'OPENIMAGEDENOISE'
     scene_kit.plain_world(scene, world)
     scene.view_settings.view_transform = 'Filmic'
+    scene.view_settings.exposure = exposure
     scene.cycles.volume_bounces = 0  # the flames emit; scattering in them is not worth its cost
-    scene.cycles.sample_clamp_indirect = 1.0  # no fireflies from the bright, small flames
+    # no fireflies from the bright, small flames (the clamp scaled with the exposure)
+    scene.cycles.sample_clamp_indirect = 1.0 / 2.0 ** max(exposure, 0.0)
     scene.cycles.volume_step_rate = 2.0  # steps of two voxels through the soft flames
 
 

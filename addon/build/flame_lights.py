@@ -1,7 +1,8 @@
 """§5.2: "for global illumination purposes, an emitting sphere at the center of each flame
 segment with a radius of h/3 gives reasonable looking lighting": a pool of point lights
 "Plume Flame Light NNN", one per live flame of the frame (spines_####.npz), placed at the spine's
-middle, radius h/3, energy = eq. 5 × Light Watts, coloured like the flame's particles. Lights
+middle, radius h/3, power = eq. 5's E × Light Unit (Blender watts), coloured by the flame's
+power-weighted mean emitted colour. Lights
 beyond the frame's flame count are switched off (energy 0). Moved per frame by the flame
 spines' frame handler (flame_spines.py)."""
 
@@ -42,7 +43,18 @@ def ensure_pool(scene, count, collection=None):
     return [lights[i] for i in range(count)]
 
 
-def update(scene, spines, watts):
+def light_color_energy(color, energy, light_unit):
+    """Blender's (colour, power) of a flame light: the flame's mean colour (luminance 1) scaled
+    to a maximum component of 1 (a light's colour), the power raised by as much, so the light
+    emits E × Light Unit of luminance-weighted watts whatever its colour."""
+    c = np.maximum(np.asarray(color, np.float64), 0.0)
+    top = float(c.max())
+    if top <= 0.0:
+        return (1.0, 1.0, 1.0), float(energy) * light_unit
+    return tuple(float(v) for v in c / top), float(energy) * light_unit * top
+
+
+def update(scene, spines, light_unit):
     """Sets the pool from a spines file's light arrays (None: every light off)."""
     lights = pool(scene)
     m = 0 if spines is None else len(spines["light_ids"])
@@ -51,8 +63,8 @@ def update(scene, spines, watts):
         if i < m:
             ob.location = tuple(float(v) for v in spines["light_centres"][i])
             light.shadow_soft_size = float(spines["light_radii"][i])
-            light.energy = float(spines["light_energy"][i]) * watts
-            light.color = tuple(float(np.clip(v, 0.0, 1.0)) for v in spines["light_colors"][i])
+            light.color, light.energy = light_color_energy(
+                spines["light_colors"][i], spines["light_energy"][i], light_unit)
         else:
             light.energy = 0.0
 

@@ -13,7 +13,8 @@ from .. import flames
 OBJECT_NAME = "Plume Flame Spines"
 FOLDER_KEY = "plume_flames_cache"
 RANGE_KEY = "plume_flames_frames"
-WATTS_KEY = "plume_flames_watts"
+UNIT_KEY = "plume_flames_light_unit"
+LIGHTS_KEY = "plume_flames_lights"
 
 _files = point_frames.LastFile(flames.read_spines, (OSError, ValueError))
 
@@ -42,7 +43,7 @@ def update_object(ob, scene, frame):
     folder, first, last = bpy.path.abspath(ob[FOLDER_KEY]), *ob[RANGE_KEY]
     spines = _files.read(flames.spines_path(folder, frame)) if first <= frame <= last else None
     set_splines(ob.data, spines)
-    flame_lights.update(scene, spines, float(ob.get(WATTS_KEY, 1.0)))
+    flame_lights.update(scene, spines, float(ob.get(UNIT_KEY, 1.0)))
     return spines is not None
 
 
@@ -73,7 +74,7 @@ def max_lights(folder, first, last):
     return most
 
 
-def build(scene, folder, first, last, watts):
+def build(scene, folder, first, last, light_unit, lights=True):
     """Creates or updates "Plume Flame Spines" and the light pool for frames first..last, set to
     the current frame. Returns the curve object."""
     ob = bpy.data.objects.get(OBJECT_NAME)
@@ -89,8 +90,8 @@ def build(scene, folder, first, last, watts):
     ob.matrix_world.identity()  # the points are in world space
     ob[FOLDER_KEY] = point_frames.stored_path(folder)
     ob[RANGE_KEY] = [int(first), int(last)]
-    ob[WATTS_KEY] = float(watts)
-    count = max_lights(folder, first, last) if watts > 0.0 else 0
+    ob[UNIT_KEY] = float(light_unit)
+    count = max_lights(folder, first, last) if lights else 0
     flame_lights.ensure_pool(scene, count)
     scene.render.use_lock_interface = True  # the handler rewrites data while rendering
     _files.clear()

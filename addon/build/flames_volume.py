@@ -1,8 +1,16 @@
 """The structural flames (structural_flames.txt §5.3: "ideally, the deformed flames should be
 volume rendered directly") as the Volume object "Plume Flames" over flames_####.vdb with an
-emission material: emission colour = blackbody of the `temperature` grid (K) × the base colour
-grid `color` (§5.1), emission strength = the `flame` grid × Emission, a light `density` (real
-flames are highly transparent, §5.3). Renders without the add-on."""
+emission material that renders without the add-on:
+- emission: the `emission` grid (RGB W/m³ in Blender's units: each particle's share of eq. 5's
+  E × Light Unit (eq. 6) in its §5.1 colour) × Flame Brightness / 4π. Cycles' volume emission strength is radiance per metre; a volume emitting
+  ε W/m³ isotropically has radiance ε / 4π per metre: measured, a 10 cm cube of strength P / V
+  lights a floor 13.0× as much as a P-watt point light (4π = 12.6), so the flame looks as bright
+  as the light it casts;
+- absorption: the `density` grid (§5.3's opacity, ∝ (d/I)²), a black scattering colour: real
+  flames are "highly transparent", only bright things show through their core.
+"""
+
+import math
 
 import bpy
 
@@ -12,8 +20,10 @@ from ..snapshot import blend_relative
 
 OBJECT_NAME = "Plume Flames"
 MATERIAL = "Plume Flames"
-#: Principled Volume density: flames absorb little (§5.3, "real flames are highly transparent").
-FLAME_DENSITY = 0.5
+#: The material's layout version (custom property): an older Plume Flames material is rebuilt.
+MATERIAL_VERSION = 2
+#: Volume emission strength per W/m³ (isotropic radiance per metre, see above).
+EMISSION_PER_WATT = 1.0 / (4.0 * math.pi)
 
 
 def _attribute(nt, name, y):
@@ -23,34 +33,38 @@ def _attribute(nt, name, y):
     return attr
 
 
-def flames_material(emission):
-    """The shared flames material (created once, then left to the artist; Emission updated)."""
+def _build_nodes(mat):
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    out.location = (300, 0)
+    N, L = nt.nodes.new, nt.links.new
+    pv = N("ShaderNodeVolumePrincipled")
+    pv.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)  # absorbs, does not scatter
+    pv.inputs["Density"].default_value = 1.0
+    pv.inputs["Density Attribute"].default_value = "density"
+    pv.inputs["Blackbody Intensity"].default_value = 0.0
+    L(_attribute(nt, "emission", -150).outputs["Vector"], pv.inputs["Emission Color"])
+    strength = nt.nodes.new("ShaderNodeValue")
+    strength.location = (-700, -400)
+    strength.name = strength.label = "Plume Emission"
+    L(strength.outputs[0], pv.inputs["Emission Strength"])
+    L(pv.outputs["Volume"], out.inputs["Volume"])
+    mat["plume_version"] = MATERIAL_VERSION
+
+
+def flames_material(brightness):
+    """The shared flames material (created once, then left to the artist; Flame Brightness
+    updated; rebuilt when made by an older Plume)."""
     mat = bpy.data.materials.get(MATERIAL)
     if mat is None:
-        mat, nt, out = datablocks.node_material(MATERIAL)
-        N, L = nt.nodes.new, nt.links.new
-        pv = N("ShaderNodeVolumePrincipled")
-        pv.inputs["Density"].default_value = FLAME_DENSITY
-        pv.inputs["Density Attribute"].default_value = "density"
-        pv.inputs["Blackbody Intensity"].default_value = 0.0
-        blackbody = N("ShaderNodeBlackbody")
-        blackbody.location = (-450, -150)
-        L(_attribute(nt, "temperature", -150).outputs["Fac"], blackbody.inputs["Temperature"])
-        # blackbody x colour, component-wise (a Vector Math node: Cycles 5.0 crashes optimizing
-        # a volume shader holding the legacy MixRGB node)
-        tint = N("ShaderNodeVectorMath")
-        tint.location, tint.operation = (-250, -150), 'MULTIPLY'
-        L(blackbody.outputs["Color"], tint.inputs[0])
-        L(_attribute(nt, "color", -350).outputs["Vector"], tint.inputs[1])
-        L(tint.outputs["Vector"], pv.inputs["Emission Color"])
-        L(_attribute(nt, "color", 150).outputs["Vector"], pv.inputs["Color"])
-        strength = volume._scaled_attribute(nt, "flame", emission, -500)
-        strength.name = "Plume Emission"
-        L(strength.outputs[0], pv.inputs["Emission Strength"])
-        L(pv.outputs["Volume"], out.inputs["Volume"])
+        mat = datablocks.node_material(MATERIAL)[0]
+    if mat.get("plume_version") != MATERIAL_VERSION:
+        mat.use_nodes = True
+        _build_nodes(mat)
     node = mat.node_tree.nodes.get("Plume Emission")
     if node is not None:
-        node.inputs[1].default_value = emission
+        node.outputs[0].default_value = brightness * EMISSION_PER_WATT
     return mat
 
 
@@ -69,6 +83,9 @@ def build(scene, folder, frame_start, frames, emission):
         # the (nearly transparent, §5.3) volume to its own lights cost most of the render time.
         ob.visible_diffuse = False
         ob.visible_shadow = False
+        # Glossy rays finding the small, bright volume by chance are fireflies on every rough
+        # surface; the lights give the glossy highlights instead.
+        ob.visible_glossy = False
     volume.play_sequence(ob, blend_relative(flames.volume_path(folder, frame_start)),
                          frame_start, frames, flames_material(emission))
     if ob.data.materials[0] is None:

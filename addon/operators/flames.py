@@ -57,7 +57,7 @@ class FlamesJob(JobRunner):
             vol = flames_volume.build(scene, snap.folder, snap.frame_start, frames,
                                       float(scene.plume_flames.emission))
             spines = flame_spines.build(scene, snap.folder, snap.frame_start, result.last_frame,
-                                        float(f.light_watts))
+                                        float(f.light_unit), bool(f.lights))
             f.volume_object, f.spines_object, f.frames_baked = vol.name, spines.name, frames
         seconds = time.perf_counter() - self.t0
         per_frame = seconds / max(frames, 1)

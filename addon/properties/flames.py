@@ -7,6 +7,7 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from ..flame_settings import LIGHT_UNIT
 from ..ranges import text
 
 PROFILE_ITEMS = (
@@ -14,6 +15,15 @@ PROFILE_ITEMS = (
     ('TORCH', "Torch", "Figure 3, middle: a torch flame"),
     ('CAMPFIRE', "Campfire", "Figure 3, right: a broad campfire flame"),
     ('CUSTOM', "Custom Curve", "The profile r(s) drawn as a curve object (Profile Curve)"),
+)
+COLOR_ITEMS = (
+    ('PROFILE', "Profile Colours", "§5.1: the profile's own colour image, painted from "
+                                   "photographs (candle: blue base, yellow-white core, orange to "
+                                   "red tip; torch and campfire: yellow base, orange, red tip)"),
+    ('IMAGE', "Colour Image", "§5.1: your reference photograph (Colour Image) mapped on the "
+                              "profile's side view, base at the bottom"),
+    ('BLACKBODY', "Blackbody", "The blackbody colour of each particle's temperature "
+                               "(Temperature × d(x)/I, §5.1: hotter regions are bluer)"),
 )
 SPREAD_ITEMS = (
     ('NONE', "Always Burning", "Every flame of the source burns from the first frame"),
@@ -37,8 +47,13 @@ class PlumeFlameSourceSettings(bpy.types.PropertyGroup):
         name="Profile Curve", type=bpy.types.Object, poll=lambda _s, ob: ob.type == 'CURVE',
         description="Custom profile (§4.4): the first spline of this curve, drawn from the base "
                     "to the tip; local X is the radius, the longer of local Y and Z the height")
-    color_image: _image("Colour Image", "§5.1: a reference photograph mapped on the 2D profile "
-                                        "gives each particle its base colour (none: white)")
+    color_source: EnumProperty(name="Colour", items=COLOR_ITEMS, default='PROFILE',
+                               description="§5.1: where each particle's base colour comes from "
+                                           "(its brightness comes from eq. 5-6)")
+    color_image: _image("Colour Image", "§5.1: a reference photograph (RGB) mapped on the 2D "
+                                        "profile's side view, base at the bottom, tip at the "
+                                        "top: each particle's base colour and relative "
+                                        "brightness (Colour: Colour Image)")
     flames: IntProperty(
         name="Flames", default=1, soft_min=1, soft_max=64,
         description="Flames on this source: 1 at the centre of its up-facing faces, more spread "
@@ -163,18 +178,31 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
                               description="Δx of the flame VDB grids (m); > 0")
     temperature_scale: FloatProperty(
         name="Temperature (K)", default=1500.0, soft_min=500.0, soft_max=4000.0,
-        description="Kelvin of the temperature grid where d = I: blackbody colour (§5.1-5.2)")
-    emission: FloatProperty(name="Emission", default=8.0, soft_min=0.0, soft_max=1000.0,
-                            description="Emission strength of the flame grid in the material")
+        description="Kelvin where d = I: the temperature grid, and the particle colour of "
+                    "sources whose Colour is Blackbody (§5.1); in [500, 40000]")
+    emission: FloatProperty(
+        name="Flame Brightness", default=1.0, soft_min=0.0, soft_max=100.0,
+        description="Multiplies the visible flame's emission in the material (1: the flame "
+                    "looks as bright as the light it casts, both E × Light Unit)")
+    opacity: FloatProperty(
+        name="Opacity", default=1.0, soft_min=0.0, soft_max=20.0,
+        description="§5.3: absorption density where d = I, falling as (d/I)^2 with the "
+                    "particles' relative brightness: real flames are highly transparent, only "
+                    "bright things show through their core; in [0, 10000]")
     heat_of_combustion: FloatProperty(
         name="Heat of Combustion (H_c)", default=15.0, soft_min=1.0, soft_max=60.0,
         description="H_c of eq. 5 in MJ/kg (15 wood, 48 gasoline)")
-    light_watts: FloatProperty(
-        name="Light Watts", default=1e5, soft_min=0.0, soft_max=1e12,
-        description="§5.2: a point light of radius h/3 per flame, of eq. 5's E × this (W). "
-                    "E = ½ k 0.3 m H_c 2 A_f r³ / h is tiny in SI units and grows as r^7 (about "
-                    "2e-8 for a 6 mm candle, 7e-5 for a 2 cm torch flame): the default gives a "
-                    "torch flame 7 W; raise it for candles (5e6 gives 0.1 W); 0: no lights")
+    light_unit: FloatProperty(
+        name="Light Unit", default=LIGHT_UNIT, soft_min=1e-3 * LIGHT_UNIT,
+        soft_max=1e3 * LIGHT_UNIT, precision=1,
+        description="k of eq. 5: Blender watts per watt of E = ½ k 0.3 m H_c 2 A_f r³ / h, for "
+                    "both the flames' emission and their lights. The default is calibrated once "
+                    "so that the Candle defaults give a candle's luminous intensity, about 1 cd "
+                    "(0.018 W in Blender's units, 683 lm/W); > 0")
+    lights: BoolProperty(
+        name="Flame Lights", default=True,
+        description="§5.2: a point light of radius h/3 at the middle of each flame, of power "
+                    "E × Light Unit and the flame's mean colour")
     cache_directory: StringProperty(
         name="Cache", subtype='DIR_PATH', default="//plume_cache/flames/",
         description="Folder of flames_####.vdb and spines_####.npz ('//' = next to the .blend)")

@@ -45,6 +45,27 @@ def image_pixels(image, owner, setting):
     return px
 
 
+def color_image(image, owner):
+    """§5.1: the Colour Image as (h, w, 3) scene-linear float32; BakeError naming the setting
+    when it is empty, unreadable or not RGB."""
+    if image is None:
+        raise BakeError(f"Plume: Flame Source '{owner}': Colour is Colour Image but Colour Image "
+                        "is empty: pick an RGB image, or set Colour to Profile Colours")
+    px = image_pixels(image, owner, "Colour Image")
+    # Blender gives every image 4 channels in memory; the file's own are in its bit depth
+    # (8 per channel, 32 for float): a greyscale file holds no colour.
+    channels = image.depth // (32 if image.is_float else 8)
+    if min(image.channels, channels) < 3:
+        raise BakeError(f"Plume: Flame Source '{owner}': Colour Image '{image.name}' must be RGB "
+                        f"or RGBA (it has {min(image.channels, channels)} channel"
+                        f"{'s' if min(image.channels, channels) != 1 else ''}: greyscale)")
+    rgb = px[..., :3]
+    if not image.is_float and image.colorspace_settings.name == 'sRGB':
+        # byte images hold sRGB-encoded values: to scene-linear, as Blender's shaders read them
+        rgb = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    return np.ascontiguousarray(rgb, np.float32)
+
+
 def curve_profile(ob, owner):
     """(k, 2) (radius, height) of the first spline of a curve object, base first (§4.4): local X
     the radius, the longer of local Y and Z the height."""
@@ -93,8 +114,9 @@ def source_input(ob, depsgraph, seed, settings, fps):
     src = flames.FlameSourceInput(name=ob.name, profile=fl.profile)
     if fl.profile == 'CUSTOM':
         src.profile_points = curve_profile(fl.profile_curve, ob.name)
-    if fl.color_image is not None:
-        src.color_image = image_pixels(fl.color_image, ob.name, "Colour Image")[..., :3]
+    src.color_source = fl.color_source
+    if fl.color_source == 'IMAGE':
+        src.color_image = color_image(fl.color_image, ob.name)
     verts, tris = mesh_arrays(ob, depsgraph)
     order = place.canonical_order(tris)
     tris = tris[order]

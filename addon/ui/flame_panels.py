@@ -30,7 +30,9 @@ class PHYSICS_PT_plume_flame_source(FlameSourcePanel, bpy.types.Panel):
         sub = layout.column()
         sub.active = fl.profile == 'CUSTOM'
         sub.prop(fl, "profile_curve")
-        layout.prop(fl, "color_image")
+        layout.prop(fl, "color_source")
+        if fl.color_source == 'IMAGE':
+            layout.prop(fl, "color_image")
         for name in ("flames", "radius", "intensity", "temperature"):
             layout.prop(fl, name)
         col = layout.column(heading="Spread")
@@ -69,8 +71,8 @@ def draw_flames(layout, scene):
     for name in ("wind", "use_force_fields", "wind_domain", "use_obstacles"):
         col.prop(f, name)
     col = layout.column(heading="Render", align=True)
-    for name in ("voxel_size", "temperature_scale", "emission", "heat_of_combustion",
-                 "light_watts", "cache_directory"):
+    for name in ("voxel_size", "temperature_scale", "emission", "opacity", "heat_of_combustion",
+                 "light_unit", "lights", "cache_directory"):
         col.prop(f, name)
     if f.summary:
         layout.label(text=f.summary, icon='INFO')

@@ -36,28 +36,29 @@ WICK_TOP = WAX_HEIGHT + 0.006
 
 def setup(scene, frames):
     flame_kit.floor(1.0, color=(0.09, 0.06, 0.04), name="Table")
-    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, 0.25, 0.3),
+    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, 0.2, 0.3),
                                      rotation=(1.5708, 0.0, 0.0))
     flame_kit.solid(bpy.context.active_object, (0.25, 0.22, 0.2), roughness=0.9, name="Wall")
     bpy.ops.mesh.primitive_cylinder_add(radius=WAX_RADIUS, depth=WAX_HEIGHT,
                                         location=(0.0, 0.0, WAX_HEIGHT / 2))
-    flame_kit.solid(bpy.context.active_object, (0.85, 0.8, 0.7), roughness=0.4, name="Wax")
+    flame_kit.wax(bpy.context.active_object)
     wick = flame_kit.flame_source("Wick", bpy.ops.mesh.primitive_cylinder_add,
                                   (0.0, 0.0, WICK_TOP - 0.004), 'CANDLE', 1, 0.005,
                                   radius=0.0008, depth=0.008, vertices=8)
     flame_kit.solid(wick, (0.01, 0.008, 0.006), roughness=0.9)
+    # A candle flame is about 3 cm tall and steady: H_p, H_i, H_max close together, little
+    # diffusion and noise, pieces rare and short-lived.
     flame_kit.flames_settings(
-        scene, frames, points=12, height_persistent=0.03, height_intermittent=0.042,
-        height_max=0.055, breakaway_frequency=2.0, lifespan_scale=1.0 / 24.0,
-        buoyancy=0.6, diffusion=2e-5, flow_noise=0.08, kolmogorov=0.0004, voxel_size=0.0008,
-        particles_per_pixel=10.0, emission=120.0, temperature_scale=1900.0,
-        light_watts=5e6)
-    scene_kit.camera(scene, (0.0, -0.32, 0.11), lens=60.0, target=(0.0, 0.0, 0.085))
+        scene, frames, points=12, height_persistent=0.024, height_intermittent=0.03,
+        height_max=0.042, breakaway_frequency=0.7, lifespan_scale=1.0 / 24.0,
+        buoyancy=0.4, diffusion=2e-6, flow_noise=0.04, kolmogorov=0.0001, voxel_size=0.0005,
+        particles_per_pixel=10.0)
+    scene_kit.camera(scene, (0.0, -0.34, 0.1), lens=50.0, target=(0.0, 0.0, 0.095))
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, width=240, height=320,
-                            samples=48)
+    # A candle lights a room dimly (1 cd): exposed as a photograph of one is, +2 stops.
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64, exposure=2.0)
 
 
 if __name__ == "__main__":

@@ -272,6 +272,7 @@ Flame flameArg(const py::handle& h, std::size_t index) {
   f.id = d.contains("id") ? d["id"].cast<std::uint32_t>() : std::uint32_t(index + 1);
   if (d.contains("source")) f.source = d["source"].cast<int>();
   if (d.contains("separated")) f.separated = d["separated"].cast<bool>();
+  if (d.contains("split_length")) f.splitLength = d["split_length"].cast<double>();
   return f;
 }
 
@@ -287,6 +288,7 @@ py::dict flameDict(const Flame& f) {
   d["id"] = f.id;
   d["source"] = f.source;
   d["separated"] = f.separated;
+  d["split_length"] = f.splitLength;
   d["age"] = f.age;
   d["lifespan"] = f.lifespan;
   d["radius"] = f.radius;

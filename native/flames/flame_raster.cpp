@@ -67,12 +67,16 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
   params.validate();
   initializeOpenVdb();
   const float h = params.voxelSize, cell = h * h * h;
-  // Scalar grids, two conserving splats with a particle volume of Δx³: emission U P_i with the
-  // temperatures T_i = T_scale d_i (temperature, flame), then the opacity weight d_i mass_i.
+  // Conserving splats with a particle volume of Δx³: the emission's red channel U P_i c_i.r with
+  // the temperatures T_i = T_scale d_i (temperature, flame), its green and blue channels, then
+  // the opacity weight d_i mass_i.
   const std::size_t n = parts.size();
-  std::vector<float> emission(n), temperature(n), opacity(n), none(n, 0.f);
+  std::vector<float> red(n), green(n), blue(n), temperature(n), opacity(n), none(n, 0.f);
   for (std::size_t m = 0; m < n; ++m) {
-    emission[m] = params.emissionScale * parts.power[m] / cell;
+    const float e = params.emissionScale * parts.power[m] / cell;
+    red[m] = e * parts.colors[m].x;
+    green[m] = e * parts.colors[m].y;
+    blue[m] = e * parts.colors[m].z;
     temperature[m] = params.temperatureScale * parts.density[m];
     opacity[m] = params.opacity * parts.density[m] * parts.mass[m] / cell;
   }
@@ -84,11 +88,11 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
   fire.ignitionTemperature = 0.f;
   fire.maxTemperature = params.temperatureScale;
   fire.threads = params.threads;
-  const FireGrids scalars = rasterizeFire({parts.positions.data(), emission.data(), temperature.data(), n}, fire);
+  const FireGrids scalars = rasterizeFire({parts.positions.data(), red.data(), temperature.data(), n}, fire);
+  const FireGrids greens = rasterizeFire({parts.positions.data(), green.data(), none.data(), n}, fire);
+  const FireGrids blues = rasterizeFire({parts.positions.data(), blue.data(), none.data(), n}, fire);
   const FireGrids opacityGrids = rasterizeFire({parts.positions.data(), opacity.data(), none.data(), n}, fire);
   FlameGrids out;
-  out.emission = scalars.density;
-  out.emission->setName("emission");
   out.density = opacityGrids.density;
   out.temperature = scalars.temperature;
   out.flame = scalars.flame;
@@ -110,6 +114,18 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
     velocity = pts::rasterizeTrilinear</*Staggered=*/false, openvdb::Vec3f>(tree, "velocity");
   }
   out.color = vectorGrid(color, "color", xform, openvdb::VEC_INVARIANT);
+  // The three channels share their topology (the same particles, the same kernel).
+  auto emission = openvdb::Vec3STree::Ptr(new openvdb::Vec3STree(scalars.density->tree(), openvdb::Vec3s(0.f),
+                                                                  openvdb::TopologyCopy()));
+  {
+    auto g = greens.density->getConstAccessor();
+    auto b = blues.density->getConstAccessor();
+    for (auto it = scalars.density->cbeginValueOn(); it; ++it) {
+      const openvdb::Coord ijk = it.getCoord();
+      emission->setValueOn(ijk, openvdb::Vec3s(*it, g.getValue(ijk), b.getValue(ijk)));
+    }
+  }
+  out.emission = vectorGrid(emission, "emission", xform, openvdb::VEC_INVARIANT);
   out.velocity = vectorGrid(velocity, "velocity", xform, openvdb::VEC_CONTRAVARIANT_RELATIVE);
   return out;
 }

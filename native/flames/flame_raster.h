@@ -2,13 +2,14 @@
 /// \file flame_raster.h
 /// Flame particles into the VDB grids of a frame (structural_flames.txt §5.3: "ideally, the
 /// deformed flames should be volume rendered directly"), for Blender's Principled Volume:
-///   emission     Σ U P_i w_i(v) / Δx³, W/m³ in Blender's light units (U = emissionScale, the
-///                light unit): eq. 6's incandescence as power, splatted with fields/fire_raster's
-///                conserving hat kernel, so Σ_v emission Δx³ = U Σ P_i ≈ U E (eq. 5) whatever
-///                the particle count. A volume renderer projects it to the camera itself (eq. 6's
-///                1 / 4π((h/2)² + l²)).
-///   color        mean base colour (§5.1) of the particles around the voxel (luminance ≈ 1),
-///                vec3: emission colour = color · emission
+///   emission     Σ U P_i c_i w_i(v) / Δx³, vec3, W/m³ in Blender's light units (U =
+///                emissionScale, the light unit; c_i the §5.1 colour, mean luminance 1): eq. 6's
+///                incandescence as power, each channel splatted with fields/fire_raster's
+///                conserving hat kernel, so Σ_v lum(emission) Δx³ = U Σ P_i ≈ U E (eq. 5)
+///                whatever the particle count. One grid, not colour × strength: the product of
+///                two interpolated grids darkens the sparse fringe, more so with fewer particles.
+///                A volume renderer projects it to the camera itself (eq. 6's 1/4π((h/2)² + l²)).
+///   color        mean base colour (§5.1) of the particles around the voxel (luminance ≈ 1)
 ///   density      opacity · Σ d_i mass_i w_i(v) / Δx³ ≈ opacity · (d/I)²: §5.3's opacity
 ///                "proportional to the relative brightness" — of the particle against the
 ///                flame's core (d = I), what is behind it being unknown before rendering
@@ -44,8 +45,8 @@ struct FlameRasterParams {
 
 /// The six grids of a frame.
 struct FlameGrids {
-  openvdb::FloatGrid::Ptr emission, density, temperature, flame;
-  openvdb::Vec3SGrid::Ptr color, velocity;
+  openvdb::FloatGrid::Ptr density, temperature, flame;
+  openvdb::Vec3SGrid::Ptr emission, color, velocity;
 };
 
 /// Rasterizes the particles (see the file comment).

@@ -32,6 +32,8 @@ void checkFlame(const Flame& flame, std::size_t f) {
   if (flame.points.size() < 2) throw std::invalid_argument(flameName(f) + " needs at least 2 spine points");
   if (!(flame.radius > 0.0) || !std::isfinite(flame.radius))
     throw std::invalid_argument(flameName(f) + ": radius must be a finite number > 0 m");
+  if (!(flame.splitLength >= 0.0) || !std::isfinite(flame.splitLength))
+    throw std::invalid_argument(flameName(f) + ": split_length must be a finite number >= 0 m");
   if (!(flame.intensity >= 0.0) || !std::isfinite(flame.intensity))
     throw std::invalid_argument(flameName(f) + ": intensity must be a finite number >= 0");
   for (const SpinePoint& p : flame.points)
@@ -126,8 +128,12 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     glm::dvec3 meanVelocity(0.0);
     for (const SpinePoint& p : flame.points) meanVelocity += p.v;
     meanVelocity /= double(flame.points.size());
+    // Eq. 5; a separated piece: its share h / h_split of the flame it broke from (flame.h).
+    const bool piece = flame.separated && flame.splitLength > length;
     const double energy =
-        flame.intensity * flameEnergy(mParams.incandescence, glm::length(meanVelocity), flame.radius, length);
+        flame.intensity *
+        flameEnergy(mParams.incandescence, glm::length(meanVelocity), flame.radius, piece ? flame.splitLength : length) *
+        (piece ? length / flame.splitLength : 1.0);
     glm::dvec3 c, t, nn, b;
     spine->frameAt(0.5, &c, &t, &nn, &b);
     out.sampled[std::size_t(f)] = n;
@@ -192,6 +198,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const ColorImage* image = mImages.empty() ? nullptr : &mImages[mImages.size() == 1 ? 0 : std::size_t(pi)];
     const SpineFrame& spine = *spines[std::size_t(chunk.flame)];
     const double aspect = density.profile().aspect(), radius = mParams.width * flame.radius;
+    // The colour image's v: a separated piece was the top h / h_split of its flame, so it takes
+    // the top of the image (no blue base on a piece of flame with no fuel under it).
+    const double pieceShare =
+        flame.separated && flame.splitLength > spine.length() ? spine.length() / flame.splitLength : 1.0;
     const int n = out.sampled[std::size_t(chunk.flame)];
     const std::vector<int>& near = neighbours[std::size_t(chunk.flame)];
     glm::dvec3 colorSum(0.0);
@@ -205,8 +215,9 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       spine.motionAt(std::clamp(p.z / aspect, 0.0, 1.0), &velocity, &age);
       // §5.1: the image on the profile's side view (u across the widest diameter, v from base
       // to tip; the glow outside takes the nearest edge's colour), else a blackbody.
-      const glm::vec3 color = image ? image->sample(0.5 + 0.5 * p.x, p.z / aspect)
-                                    : blackbodyColor(mParams.temperature * s.density);
+      const double v = 1.0 - pieceShare * (1.0 - p.z / aspect);
+      const glm::vec3 color = image && image->width > 0 ? image->sample(0.5 + 0.5 * p.x, v)
+                                                        : blackbodyColor(mParams.temperature * s.density);
       p += mFlow.displacement(p, time - age, flame.radius);
       glm::dvec3 x = spine.map(p, aspect, radius);
       x += kolmogorov.displacement(x);

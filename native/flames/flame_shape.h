@@ -73,8 +73,8 @@ struct FlameShapeFrame {
 /// The shape stage, built once per bake (profile tables, noise tile), run once per frame.
 class FlameShaper {
  public:
-  /// `profiles`: flame f uses profiles[min(f.source, size-1)]; `images`: none (white), one for
-  /// all, or one per profile. Throws std::invalid_argument on bad settings.
+  /// `profiles`: flame f uses profiles[min(f.source, size-1)]; `images`: none (blackbody), one for
+  /// all, or one per profile; an empty (0 × 0) image: the blackbody of T · d_i/I. Throws std::invalid_argument on bad settings.
   FlameShaper(const std::vector<FlameProfile>& profiles, const FlameShapeParams& params,
               std::vector<ColorImage> images = {});
   /// The frame at time t (s) seen from `camera`.

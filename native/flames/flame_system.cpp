@@ -145,6 +145,7 @@ void FlameSystem::processFlame(std::size_t index, double dt, FlameOutcome& out) 
       out.piece = flame;  // radius, intensity, temperature, source
       out.piece.points = std::move(upper);
       out.piece.separated = true;
+      out.piece.splitLength = spine.length();
       out.piece.age = 0.0;
       out.pieceLifespan = drawLifespan(mParams.lifespanScale, state.rng);
     }

@@ -87,6 +87,27 @@ TEST(FlamesEmission, ParticlePowerSumsToEquation5ForAnyCount) {
   }
 }
 
+TEST(FlamesEmission, ASeparatedPieceCarriesItsShareOfTheParentsEnergy) {
+  // E = ½ k 0.3 m H_c 2 A_f r³ / h, m = |v_c| r², A_f = π r² (defaults k = 1, H_c = 15 MJ/kg).
+  auto eq5 = [](double v, double r, double h) {
+    return 0.5 * 0.3 * (v * r * r) * 15.0e6 * 2.0 * (kPi * r * r) * r * r * r / h;
+  };
+  FlameShapeParams params;
+  params.sampling.fixedCount = 500;
+  const FlameShaper shaper({FlameProfile::library(ProfileShape::Torch)}, params);
+  FlameCamera camera;
+  Flame attached = uprightFlame(0.12, 0.02, 1.0, 1), piece = uprightFlame(0.03, 0.02, 1.0, 2);
+  piece.separated = true;
+  piece.splitLength = 0.12;
+  const FlameShapeFrame frame = shaper.shape({attached, piece}, 0.0, camera);
+  const double h = SpineFrame(attached).length();
+  EXPECT_NEAR(frame.energy[0] / eq5(1.0, 0.02, h), 1.0, 1e-9);
+  // The piece: a quarter of the parent's length, a quarter of its energy (eq. 5's 1/h alone
+  // would make it 4× the whole flame).
+  EXPECT_NEAR(frame.energy[1] / (eq5(1.0, 0.02, 0.12) * SpineFrame(piece).length() / 0.12), 1.0, 1e-9);
+  EXPECT_LT(frame.energy[1], frame.energy[0]);
+}
+
 TEST(FlamesEmission, ColoursComeFromTheImageOnTheProfileWithMeanLuminanceOne) {
   FlameShapeParams params;
   params.sampling.fixedCount = 20000;
@@ -151,14 +172,16 @@ TEST(FlamesEmission, EmissionGridHoldsTheLightUnitTimesThePowerAndOpacityTheSqua
   const FlameGrids grids = rasterizeFlames(frame.particles, raster);
   double emitted = 0.0, core = 0.0;
   int coreVoxels = 0;
-  for (auto it = grids.emission->cbeginValueOn(); it; ++it) emitted += double(*it);
+  for (auto it = grids.emission->cbeginValueOn(); it; ++it)
+    emitted += double(luminance(glm::vec3((*it)[0], (*it)[1], (*it)[2])));
   for (auto it = grids.density->cbeginValueOn(); it; ++it) {
     const openvdb::Vec3d x = grids.density->indexToWorld(it.getCoord());
     // Near the axis where the candle is widest (s = 0.15…0.45, ρ < R/3): d = I.
     if (std::hypot(x.x(), x.y()) < 0.02 / 3.0 && x.z() > 0.015 && x.z() < 0.045) core += *it, ++coreVoxels;
   }
   const double cell = std::pow(double(raster.voxelSize), 3.0);
-  // Conserving splat: Σ emission Δx³ = U Σ P_i (float sums over ~10⁴ voxels: 1e-4).
+  // Conserving splats and colours of mean luminance 1: Σ lum(emission) Δx³ = U Σ P_i (float
+  // sums over ~10⁴ voxels: 1e-4).
   EXPECT_NEAR(emitted * cell / (250.0 * sum(frame.particles.power)), 1.0, 1e-4);
   // The core is filled (d = I): the splatted Σ d_i m_i / Δx³ is ≈ d² = 1 there, times the
   // opacity. Each voxel holds ~20 particles (±22 %); the mean over the core's voxels is within 10 %.

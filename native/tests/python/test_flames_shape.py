@@ -77,8 +77,8 @@ def test_write_flames_vdb(tmp_path):
     names = native.vdb_grid_names(str(path))
     assert set(names) == {"emission", "density", "temperature", "flame", "color", "velocity"}
     emission = native.read_vdb_grid(str(path), "emission")
-    # The splatted power is conserved: Σ emission Δx³ = light unit × Σ P_i.
-    total = emission["values"].astype(np.float64).sum() * 0.01**3
+    # The splatted power is conserved: Σ lum(emission) Δx³ = light unit × Σ P_i (mean lum. 1).
+    total = (emission["values"].astype(np.float64) @ [0.2126, 0.7152, 0.0722]).sum() * 0.01**3
     assert total == pytest.approx(3.0 * out["power"].astype(np.float64).sum(), rel=1e-3)
     density = native.read_vdb_grid(str(path), "density")  # opacity × Σ d_i m_i / Δx³ (§5.3)
     weight = (out["density"].astype(np.float64) * out["mass"]).sum()

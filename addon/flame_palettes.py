@@ -1,0 +1,72 @@
+"""The default colour image of each library profile (structural_flames.txt §5.1: "we find a
+reference photograph and map the picture onto the two-dimensional profile"), no ``bpy``.
+
+Each palette is painted from what photographs of such flames show, on the profile's side view:
+u across the widest diameter (x from -1 to 1, in widest radii), v from the base (s = 0) to the tip
+(s = 1). Values are scene-linear RGB whose brightness is relative: the bake scales every flame so
+that its power-weighted mean luminance is 1 (eq. 5-6 give the flame's brightness; the image
+gives its colour and where it is brighter or darker).
+
+- Candle: a dim blue cup at the base (the blue, hot, soot-free reaction zone around the wick), a
+  bright yellow-white core (glowing soot), an orange mantle, an orange to red tip.
+- Torch: yellow-white at the base where the fuel burns, orange above, a dark red tip.
+- Campfire: a bright yellow-orange base, orange, deep red tongues at the tip.
+"""
+
+import numpy as np
+
+#: Image size: the colour changes over a few tenths of the profile; 64 x 128 is smooth enough.
+WIDTH, HEIGHT = 64, 128
+
+
+def _ramp(s, stops):
+    """Piecewise-linear colour over s from (s_k, (r, g, b)) stops, sorted by s."""
+    keys = np.array([k for k, _ in stops])
+    rgb = np.array([c for _, c in stops], np.float64)
+    return np.stack([np.interp(s, keys, rgb[:, i]) for i in range(3)], axis=-1)
+
+
+def _smoothstep(edge0, edge1, x):
+    t = np.clip((x - edge0) / (edge1 - edge0), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def _candle(x, s):
+    core = _ramp(s, [(0.0, (1.0, 0.78, 0.42)), (0.55, (1.0, 0.8, 0.48)),
+                     (0.8, (1.0, 0.55, 0.18)), (1.0, (0.75, 0.22, 0.05))])
+    mantle = _ramp(s, [(0.0, (0.8, 0.38, 0.08)), (0.6, (0.9, 0.4, 0.08)),
+                       (1.0, (0.55, 0.13, 0.03))])
+    rgb = core + (mantle - core) * _smoothstep(0.35, 1.0, np.abs(x))[..., None]
+    # The blue base: strongest at the bottom and outside, gone by a fifth of the height.
+    blue = np.array([0.12, 0.3, 1.0]) * 0.45
+    w = (1.0 - _smoothstep(0.04, 0.2, s)) * (0.55 + 0.45 * _smoothstep(0.0, 0.6, np.abs(x)))
+    return rgb + (blue - rgb) * w[..., None]
+
+
+def _torch(x, s):
+    core = _ramp(s, [(0.0, (1.0, 0.72, 0.3)), (0.3, (1.0, 0.6, 0.18)),
+                     (0.65, (1.0, 0.38, 0.07)), (1.0, (0.45, 0.08, 0.02))])
+    edge = _ramp(s, [(0.0, (0.9, 0.4, 0.08)), (0.5, (0.8, 0.25, 0.04)),
+                     (1.0, (0.3, 0.05, 0.01))])
+    return core + (edge - core) * _smoothstep(0.4, 1.0, np.abs(x))[..., None]
+
+
+def _campfire(x, s):
+    core = _ramp(s, [(0.0, (1.2, 0.85, 0.4)), (0.25, (1.0, 0.62, 0.2)),
+                     (0.6, (1.0, 0.38, 0.07)), (1.0, (0.5, 0.1, 0.02))])
+    edge = _ramp(s, [(0.0, (1.0, 0.5, 0.12)), (0.5, (0.85, 0.26, 0.04)),
+                     (1.0, (0.3, 0.05, 0.01))])
+    return core + (edge - core) * _smoothstep(0.35, 1.0, np.abs(x))[..., None]
+
+
+PALETTES = {'CANDLE': _candle, 'TORCH': _torch, 'CAMPFIRE': _campfire}
+
+
+def palette_image(profile):
+    """(HEIGHT, WIDTH, 3) float32, row 0 at the base, of library profile `profile` ('CANDLE',
+    'TORCH', 'CAMPFIRE'; a custom curve gets the torch's)."""
+    paint = PALETTES.get(profile, _torch)
+    x = (np.arange(WIDTH) + 0.5) / WIDTH * 2.0 - 1.0
+    s = (np.arange(HEIGHT) + 0.5) / HEIGHT
+    xx, ss = np.meshgrid(x, s)
+    return np.ascontiguousarray(paint(xx, ss), np.float32)
