@@ -144,7 +144,7 @@ def load_frames(settings: Optional[FlameSmokeSettings], frame_start, frame_end, 
         raise BakeError(f"{owner}: Smoke Yield must be >= 0 (got {settings.smoke_yield})")
     if not math.isfinite(settings.smoke_point) or settings.smoke_point < 0.0:
         raise BakeError(f"{owner}: Smoke Point must be >= 0 m, the flame height above which "
-                        f"smoke escapes (§6.3) (got {settings.smoke_point})")
+                        f"smoke escapes (§6.3) (got {settings.smoke_point:g})")
     if not math.isfinite(settings.temperature):
         raise BakeError(f"{owner}: Smoke Temperature must be a finite number "
                         f"(got {settings.temperature})")

@@ -175,12 +175,12 @@ class FlameSmokeTest(unittest.TestCase):
         clean = self.domain_totals(self.bake_domain("clean", 10.0, 1.01 * max(tallest)))
         print(f"  smoke point {1.01 * max(tallest):.3f} m: Σρ per frame {clean}")
         self.assertEqual(clean, [0.0] * FRAMES)
-        # In between: the height the tallest flame has at the middle frame (the flames grow
-        # from a few mm at frame 1). Before the first frame with a flame that tall: no smoke;
-        # from it on: smoke.
-        point = tallest[FRAMES // 2 - 1]
-        first = next(f for f in range(1, FRAMES + 1) if tallest[f - 1] >= point)
-        self.assertGreater(first, 1)
+        # In between (the flames grow from a few mm at frame 1): halfway between the tallest
+        # flame so far and the first taller one from the middle frame on, away from both (the
+        # setting is single precision). Before that frame: no smoke; from it on: smoke.
+        first = next(f for f in range(FRAMES // 2, FRAMES + 1)
+                     if tallest[f - 1] > max(tallest[:f - 1]))
+        point = 0.5 * (max(tallest[:first - 1]) + tallest[first - 1])
         totals = self.domain_totals(self.bake_domain("point", 10.0, point))
         print(f"  smoke point {point:.3f} m: first flame that tall at frame {first}; Σρ per "
               f"frame {[round(t, 4) for t in totals]}")
