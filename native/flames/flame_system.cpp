@@ -36,7 +36,8 @@ void FlameSystem::setSource(int index, const FlameSource& source) {
 
 void FlameSystem::setParams(const FlameParams& params) {
   params.validate();
-  if (params.spineNoise != mParams.spineNoise) mSpineNoise = std::make_shared<SpineNoise>(params.spineNoise, mSeed);
+  if (params.spineNoise != mParams.spineNoise)
+    mSpineNoise = std::make_shared<SpineNoise>(params.spineNoise, mSeed, *mSpineNoise);
   mParams = params;
 }
 

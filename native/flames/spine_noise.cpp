@@ -44,7 +44,19 @@ SpineNoise::SpineNoise(const SpineNoiseParams& params, std::uint64_t seed) : mPa
   field.frequency = params.frequency;
   field.resolution = params.resolution;
   // Its own stream of the system's seed: not the render particles' field of the same seed.
-  mField = std::make_unique<KolmogorovNoise>(field, seed ^ 0x5E11E5B1A0C0FFEEull);
+  mField = std::make_shared<KolmogorovNoise>(field, seed ^ 0x5E11E5B1A0C0FFEEull);
+}
+
+SpineNoise::SpineNoise(const SpineNoiseParams& params, std::uint64_t seed, const SpineNoise& previous) {
+  SpineNoiseParams same = previous.mParams;
+  same.amplitude = params.amplitude;
+  if (previous.mField && params.amplitude > 0.0 && same == params) {
+    params.validate();
+    mParams = params;
+    mField = previous.mField;
+  } else {
+    *this = SpineNoise(params, seed);
+  }
 }
 
 glm::dvec3 SpineNoise::velocity(const glm::dvec3& x, double t) const {

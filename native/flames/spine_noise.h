@@ -56,6 +56,9 @@ class SpineNoise {
  public:
   /// Throws std::invalid_argument for bad params.
   SpineNoise(const SpineNoiseParams& params, std::uint64_t seed);
+  /// The same for new params, sharing `previous`'s field (of the same seed) when only the
+  /// amplitude differs: a keyed amplitude does not synthesize the tile again every frame.
+  SpineNoise(const SpineNoiseParams& params, std::uint64_t seed, const SpineNoise& previous);
   /// v_K(x, t) (m/s) at world x (m) and time t (s); zero when the amplitude is 0.
   glm::dvec3 velocity(const glm::dvec3& x, double t) const;
   const SpineNoiseParams& params() const { return mParams; }
@@ -63,7 +66,7 @@ class SpineNoise {
 
  private:
   SpineNoiseParams mParams;
-  std::unique_ptr<KolmogorovNoise> mField;  ///< unit amplitude; null when off
+  std::shared_ptr<const KolmogorovNoise> mField;  ///< unit amplitude; null when off
 };
 
 }  // namespace plume

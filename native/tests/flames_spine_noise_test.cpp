@@ -137,5 +137,27 @@ TEST(FlameSpineNoise, SameSeedSameFlamesOnOneOrTwoThreads) {
   EXPECT_NE(one, run(2, 8));
 }
 
+TEST(FlameSpineNoise, KeyedSettingsRebuildTheFieldOfTheSameSeed) {
+  // setParams() with another amplitude scales the same field; other settings make a new field of
+  // the same seed, the field a system built with them from the start has.
+  FlameParams p;
+  FlameSystem s(p, 4);
+  const glm::dvec3 x(0.013, -0.021, 0.37);
+  const glm::dvec3 v = s.spineNoise().velocity(x, 0.3);
+  p.spineNoise.amplitude *= 2.0;
+  s.setParams(p);
+  EXPECT_EQ(s.spineNoise().velocity(x, 0.3), 2.0 * v);
+  p.spineNoise.scale = 0.1;
+  s.setParams(p);
+  EXPECT_EQ(s.spineNoise().velocity(x, 0.3), FlameSystem(p, 4).spineNoise().velocity(x, 0.3));
+  EXPECT_NE(s.spineNoise().velocity(x, 0.3), 2.0 * v);
+  p.spineNoise.amplitude = 0.0;
+  s.setParams(p);
+  EXPECT_EQ(s.spineNoise().velocity(x, 0.3), glm::dvec3(0.0));
+  p.spineNoise.scale = -1.0;  // refused, the old settings kept
+  EXPECT_THROW(s.setParams(p), std::invalid_argument);
+  EXPECT_EQ(s.params().spineNoise.scale, 0.1);
+}
+
 }  // namespace
 }  // namespace plume
