@@ -59,8 +59,8 @@ class FlameSmokeSettings:
     enabled: bool = False
     smoke_yield: float = 10.0  # the paper's "arbitrary scale factor": mass per second per unit E
     temperature: float = 0.0   # T − T_amb of the smoke; 0 = automatic (eq. 2)
-    #: §6.3 smoke point (m): flames shorter than this emit no smoke. The default, SMOKE_POINT.
-    smoke_point: float = 0.1
+    #: §6.3 smoke point (m): flames shorter than this emit no smoke.
+    smoke_point: float = SMOKE_POINT
     folder: str = ""           # absolute flames cache folder (scene.plume_flames.cache_directory)
     #: per frame of the bake: dict of EMITTER_ARRAYS (filled by load_frames)
     frames: List[dict] = field(default_factory=list)
