@@ -99,7 +99,7 @@ def smoke_temperature(settings, lifts, solver, domain_name):
 def frame_emitters(spines, settings, solver, domain_name):
     """The point emitters of one spines dict (flames.read_spines) as EMITTER_ARRAYS."""
     counts = np.asarray(spines["counts"], np.int64)
-    points = np.asarray(spines["points"], np.float64)
+    points = np.asarray(spines["points"], np.float64).reshape(-1, 3)
     ends = np.cumsum(counts)
     # E of each flame: the energy of its lights (eq. 5 × intensity, one per flame segment §5.2).
     energy = np.zeros(len(counts))
