@@ -9,7 +9,7 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
-from .ranges import RANGES
+from .ranges import RANGES, text
 from .settings import BakeError
 
 PROFILES = ('CANDLE', 'TORCH', 'CAMPFIRE', 'CUSTOM')
@@ -56,7 +56,17 @@ class FlameSettings:
     max_particles: int = 50000
     merging: bool = True               # §4.5
     flow_noise: float = 0.15           # §4.5 buoyancy noise (widest radii)
+    flow_noise_scale: float = 0.8      # λ, widest radii
+    flow_noise_frequency: float = 3.0  # ν, Hz
+    flow_noise_rotation: float = 0.5   # ω · 2r, rad·m/s
     kolmogorov: float = 0.003          # §4.5 Kolmogorov noise (m RMS)
+    kolmogorov_scale: float = 0.5      # Λ, m
+    kolmogorov_frequency: float = 0.5  # ν, Hz
+    kolmogorov_drift: Tuple[float, float, float] = (0.0, 0.0, 0.5)  # c, m/s
+    spine_noise: float = 0.04          # §4.2 Kolmogorov velocity on the spine (m/s RMS)
+    spine_noise_scale: float = 0.25    # Λ, m
+    spine_noise_frequency: float = 1.0  # ν, Hz
+    spine_noise_drift: Tuple[float, float, float] = (0.0, 0.0, 0.5)  # c, m/s
     voxel_size: float = 0.002
     temperature_scale: float = 1500.0  # K at d = I (temperature grid, blackbody colour)
     heat_of_combustion: float = 15.0   # H_c, MJ/kg (eq. 5)
@@ -185,8 +195,8 @@ def validate_settings(s: FlameSettings, frame):
            f"{at} Max Particles must be in [64, 10000000] (got {s.max_particles})")
     _check(_finite(s.voxel_size) and s.voxel_size > 0.0,
            f"{at} Voxel Size must be > 0 (got {s.voxel_size})")
-    _check(_finite(s.flow_noise, s.kolmogorov) and s.flow_noise >= 0.0 and s.kolmogorov >= 0.0,
-           f"{at} Flow Noise and Kolmogorov Noise must be >= 0")
+    for name, label, unit, open_low in NOISE_SETTINGS:
+        _check_noise(s, at, name, label, unit, open_low)
     _check(_finite(s.temperature_scale) and 500.0 <= s.temperature_scale <= 40000.0,
            f"{at} Temperature must be in [500, 40000] K (got {s.temperature_scale})")
     _check(_finite(s.light_unit) and s.light_unit > 0.0,
@@ -194,6 +204,34 @@ def validate_settings(s: FlameSettings, frame):
            f"(got {s.light_unit}; the calibrated default is {LIGHT_UNIT:g})")
     _check(_finite(s.opacity) and 0.0 <= s.opacity <= 1e4,
            f"{at} Opacity must be in [0, 10000] (got {s.opacity})")
+
+
+#: The noise settings (§4.2, §4.5): (FlameSettings field, panel name with the paper's symbol,
+#: unit, whether 0 is excluded); their bounds are the core's (ranges.RANGES["flames.<field>"]).
+NOISE_SETTINGS = (
+    ("flow_noise", "Flow Noise", " widest radii", False),
+    ("flow_noise_scale", "Flow Noise Scale (λ)", " widest radii", True),
+    ("flow_noise_frequency", "Flow Noise Frequency (ν)", " Hz", False),
+    ("flow_noise_rotation", "Flow Noise Rotation (ω·2r)", " rad·m/s", False),
+    ("kolmogorov", "Kolmogorov Noise", " m", False),
+    ("kolmogorov_scale", "Kolmogorov Scale (Λ)", " m", True),
+    ("kolmogorov_frequency", "Kolmogorov Frequency (ν)", " Hz", False),
+    ("kolmogorov_drift", "Kolmogorov Drift (c)", " m/s per axis", False),
+    ("spine_noise", "Spine Noise", " m/s", False),
+    ("spine_noise_scale", "Spine Noise Scale (Λ)", " m", True),
+    ("spine_noise_frequency", "Spine Noise Frequency (ν)", " Hz", False),
+    ("spine_noise_drift", "Spine Noise Drift (c)", " m/s per axis", False),
+)
+
+
+def _check_noise(s, at, name, label, unit, open_low):
+    """BakeError "<label> must be in [lo, hi]<unit> (got v)" (a vector: every component)."""
+    value = getattr(s, name)
+    values = tuple(value) if isinstance(value, (tuple, list)) else (value,)
+    lo, hi = RANGES[f"flames.{name}"]
+    ok = all(_finite(v) and (v > lo if open_low else v >= lo) and v <= hi for v in values)
+    _check(ok, f"{at} {label} must be in {text(f'flames.{name}', open_low)}{unit} "
+               f"(got {value if len(values) > 1 else values[0]})")
 
 
 def validate_source_values(src: FlameSourceInput):

@@ -10,6 +10,9 @@ Two passes: Bake Flames writes <flames cache>/spines_####.npz; a domain with Fla
 reads, for each frame it advances into, that frame's spines and gives the solver one point
 emitter (native/solver/point_emitters.h) per flame with energy E > 0:
 
+- which flames: those at least Smoke Point tall (§6.3: "the smoke point: the minimum laminar
+  flame height at which smoke first escapes from the flame tip"), h = |x_{n-1} − x_0| as below;
+  shorter ones burn clean and emit nothing;
 - position: the smoke point, tip + h t̂: the flame's axis from its first control point x_0 to its
   tip x_{n-1} continued by its own length, h = |x_{n-1} − x_0| along t̂ = (x_{n-1} − x_0) / h
   (the tip itself for a flame of no length). Not the spine's arc length and last segment: the control points
@@ -40,6 +43,11 @@ from . import flames
 from .settings import BakeError
 
 SETTING = "Flame Smoke"
+#: Default Smoke Point (m). Laminar smoke points of fuels run from ~2 cm (aromatics, kerosene)
+#: to ~16 cm (propane); 0.1 m sits above a candle (real ones 3-5 cm tall burn clean; the
+#: candle of the tests breaks by H_max = 0.08 m) and well below a campfire's tongues
+#: (0.3-1 m), which smoke.
+SMOKE_POINT = 0.1
 #: The arrays of one frame, the keyword arguments of SmokeSolver.set_point_emitters.
 EMITTER_ARRAYS = ("positions", "radii", "density_rates", "velocities", "temperatures")
 
@@ -51,13 +59,16 @@ class FlameSmokeSettings:
     enabled: bool = False
     smoke_yield: float = 10.0  # the paper's "arbitrary scale factor": mass per second per unit E
     temperature: float = 0.0   # T − T_amb of the smoke; 0 = automatic (eq. 2)
+    #: §6.3 smoke point (m): flames shorter than this emit no smoke.
+    smoke_point: float = SMOKE_POINT
     folder: str = ""           # absolute flames cache folder (scene.plume_flames.cache_directory)
     #: per frame of the bake: dict of EMITTER_ARRAYS (filled by load_frames)
     frames: List[dict] = field(default_factory=list)
 
     def fingerprint(self):
         """The result-relevant settings (manifest.json compares them on resume)."""
-        return {"smoke_yield": self.smoke_yield, "temperature": self.temperature}
+        return {"smoke_yield": self.smoke_yield, "temperature": self.temperature,
+                "smoke_point": self.smoke_point}
 
     def frame_bytes(self, index):
         """The emitters of frame index `index`, as bytes for the frame input hash."""
@@ -88,7 +99,7 @@ def smoke_temperature(settings, lifts, solver, domain_name):
 def frame_emitters(spines, settings, solver, domain_name):
     """The point emitters of one spines dict (flames.read_spines) as EMITTER_ARRAYS."""
     counts = np.asarray(spines["counts"], np.int64)
-    points = np.asarray(spines["points"], np.float64)
+    points = np.asarray(spines["points"], np.float64).reshape(-1, 3)
     ends = np.cumsum(counts)
     # E of each flame: the energy of its lights (eq. 5 × intensity, one per flame segment §5.2).
     energy = np.zeros(len(counts))
@@ -97,10 +108,14 @@ def frame_emitters(spines, settings, solver, domain_name):
         n = index.get(int(fid))
         if n is not None:
             energy[n] += float(e)
-    keep = [n for n in range(len(counts)) if counts[n] >= 2 and energy[n] > 0.0]
+    bases, tips = points[ends - counts], points[ends - 1]
+    heights = np.linalg.norm(tips - bases, axis=1)  # h = |x_{n-1} − x_0|
+    # §6.3: a flame shorter than the smoke point burns clean.
+    keep = [n for n in range(len(counts)) if counts[n] >= 2 and energy[n] > 0.0
+            and heights[n] >= settings.smoke_point]
     positions, velocities = np.zeros((len(keep), 3)), np.zeros((len(keep), 3))
     for row, n in enumerate(keep):
-        base, tip = points[ends[n] - counts[n]], points[ends[n] - 1]
+        base, tip = bases[n], tips[n]
         positions[row] = tip + (tip - base)  # h t̂ = x_{n-1} − x_0: h above the tip on its axis
         velocities[row] = spines["velocities"][ends[n] - 1]  # V_{p_{n-1}}
     arrays = {
@@ -127,6 +142,9 @@ def load_frames(settings: Optional[FlameSmokeSettings], frame_start, frame_end, 
     owner = _owner(domain_name)
     if not math.isfinite(settings.smoke_yield) or settings.smoke_yield < 0.0:
         raise BakeError(f"{owner}: Smoke Yield must be >= 0 (got {settings.smoke_yield})")
+    if not math.isfinite(settings.smoke_point) or settings.smoke_point < 0.0:
+        raise BakeError(f"{owner}: Smoke Point must be >= 0 m, the flame height above which "
+                        f"smoke escapes (§6.3) (got {settings.smoke_point:g})")
     if not math.isfinite(settings.temperature):
         raise BakeError(f"{owner}: Smoke Temperature must be a finite number "
                         f"(got {settings.temperature})")

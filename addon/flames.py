@@ -58,6 +58,10 @@ class FlameNative:
         p.breakaway_frequency = float(s.breakaway_frequency)
         p.buoyancy = float(s.buoyancy)
         p.diffusion = float(s.diffusion)
+        p.spine_noise_amplitude = float(s.spine_noise)  # §4.2 Kolmogorov velocity
+        p.spine_noise_scale = float(s.spine_noise_scale)
+        p.spine_noise_frequency = float(s.spine_noise_frequency)
+        p.spine_noise_drift = tuple(float(v) for v in s.spine_noise_drift)
         p.validate()
         return p
 
@@ -68,7 +72,12 @@ class FlameNative:
             profiles, images=images, seed=int(self.snap.seed),
             particles_per_pixel=float(s.particles_per_pixel), max_particles=int(s.max_particles),
             fixed_count=0 if has_camera else FIXED_PARTICLES,
-            flow_noise_amplitude=float(s.flow_noise), kolmogorov_amplitude=float(s.kolmogorov),
+            flow_noise_amplitude=float(s.flow_noise), flow_noise_scale=float(s.flow_noise_scale),
+            flow_noise_frequency=float(s.flow_noise_frequency),
+            flow_noise_rotation=float(s.flow_noise_rotation),
+            kolmogorov_amplitude=float(s.kolmogorov), kolmogorov_scale=float(s.kolmogorov_scale),
+            kolmogorov_frequency=float(s.kolmogorov_frequency),
+            kolmogorov_drift=tuple(float(v) for v in s.kolmogorov_drift),
             heat_of_combustion=float(s.heat_of_combustion) * 1e6, merging=bool(s.merging),
             temperature=float(s.temperature_scale))
 
@@ -91,8 +100,10 @@ class FlameNative:
 
 def shape_key(s: FlameSettings):
     """The settings the FlameShaper is built from: a change rebuilds it."""
-    return (s.particles_per_pixel, s.max_particles, s.merging, s.flow_noise, s.kolmogorov,
-            s.heat_of_combustion, s.temperature_scale)
+    return (s.particles_per_pixel, s.max_particles, s.merging, s.flow_noise, s.flow_noise_scale,
+            s.flow_noise_frequency, s.flow_noise_rotation, s.kolmogorov, s.kolmogorov_scale,
+            s.kolmogorov_frequency, tuple(s.kolmogorov_drift), s.heat_of_combustion,
+            s.temperature_scale)
 
 
 @dataclass

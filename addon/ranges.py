@@ -13,6 +13,12 @@ def _native_range(name):
     return int(lo), int(hi)
 
 
+def _native_float_range(name):
+    """(lo, hi) of a real-valued setting the core checks, as it defines it."""
+    lo, hi = _native.setting_ranges()[name]
+    return float(lo), float(hi)
+
+
 RANGES = {
     # a domain's grid bake (obj.plume.domain)
     "resolution": _native_range("resolution"),  # cells along the longest axis
@@ -27,6 +33,11 @@ RANGES = {
     "flames.points": _native_range("flames.points"),
     "flames.flames_per_source": (1, 1024),
     "flames.substeps": (1, 64),
+    # the noises of structural flames (§4.2 spine, §4.5 render particles), bounds of the core
+    **{f"flames.{name}": _native_float_range(f"flames.{name}") for name in (
+        "flow_noise", "flow_noise_scale", "flow_noise_frequency", "flow_noise_rotation",
+        "kolmogorov", "kolmogorov_scale", "kolmogorov_frequency", "kolmogorov_drift",
+        "spine_noise", "spine_noise_scale", "spine_noise_frequency", "spine_noise_drift")},
     # flow-graph fire synthesis (obj.plume.domain.flowgraph)
     "flowgraph.preview_points": (100, 1000000),
     "flowgraph.group_cache": (0, 65536),  # MB
@@ -38,7 +49,8 @@ def bounds(name):
     return RANGES[name]
 
 
-def text(name):
-    """"[lo, hi]" of a setting, as descriptions and error messages show it."""
-    lo, hi = RANGES[name]
-    return f"[{lo}, {hi}]"
+def text(name, open_low=False):
+    """"[lo, hi]" of a setting, as descriptions and error messages show it; "(lo, hi]" when lo
+    itself is excluded (a scale > 0)."""
+    lo, hi = (f"{v:g}" if isinstance(v, float) else str(v) for v in RANGES[name])
+    return f"{'(' if open_low else '['}{lo}, {hi}]"

@@ -1,9 +1,10 @@
 """Smoke from structural flames (structural_flames.txt §6.3), the artist's two passes
 through the operators: Bake Flames on a torch (5 flames, TORCH profile, 12 frames), then a 32³
 Plume domain with Flame Smoke on. The domain's VDBs hold smoke above the flame tips and none
-below the flames' base; the smoke mass doubles with Smoke Yield; a Cycles render shows it. Bad
-input (Flame Smoke on with no flames baked, or with the domain's frames beyond the flames' range)
-gives an error naming the setting and changes nothing.
+below the flames' base; the smoke mass doubles with Smoke Yield; a Cycles render shows it; flames
+shorter than the Smoke Point emit none. Bad input (Flame Smoke on with no flames baked, with the
+domain's frames beyond the flames' range, or a negative Smoke Point) gives an error naming the
+setting and changes nothing.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_flame_smoke.py
@@ -58,11 +59,14 @@ class FlameSmokeTest(unittest.TestCase):
     def tearDownClass(cls):
         rmtree(cls.tmp)
 
-    def bake_domain(self, name, smoke_yield):
+    def bake_domain(self, name, smoke_yield, smoke_point=0.0):
+        """Bakes the domain with Flame Smoke; Smoke Point 0 by default: every flame smokes,
+        even the few-mm flames of frame 1, which the checks of the smoke's place need."""
         d = self.domain.plume.domain
         d.cache_directory = os.path.join(self.tmp, name) + "/"
         d.flame_smoke = True
         d.flame_smoke_yield = smoke_yield
+        d.flame_smoke_point = smoke_point
         select_only(self.domain)
         t0 = time.perf_counter()
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
@@ -151,6 +155,53 @@ class FlameSmokeTest(unittest.TestCase):
         # As test_bake.py: half an 8-bit level on average and 1% of the pixels.
         self.assertGreater(float(diff.mean()), 0.002)
         self.assertGreater(changed, 0.01)
+
+    def flame_heights(self, frame):
+        """h = |x_{n-1} − x_0| of every flame of a frame (flame_smoke.py's flame height)."""
+        sp = self.spines[frame - 1]
+        ends = np.cumsum(sp["counts"]) - 1
+        return np.linalg.norm(sp["points"][ends] - sp["points"][ends - sp["counts"] + 1], axis=1)
+
+    def domain_totals(self, folder):
+        return [float(density_grid(os.path.join(folder, f"volume_{frame:04d}.vdb"))[0].sum())
+                for frame in range(1, FRAMES + 1)]
+
+    def test_smoke_point(self):
+        """§6.3: flames shorter than the Smoke Point emit no smoke into the domain; from the
+        first frame where a flame reaches it, smoke appears."""
+        tallest = [float(self.flame_heights(f).max()) for f in range(1, FRAMES + 1)]
+        print("  tallest flame per frame (m): " + " ".join(f"{h:.3f}" for h in tallest))
+        # Above every flame of the bake: a clean burn, nothing in the domain at any frame.
+        clean = self.domain_totals(self.bake_domain("clean", 10.0, 1.01 * max(tallest)))
+        print(f"  smoke point {1.01 * max(tallest):.3f} m: Σρ per frame {clean}")
+        self.assertEqual(clean, [0.0] * FRAMES)
+        # In between (the flames grow from a few mm at frame 1): halfway between the tallest
+        # flame so far and the first taller one from the middle frame on, away from both (the
+        # setting is single precision). Before that frame: no smoke; from it on: smoke.
+        first = next(f for f in range(FRAMES // 2, FRAMES + 1)
+                     if tallest[f - 1] > max(tallest[:f - 1]))
+        point = 0.5 * (max(tallest[:first - 1]) + tallest[first - 1])
+        totals = self.domain_totals(self.bake_domain("point", 10.0, point))
+        print(f"  smoke point {point:.3f} m: first flame that tall at frame {first}; Σρ per "
+              f"frame {[round(t, 4) for t in totals]}")
+        self.assertEqual(totals[:first - 1], [0.0] * (first - 1))
+        self.assertTrue(all(t > 0.0 for t in totals[first - 1:]))
+        # The default keeps a candle clean (its flames break by H_max = 0.08 m, below it) while
+        # these torch flames pass it.
+        default = type(self.domain.plume.domain).bl_rna.properties["flame_smoke_point"].default
+        self.assertGreater(default, 0.08)
+        self.assertLess(default, max(tallest))
+
+    def test_negative_smoke_point(self):
+        d = self.domain.plume.domain
+        d.cache_directory = os.path.join(self.tmp, "negative") + "/"
+        d.flame_smoke = True
+        d.flame_smoke_point = -0.01
+        try:
+            self.check_error(r"Flame Smoke: Smoke Point must be >= 0 m.*got -0\.01",
+                             os.path.join(self.tmp, "negative"))
+        finally:
+            d.flame_smoke_point = 0.0
 
     def check_error(self, pattern, folder):
         def state():

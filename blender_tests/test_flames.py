@@ -2,8 +2,10 @@
 (1 flame, CANDLE profile) and a torch (5 flames, TORCH profile) bake 12 frames with
 plume.flames_bake; the VDBs hold the named grids, the spines curve has one spline per live flame
 through that flame's points, the lights exist with energy > 0, and Cycles renders the flames
-non-empty. Bad input (no flame source, n < 2, H_p >= H_i, a Custom profile with no curve, a
-missing image file) gives an error naming the setting and changes nothing.
+non-empty. Bad input (no flame source, n < 2, H_p >= H_i, a noise setting out of range, a Custom
+profile with no curve, a missing image file) gives an error naming the setting and changes
+nothing. The noises' settings reach the bake: the spine's Kolmogorov noise moves the control
+points, the render noise the VDB.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_flames.py
@@ -321,6 +323,18 @@ class FlamesTest(unittest.TestCase):
         f.height_max = 0.01
         assert_reports_error(self, op, r"Max Height \(H_max.*Intermittent Height", state)
         f.height_max = 0.08
+        # The noises (§4.2, §4.5): named with the paper's symbol and the core's range.
+        f.spine_noise_scale = 0.0
+        assert_reports_error(self, op, r"Spine Noise Scale \(Λ\) must be in \(0, 10000\] m", state)
+        f.spine_noise_scale = 0.25
+        f.kolmogorov_drift = (0.0, 0.0, -5000.0)
+        assert_reports_error(self, op, r"Kolmogorov Drift \(c\) must be in \[-1000, 1000\] m/s",
+                             state)
+        f.kolmogorov_drift = (0.0, 0.0, 0.5)
+        f.flow_noise_frequency = -1.0
+        assert_reports_error(self, op, r"Flow Noise Frequency \(ν\) must be in \[0, 1000\] Hz",
+                             state)
+        f.flow_noise_frequency = 3.0
         src.plume.flame.profile = 'CUSTOM'
         assert_reports_error(self, op, r"'Candle'.*Profile Curve is empty", state)
         src.plume.flame.profile = 'CANDLE'
@@ -334,6 +348,43 @@ class FlamesTest(unittest.TestCase):
         src.plume.flame.color_source = 'PROFILE'
         src.plume.role = 'NONE'
         assert_reports_error(self, op, r"no Flame Source", state)
+
+    def test_noise_settings_reach_the_bake(self):
+        """§4.2: the spine's Kolmogorov noise moves the candle's control points (off, eq. 1
+        without it) and its scale Λ changes how; the same settings bake the same spines. §4.5:
+        the render particles' Kolmogorov scale changes the VDB, not the spines."""
+        from plume import flames as flames_mod
+        frame = 6
+
+        def bake(name, **settings):
+            folder = os.path.join(self.tmp, name)
+            flame_scene(folder)
+            f = bpy.context.scene.plume_flames
+            f.frame_end = frame
+            for key, value in settings.items():
+                setattr(f, key, value)
+            self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})
+            sp = flames_mod.read_spines(flames_mod.spines_path(folder, frame))
+            grid = native().read_vdb_grid(flames_mod.volume_path(folder, frame), "density")
+            # The attached flame: the first (one source), n points.
+            return sp["points"][:f.points], np.asarray(grid["values"])
+
+        on, density = bake("noise_on")
+        again, density_again = bake("noise_again")
+        off, _ = bake("noise_off", spine_noise=0.0)
+        scale, _ = bake("noise_scale", spine_noise_scale=0.05)
+        same_spines, other_density = bake("render_scale", kolmogorov_scale=0.05)
+        np.testing.assert_array_equal(on, again)
+        np.testing.assert_array_equal(density, density_again)
+        moved = float(np.abs(on - off).max())
+        print(f"  candle, frame {frame}: spine noise moves a control point by up to "
+              f"{moved * 1e3:.2f} mm; Λ = 0.05 m instead of 0.25 m by up to "
+              f"{float(np.abs(on - scale).max()) * 1e3:.2f} mm")
+        self.assertGreater(moved, 1e-4)
+        self.assertGreater(float(np.abs(on - scale).max()), 1e-4)
+        np.testing.assert_array_equal(on, same_spines)
+        self.assertFalse(density.shape == other_density.shape
+                         and np.array_equal(density, other_density))
 
 
 if __name__ == "__main__":

@@ -36,8 +36,11 @@ SOURCE_PROPS = ("density", "temperature", "fuel", "velocity", "motion_factor", "
 PANELS = ("PHYSICS_PT_plume", "PHYSICS_PT_plume_settings", "PHYSICS_PT_plume_forces",
           "PHYSICS_PT_plume_advection", "PHYSICS_PT_plume_pressure", "PHYSICS_PT_plume_boundaries",
           "PHYSICS_PT_plume_combustion", "PHYSICS_PT_plume_cache", "PHYSICS_PT_plume_source",
-          "PHYSICS_PT_plume_obstacle", "PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames")
-FLAME_PANELS = {"PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames"}
+          "PHYSICS_PT_plume_flame_smoke", "PHYSICS_PT_plume_obstacle",
+          "PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames",
+          "PHYSICS_PT_plume_flames_noise")
+FLAME_PANELS = {"PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames",
+                "PHYSICS_PT_plume_flames_noise"}
 OPERATORS = ("PLUME_OT_role_set", "PLUME_OT_bake", "PLUME_OT_cache_free", "PLUME_OT_flames_bake",
              "PLUME_OT_flames_free", "PLUME_OT_flames_bake_spines_keyframes")
 

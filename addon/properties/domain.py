@@ -6,6 +6,7 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from ..flame_smoke import SMOKE_POINT
 from ..ranges import RANGES, text
 from .flowgraph import PlumeFlowGraphSettings
 from .toon import PlumeToonSettings
@@ -143,6 +144,13 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         description="The paper's arbitrary scale factor: smoke mass (density × m³) per second "
                     "per unit of flame energy E (eq. 5); 10 gives a torch's flames (E ~ 1e-4) "
                     "smoke of density ~1 at the smoke points")
+    flame_smoke_point: FloatProperty(
+        name="Smoke Point", default=SMOKE_POINT, soft_min=0.0, soft_max=2.0, unit='LENGTH',
+        description="§6.3: the minimum laminar flame height at which smoke first escapes from "
+                    "the flame tip (m): flames shorter than this (|tip − base|) emit no smoke. "
+                    f"The default, {SMOKE_POINT:g} m, keeps candles clean and lets torches' and "
+                    "campfires' tall flames smoke (fuels' smoke points: ~0.02 m kerosene to "
+                    "~0.16 m propane); 0: every flame smokes; >= 0")
     flame_smoke_temperature: FloatProperty(
         name="Smoke Temperature", default=0.0, soft_min=0.0, soft_max=10.0,
         description="Temperature of the smoke above ambient; 0 = automatic: the temperature "

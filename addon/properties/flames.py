@@ -146,13 +146,65 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
     merging: BoolProperty(name="Merging", default=True,
                           description="§4.5: drop particles inside a neighbouring flame and "
                                       "outside their own (flames appear to merge)")
+    # --- Noise (§4.2 on the spine, §4.5 on the render particles) ---
     flow_noise: FloatProperty(name="Flow Noise", default=0.15, soft_min=0.0, soft_max=1.0,
                               description="§4.5: buoyancy (flow) noise amplitude, in widest "
-                                          "radii of the profile; 0 turns it off")
+                                          "radii of the profile; 0 turns it off; in "
+                                          + text('flames.flow_noise'))
+    flow_noise_scale: FloatProperty(
+        name="Flow Noise Scale (λ)", default=0.8, soft_min=0.05, soft_max=5.0,
+        description="λ: feature size of the flow noise across the flame, in widest radii of "
+                    "the profile (§4.5, Perlin & Neyret); in "
+                    + text('flames.flow_noise_scale', open_low=True))
+    flow_noise_frequency: FloatProperty(
+        name="Flow Noise Frequency (ν)", default=3.0, soft_min=0.0, soft_max=20.0,
+        description="ν: noise cells leaving the flame's base per second (Hz), rising with the "
+                    "spine's points (§4.5); in " + text('flames.flow_noise_frequency'))
+    flow_noise_rotation: FloatProperty(
+        name="Flow Noise Rotation (ω·2r)", default=0.5, soft_min=0.0, soft_max=5.0,
+        description="ω × source diameter 2r (rad·m/s): the flow noise's gradients turn at "
+                    "ω = this / 2r, faster on small sources (§4.5); in "
+                    + text('flames.flow_noise_rotation'))
     kolmogorov: FloatProperty(name="Kolmogorov Noise", default=0.003, soft_min=0.0,
                               soft_max=0.1, unit='LENGTH', precision=4,
-                              description="§4.5: RMS displacement of the Kolmogorov-spectrum "
-                                          "turbulence (m); 0 turns it off")
+                              description="§4.5: RMS displacement of the render particles by the "
+                                          "Kolmogorov-spectrum turbulence (m); 0 turns it off; "
+                                          "in " + text('flames.kolmogorov'))
+    kolmogorov_scale: FloatProperty(
+        name="Kolmogorov Scale (Λ)", default=0.5, soft_min=0.01, soft_max=10.0, unit='LENGTH',
+        description="Λ: the largest eddy of the render particles' Kolmogorov noise, the period "
+                    "of its E(k) ∝ k^(−5/3) tile (m, §4.5); in "
+                    + text('flames.kolmogorov_scale', open_low=True))
+    kolmogorov_frequency: FloatProperty(
+        name="Kolmogorov Frequency (ν)", default=0.5, soft_min=0.0, soft_max=10.0,
+        description="ν: how fast the render particles' Kolmogorov noise changes in place (Hz, "
+                    "§4.5: generated per frame); in " + text('flames.kolmogorov_frequency'))
+    kolmogorov_drift: FloatVectorProperty(
+        name="Kolmogorov Drift (c)", size=3, subtype='VELOCITY', unit='VELOCITY',
+        default=(0.0, 0.0, 0.5), soft_min=-5.0, soft_max=5.0,
+        description="c: velocity carrying the render particles' frozen Kolmogorov turbulence "
+                    "(m/s, §4.5); each axis in " + text('flames.kolmogorov_drift'))
+    spine_noise: FloatProperty(
+        name="Spine Noise", default=0.04, soft_min=0.0, soft_max=0.5, unit='VELOCITY',
+        precision=3,
+        description="§4.2, §7: RMS speed (m/s) of the Kolmogorov-spectrum velocity added to eq. "
+                    "1 for every control point of the spines (the torch's \"thermal buoyancy and "
+                    "Kolmogorov noise\"): the flames sway and curl; 0 turns it off; in "
+                    + text('flames.spine_noise'))
+    spine_noise_scale: FloatProperty(
+        name="Spine Noise Scale (Λ)", default=0.25, soft_min=0.01, soft_max=10.0, unit='LENGTH',
+        description="Λ: the largest eddy of the spine's Kolmogorov noise (m, §4.2); about a "
+                    "flame's length sways whole flames; in "
+                    + text('flames.spine_noise_scale', open_low=True))
+    spine_noise_frequency: FloatProperty(
+        name="Spine Noise Frequency (ν)", default=1.0, soft_min=0.0, soft_max=10.0,
+        description="ν: how fast the spine's Kolmogorov noise changes in place (Hz, §4.2); in "
+                    + text('flames.spine_noise_frequency'))
+    spine_noise_drift: FloatVectorProperty(
+        name="Spine Noise Drift (c)", size=3, subtype='VELOCITY', unit='VELOCITY',
+        default=(0.0, 0.0, 0.5), soft_min=-5.0, soft_max=5.0,
+        description="c: velocity carrying the spine's frozen Kolmogorov turbulence (m/s, "
+                    "§4.2), up with the hot gas; each axis in " + text('flames.spine_noise_drift'))
     # --- Wind (§4.2, §6, §6.1) ---
     wind: FloatVectorProperty(name="Wind", size=3, subtype='VELOCITY', unit='VELOCITY',
                               default=(0.0, 0.0, 0.0),

@@ -83,4 +83,5 @@ def flame_smoke_settings(domain, scene):
     from ..flame_smoke import FlameSmokeSettings
     return FlameSmokeSettings(enabled=True, smoke_yield=float(d.flame_smoke_yield),
                               temperature=float(d.flame_smoke_temperature),
+                              smoke_point=float(d.flame_smoke_point),
                               folder=flames_cache_folder(scene))

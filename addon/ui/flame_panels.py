@@ -65,7 +65,7 @@ def draw_flames(layout, scene):
                  "lifespan_scale", "breakaway_frequency", "buoyancy", "diffusion"):
         col.prop(f, name)
     col = layout.column(heading="Shape", align=True)
-    for name in ("particles_per_pixel", "max_particles", "merging", "flow_noise", "kolmogorov"):
+    for name in ("particles_per_pixel", "max_particles", "merging"):
         col.prop(f, name)
     col = layout.column(heading="Wind", align=True)
     for name in ("wind", "use_force_fields", "wind_domain", "use_obstacles"):
@@ -78,11 +78,42 @@ def draw_flames(layout, scene):
         layout.label(text=f.summary, icon='INFO')
 
 
+#: The "Noise" sub-panel: (heading, settings) per noise.
+NOISE_GROUPS = (
+    ("Spine (§4.2)", ("spine_noise", "spine_noise_scale", "spine_noise_frequency",
+                      "spine_noise_drift")),
+    ("Flow (§4.5)", ("flow_noise", "flow_noise_scale", "flow_noise_frequency",
+                     "flow_noise_rotation")),
+    ("Kolmogorov (§4.5)", ("kolmogorov", "kolmogorov_scale", "kolmogorov_frequency",
+                           "kolmogorov_drift")),
+)
+
+
+def draw_flame_noise(layout, scene):
+    """The three noises: Kolmogorov velocity on the spines' control points (§4.2), flow noise
+    and Kolmogorov displacement of the render particles (§4.5)."""
+    layout.use_property_split = True
+    f = scene.plume_flames
+    for heading, names in NOISE_GROUPS:
+        col = layout.column(heading=heading, align=True)
+        for name in names:
+            col.prop(f, name)
+
+
 class PHYSICS_PT_plume_flames(FlameSourcePanel, bpy.types.Panel):
     bl_label = "Flames"
 
     def draw(self, context):
         draw_flames(self.layout, context.scene)
+
+
+class PHYSICS_PT_plume_flames_noise(FlameSourcePanel, bpy.types.Panel):
+    bl_label = "Noise"
+    bl_parent_id = "PHYSICS_PT_plume_flames"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        draw_flame_noise(self.layout, context.scene)
 
 
 class SCENE_PT_plume_flames(bpy.types.Panel):
@@ -96,4 +127,17 @@ class SCENE_PT_plume_flames(bpy.types.Panel):
         draw_flames(self.layout, context.scene)
 
 
-classes = (PHYSICS_PT_plume_flame_source, PHYSICS_PT_plume_flames, SCENE_PT_plume_flames)
+class SCENE_PT_plume_flames_noise(bpy.types.Panel):
+    bl_label = "Noise"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "scene"
+    bl_parent_id = "SCENE_PT_plume_flames"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        draw_flame_noise(self.layout, context.scene)
+
+
+classes = (PHYSICS_PT_plume_flame_source, PHYSICS_PT_plume_flames,
+           PHYSICS_PT_plume_flames_noise, SCENE_PT_plume_flames, SCENE_PT_plume_flames_noise)

@@ -166,6 +166,7 @@ class PHYSICS_PT_plume_flame_smoke(PlumeDomainPanel, bpy.types.Panel):
         d = context.object.plume.domain
         layout.active = d.flame_smoke
         layout.prop(d, "flame_smoke_yield")
+        layout.prop(d, "flame_smoke_point")
         layout.prop(d, "flame_smoke_temperature")
 
 

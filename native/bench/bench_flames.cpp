@@ -31,9 +31,18 @@ void stepScene(benchmark::State& state, FlameSystem system, int warmup) {
 }
 
 void torchStep(benchmark::State& state) { stepScene(state, testing::torchFlames(1, 16), 48); }
+/// The torch without the spine's Kolmogorov noise (§4.2): the cost of v_K is the difference.
+void torchStepWithoutSpineNoise(benchmark::State& state) {
+  FlameSystem system = testing::torchFlames(1, 16);
+  FlameParams p = system.params();
+  p.spineNoise.amplitude = 0.0;
+  system.setParams(p);
+  stepScene(state, std::move(system), 48);
+}
 void dragonStep(benchmark::State& state) { stepScene(state, testing::dragonFlames(1, 16), 72); }
 
 BENCHMARK(torchStep)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+BENCHMARK(torchStepWithoutSpineNoise)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 BENCHMARK(dragonStep)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -60,6 +60,20 @@ void bindSettings(py::module_& m) {
           [](FlameParams& p, const py::object& g) { p.gravity = dvec3Arg(g, "gravity"); })
       .def_readwrite("integrator", &FlameParams::integrator)
       .def_readwrite("obstacle_margin", &FlameParams::obstacleMargin, "m kept outside obstacles")
+      .def_property(
+          "spine_noise_amplitude", [](const FlameParams& p) { return p.spineNoise.amplitude; },
+          [](FlameParams& p, double v) { p.spineNoise.amplitude = v; },
+          "RMS speed (m/s) of the Kolmogorov velocity v_K on the control points (eq. 1, §4.2); 0 = off")
+      .def_property(
+          "spine_noise_scale", [](const FlameParams& p) { return p.spineNoise.scale; },
+          [](FlameParams& p, double v) { p.spineNoise.scale = v; }, "Lambda (m): the largest eddy of v_K")
+      .def_property(
+          "spine_noise_frequency", [](const FlameParams& p) { return p.spineNoise.frequency; },
+          [](FlameParams& p, double v) { p.spineNoise.frequency = v; }, "nu (Hz): how fast v_K changes in place")
+      .def_property(
+          "spine_noise_drift", [](const FlameParams& p) { return vec3Tuple(p.spineNoise.drift); },
+          [](FlameParams& p, const py::object& v) { p.spineNoise.drift = dvec3Arg(v, "spine_noise_drift"); },
+          "c (m/s): the velocity carrying v_K's frozen turbulence")
       .def("validate", &FlameParams::validate, "Raises ValueError naming a bad setting and its range.")
       .def("frequency", &FlameParams::frequency, py::arg("radius"), "f (Hz) for a source of radius r (m)");
 
@@ -179,6 +193,14 @@ void bindSystem(py::module_& m) {
       .def("step", &FlameSystem::step, py::arg("dt"), py::call_guard<py::gil_scoped_release>(),
            "Advances the flames by dt seconds.")
       .def_property_readonly("time", &FlameSystem::time)
+      .def(
+          "spine_noise_velocity",
+          [](const FlameSystem& s, const py::object& x, double t) {
+            std::vector<glm::dvec3> p = dpointsArg(x, "points");
+            for (glm::dvec3& v : p) v = s.spineNoise().velocity(v, t);
+            return rowsArray(p);
+          },
+          py::arg("points"), py::arg("time") = 0.0, "v_K of eq. 1 (m/s) at (N, 3) points, as (N, 3).")
       .def(
           "flames",
           [](const FlameSystem& s) {

@@ -5,6 +5,9 @@
 #include "bindings/bindings.h"
 
 #include "flames/flame_params.h"
+#include "flames/flow_noise.h"
+#include "flames/kolmogorov_noise.h"
+#include "flames/spine_noise.h"
 #include "flowgraph/pathline_recorder.h"
 #include "solver/smoke_params.h"
 #include "tracers/point_sources.h"
@@ -30,11 +33,24 @@ PYBIND11_MODULE(_native, m) {
         d["point_sources"] = py::make_tuple(1, plume::kMaxPointsPerCell);
         d["pathline_nodes_per_frame"] = py::make_tuple(1, plume::kMaxNodesPerFrame);
         d["flames.points"] = py::make_tuple(plume::kMinSpinePoints, plume::kMaxSpinePoints);
+        // The noises (§4.2, §4.5): a scale is > 0 (lower bound excluded), a drift per component.
+        d["flames.flow_noise"] = py::make_tuple(0.0, plume::kMaxFlowNoiseAmplitude);
+        d["flames.flow_noise_scale"] = py::make_tuple(0.0, plume::kMaxFlowNoiseScale);
+        d["flames.flow_noise_frequency"] = py::make_tuple(0.0, plume::kMaxFlowNoiseFrequency);
+        d["flames.flow_noise_rotation"] = py::make_tuple(0.0, plume::kMaxFlowNoiseRotation);
+        d["flames.kolmogorov"] = py::make_tuple(0.0, plume::kMaxKolmogorovAmplitude);
+        d["flames.kolmogorov_scale"] = py::make_tuple(0.0, plume::kMaxKolmogorovScale);
+        d["flames.kolmogorov_frequency"] = py::make_tuple(0.0, plume::kMaxKolmogorovFrequency);
+        d["flames.kolmogorov_drift"] = py::make_tuple(-plume::kMaxKolmogorovDrift, plume::kMaxKolmogorovDrift);
+        d["flames.spine_noise"] = py::make_tuple(0.0, plume::kMaxSpineNoiseAmplitude);
+        d["flames.spine_noise_scale"] = py::make_tuple(0.0, plume::kMaxSpineNoiseScale);
+        d["flames.spine_noise_frequency"] = py::make_tuple(0.0, plume::kMaxSpineNoiseFrequency);
+        d["flames.spine_noise_drift"] = py::make_tuple(-plume::kMaxSpineNoiseDrift, plume::kMaxSpineNoiseDrift);
         return d;
       },
       "{setting: (lo, hi)}: the accepted range of every bounded setting the core checks "
       "(SmokeParams.ranges(), the streak tracer's emission_period, point sources per cell, "
-      "pathline nodes per frame, a flame spine's control points), the one definition the add-on's properties and messages read.");
+      "pathline nodes per frame, a flame spine's control points, the flames' noise settings), the one definition the add-on's properties and messages read.");
 
   py::enum_<plume::Advection>(m, "Advection",
                               "Advection scheme: semi-Lagrangian (Stam 1999), BFECC (Kim et al. "

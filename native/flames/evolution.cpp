@@ -14,9 +14,10 @@ glm::dvec3 buoyancyVelocity(const FlameParams& params, double temperature, doubl
 }
 
 glm::dvec3 driftVelocity(const FlameParams& params, const WindField* wind, const glm::dvec3& x, double t,
-                         double age, double temperature, const glm::dvec3& sourceTerm) {
+                         double age, double temperature, const glm::dvec3& sourceTerm, const SpineNoise* noise) {
   glm::dvec3 v = sourceTerm + buoyancyVelocity(params, temperature, age);
   if (wind) v += wind->evaluate(x, t);
+  if (noise && noise->enabled()) v += noise->velocity(x, t);
   return v;
 }
 
@@ -24,7 +25,7 @@ void evolvePoints(std::vector<SpinePoint>& points, const FlameParams& params, co
                   Rng& rng) {
   const double dt = in.dt, t = in.time;
   auto f = [&](const glm::dvec3& x, double time, double age) {
-    return driftVelocity(params, in.wind, x, time, age, in.temperature, in.sourceTerm);
+    return driftVelocity(params, in.wind, x, time, age, in.temperature, in.sourceTerm, in.noise);
   };
   const double sigma = in.temperature * std::sqrt(2.0 * params.diffusion * dt);
   for (SpinePoint& p : points) {

@@ -1,12 +1,15 @@
 #pragma once
 /// \file evolution.h
 /// Flame evolution (structural_flames.txt §4.2): each structural particle p moves by eq. 1,
-///   dx_p/dt = w(x_p, t) + d(T_p) + V_p + c(T_p, t),
-/// wind, Brownian diffusion scaled by temperature, source motion and buoyancy (eq. 2).
+///   dx_p/dt = w(x_p, t) + v_K(x_p, t) + d(T_p) + V_p + c(T_p, t),
+/// wind, the Kolmogorov noise field ("we add rotational components in the form of simulated wind
+/// fields and a noise field generated from a Kolmogorov spectrum", spine_noise.h), Brownian
+/// diffusion scaled by temperature, source motion and buoyancy (eq. 2).
 
 #include "core/rng.h"
 #include "flames/flame.h"
 #include "flames/flame_params.h"
+#include "flames/spine_noise.h"
 #include "flames/wind.h"
 
 #include <vector>
@@ -22,13 +25,16 @@ namespace plume {
 glm::dvec3 buoyancyVelocity(const FlameParams& params, double temperature, double age);
 
 /// The deterministic part of eq. 1 (no diffusion) at x, time t, particle age t_p:
-/// w(x, t) + V_p + c(T_p, t). `sourceTerm` is V_p (see EvolutionInput::sourceTerm).
+/// w(x, t) + v_K(x, t) + V_p + c(T_p, t). `sourceTerm` is V_p (see EvolutionInput::sourceTerm);
+/// `noise` is v_K (null: none).
 glm::dvec3 driftVelocity(const FlameParams& params, const WindField* wind, const glm::dvec3& x, double t,
-                         double age, double temperature, const glm::dvec3& sourceTerm);
+                         double age, double temperature, const glm::dvec3& sourceTerm,
+                         const SpineNoise* noise = nullptr);
 
 /// What a step of eq. 1 needs besides the points.
 struct EvolutionInput {
   const WindField* wind = nullptr;  ///< w (null: still air)
+  const SpineNoise* noise = nullptr;  ///< v_K, the Kolmogorov noise field (null: none)
   double time = 0.0;                ///< t at the start of the step (s)
   double dt = 0.0;                  ///< step (s), > 0
   double temperature = 1.0;         ///< T_p of the flame (normalized)

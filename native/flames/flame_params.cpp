@@ -53,6 +53,7 @@ void FlameParams::validate() const {
   requireFinite("gravity", gravity);
   requireIn("|gravity|", glm::length(gravity), 0.01, 1000.0, " m/s^2");
   requireIn("obstacle_margin", obstacleMargin, 0.0, 1.0, " m");
+  spineNoise.validate();
 }
 
 double FlameParams::frequency(double radius) const {

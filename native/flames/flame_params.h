@@ -4,6 +4,8 @@
 /// source (§4.2 moving sources, §6.2 spread maps: activation time, duration, intensity, diameter,
 /// height). Units: metres, seconds; Blender Z up.
 
+#include "flames/spine_noise.h"
+
 #include <glm/glm.hpp>
 
 #include <limits>
@@ -48,6 +50,8 @@ struct FlameParams {
   FlameIntegrator integrator = FlameIntegrator::Midpoint;
   /// Control points are kept at least this far outside obstacles (m, §6.1), in [0, 1].
   double obstacleMargin = 1e-3;
+  /// v_K of eq. 1: the Kolmogorov velocity on every control point (§4.2, §7 torch).
+  SpineNoiseParams spineNoise;
 
   /// Throws std::invalid_argument for a setting outside its range (message names it).
   void validate() const;

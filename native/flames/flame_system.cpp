@@ -15,6 +15,7 @@ namespace plume {
 
 FlameSystem::FlameSystem(const FlameParams& params, std::uint64_t seed) : mParams(params), mSeed(seed) {
   mParams.validate();
+  mSpineNoise = std::make_shared<SpineNoise>(mParams.spineNoise, mSeed);
 }
 
 int FlameSystem::addSource(const FlameSource& source) {
@@ -35,6 +36,8 @@ void FlameSystem::setSource(int index, const FlameSource& source) {
 
 void FlameSystem::setParams(const FlameParams& params) {
   params.validate();
+  if (params.spineNoise != mParams.spineNoise)
+    mSpineNoise = std::make_shared<SpineNoise>(params.spineNoise, mSeed, *mSpineNoise);
   mParams = params;
 }
 
@@ -103,6 +106,7 @@ void FlameSystem::processFlame(std::size_t index, double dt, FlameOutcome& out) 
 
   EvolutionInput in;
   in.wind = mWind.size() > 0 ? &mWind : nullptr;
+  in.noise = mSpineNoise.get();
   in.time = mTime;
   in.dt = dt;
   in.temperature = flame.temperature;
@@ -125,7 +129,7 @@ void FlameSystem::processFlame(std::size_t index, double dt, FlameOutcome& out) 
   if (attached) {
     SpinePoint base;
     base.x = source.position;
-    base.v = driftVelocity(mParams, in.wind, base.x, mTime + dt, 0.0, flame.temperature, in.sourceTerm);
+    base.v = driftVelocity(mParams, in.wind, base.x, mTime + dt, 0.0, flame.temperature, in.sourceTerm, in.noise);
     flame.points.insert(flame.points.begin(), base);
     for (SpinePoint& p : flame.points) p.v += carriedVelocity;  // world-frame dx/dt
   }

@@ -12,6 +12,7 @@
 #include "flames/flame.h"
 #include "flames/flame_params.h"
 #include "flames/obstacle_sdf.h"
+#include "flames/spine_noise.h"
 #include "flames/wind.h"
 
 #include <cstdint>
@@ -45,8 +46,11 @@ class FlameSystem {
   const std::vector<FlameSource>& sources() const { return mSources; }
 
   /// Replaces the settings (keyable); throws std::invalid_argument and keeps the old ones if bad.
+  /// A change of the spine noise's settings rebuilds its field (same seed).
   void setParams(const FlameParams& params);
   const FlameParams& params() const { return mParams; }
+  /// v_K of eq. 1 (§4.2): the Kolmogorov velocity field of this system's seed.
+  const SpineNoise& spineNoise() const { return *mSpineNoise; }
 
   /// w of eq. 1: the fields added here are summed.
   CompositeWind& wind() { return mWind; }
@@ -58,7 +62,7 @@ class FlameSystem {
   ///  1. sources: a source past its end time releases its flame as a separated one (lifespan A·i³);
   ///     a source active at t with no flame starts one with a single particle (§4.1, §6.2);
   ///  2. per flame, in parallel: attached flames follow their source's displacement; every point
-  ///     moves by eq. 1 (V_p = −V for attached flames); attached flames get a new particle at the
+  ///     moves by eq. 1 (V_p = −V for attached flames; v_K read from one shared field); attached flames get a new particle at the
   ///     source and are fitted and re-sampled to n points (first and last kept), separated ones to
   ///     their own count; the breakaway process may split off the top; points are pushed out of
   ///     obstacles (all but an attached flame's base, which is the source);
@@ -103,6 +107,7 @@ class FlameSystem {
   std::vector<Flame> mFlames;
   std::vector<FlameState> mStates;  // aligned with mFlames
   CompositeWind mWind;
+  std::shared_ptr<const SpineNoise> mSpineNoise;  // v_K, rebuilt when its settings change
   ObstacleSet mObstacles;
   FlameStatistics mStats;
 };

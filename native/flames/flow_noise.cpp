@@ -3,6 +3,8 @@
 
 #include "flames/flow_noise.h"
 
+#include "core/format.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -29,14 +31,19 @@ float fade(float t) { return t * t * t * (t * (t * 6.f - 15.f) + 10.f); }
 }  // namespace
 
 void FlowNoiseParams::validate() const {
-  if (!(amplitude >= 0.0 && amplitude <= 10.0))
-    throw std::invalid_argument("flow_noise_amplitude must be in [0, 10] widest radii (got " + std::to_string(amplitude) + ")");
-  if (!(scale > 0.0 && scale <= 100.0))
-    throw std::invalid_argument("flow_noise_scale must be in (0, 100] widest radii (got " + std::to_string(scale) + ")");
-  if (!(frequency >= 0.0 && frequency <= 1000.0))
-    throw std::invalid_argument("flow_noise_frequency must be in [0, 1000] Hz (got " + std::to_string(frequency) + ")");
-  if (!(rotation >= 0.0 && rotation <= 1000.0))
-    throw std::invalid_argument("flow_noise_rotation must be in [0, 1000] rad·m/s (got " + std::to_string(rotation) + ")");
+  auto bound = [](double v) { return formatNumber(v); };
+  if (!(amplitude >= 0.0 && amplitude <= kMaxFlowNoiseAmplitude))
+    throw std::invalid_argument("flow_noise_amplitude must be in [0, " + bound(kMaxFlowNoiseAmplitude) +
+                                "] widest radii (got " + bound(amplitude) + ")");
+  if (!(scale > 0.0 && scale <= kMaxFlowNoiseScale))
+    throw std::invalid_argument("flow_noise_scale (lambda) must be in (0, " + bound(kMaxFlowNoiseScale) +
+                                "] widest radii (got " + bound(scale) + ")");
+  if (!(frequency >= 0.0 && frequency <= kMaxFlowNoiseFrequency))
+    throw std::invalid_argument("flow_noise_frequency (nu) must be in [0, " + bound(kMaxFlowNoiseFrequency) +
+                                "] Hz (got " + bound(frequency) + ")");
+  if (!(rotation >= 0.0 && rotation <= kMaxFlowNoiseRotation))
+    throw std::invalid_argument("flow_noise_rotation must be in [0, " + bound(kMaxFlowNoiseRotation) +
+                                "] rad·m/s (got " + bound(rotation) + ")");
 }
 
 FlowNoise::FlowNoise(const FlowNoiseParams& params, std::uint64_t seed) : mParams(params), mSeed(seed) {

@@ -22,6 +22,13 @@
 
 namespace plume {
 
+/// Upper bounds of FlowNoiseParams (lower: 0, the scale excluded): validate() checks them and the
+/// add-on reads them (_native.setting_ranges()["flames.flow_noise*"]).
+constexpr double kMaxFlowNoiseAmplitude = 10.0;    ///< widest radii
+constexpr double kMaxFlowNoiseScale = 100.0;       ///< widest radii
+constexpr double kMaxFlowNoiseFrequency = 1000.0;  ///< Hz
+constexpr double kMaxFlowNoiseRotation = 1000.0;   ///< rad·m/s
+
 /// Settings of the buoyancy (flow) noise.
 struct FlowNoiseParams {
   double amplitude = 0.15;  ///< displacement, widest radii (0 turns it off)

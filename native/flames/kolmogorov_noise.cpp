@@ -3,6 +3,7 @@
 
 #include "flames/kolmogorov_noise.h"
 
+#include "core/format.h"
 #include "core/rng.h"
 
 #include <cmath>
@@ -54,14 +55,21 @@ void fft3d(std::vector<std::complex<double>>& data, int n, bool inverse) {
 }
 
 void KolmogorovParams::validate() const {
-  if (!(amplitude >= 0.0 && amplitude <= 100.0))
-    throw std::invalid_argument("kolmogorov_amplitude must be in [0, 100] m (got " + std::to_string(amplitude) + ")");
-  if (!(scale > 0.0 && scale <= 1e4))
-    throw std::invalid_argument("kolmogorov_scale must be in (0, 10000] m (got " + std::to_string(scale) + ")");
-  if (!std::isfinite(drift.x) || !std::isfinite(drift.y) || !std::isfinite(drift.z))
-    throw std::invalid_argument("kolmogorov_drift must be finite");
-  if (!(frequency >= 0.0 && frequency <= 1000.0))
-    throw std::invalid_argument("kolmogorov_frequency must be in [0, 1000] Hz (got " + std::to_string(frequency) + ")");
+  auto bound = [](double v) { return formatNumber(v); };
+  if (!(amplitude >= 0.0 && amplitude <= kMaxKolmogorovAmplitude))
+    throw std::invalid_argument("kolmogorov_amplitude must be in [0, " + bound(kMaxKolmogorovAmplitude) + "] m (got " +
+                                bound(amplitude) + ")");
+  if (!(scale > 0.0 && scale <= kMaxKolmogorovScale))
+    throw std::invalid_argument("kolmogorov_scale (Lambda) must be in (0, " + bound(kMaxKolmogorovScale) + "] m (got " +
+                                bound(scale) + ")");
+  for (int a = 0; a < 3; ++a)
+    if (!(std::abs(drift[a]) <= kMaxKolmogorovDrift))
+      throw std::invalid_argument(std::string("kolmogorov_drift (c) ") + "xyz"[a] + " must be in [-" +
+                                  bound(kMaxKolmogorovDrift) + ", " + bound(kMaxKolmogorovDrift) + "] m/s (got " +
+                                  bound(drift[a]) + ")");
+  if (!(frequency >= 0.0 && frequency <= kMaxKolmogorovFrequency))
+    throw std::invalid_argument("kolmogorov_frequency (nu) must be in [0, " + bound(kMaxKolmogorovFrequency) +
+                                "] Hz (got " + bound(frequency) + ")");
   if (resolution < 8 || resolution > 128 || (resolution & (resolution - 1)) != 0)
     throw std::invalid_argument("kolmogorov_resolution must be a power of two in [8, 128] (got " +
                                 std::to_string(resolution) + ")");

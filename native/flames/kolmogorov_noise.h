@@ -21,6 +21,13 @@
 
 namespace plume {
 
+/// Bounds of KolmogorovParams: validate() checks them and the add-on reads them
+/// (_native.setting_ranges()["flames.kolmogorov*"]).
+constexpr double kMaxKolmogorovAmplitude = 100.0;   ///< m
+constexpr double kMaxKolmogorovScale = 1.0e4;       ///< m, Λ in (0, this]
+constexpr double kMaxKolmogorovFrequency = 1000.0;  ///< Hz
+constexpr double kMaxKolmogorovDrift = 1000.0;      ///< m/s, each component of c in [−this, this]
+
 /// Settings of the Kolmogorov noise.
 struct KolmogorovParams {
   double amplitude = 0.01;  ///< RMS displacement, m (0 turns it off)

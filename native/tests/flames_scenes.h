@@ -12,7 +12,8 @@
 namespace plume::testing {
 
 /// Five sources on a torch head (radius 4 cm) moving at `speed` m/s along +x, n = `points`,
-/// buoyancy, diffusion and a little turbulence.
+/// buoyancy, diffusion, a little turbulence and (FlameParams' default) the Kolmogorov noise on
+/// the control points (§7: "influenced by thermal buoyancy and Kolmogorov noise").
 inline FlameSystem torchFlames(std::uint64_t seed, int points = 16, double speed = 1.5) {
   FlameParams p;
   p.points = points;

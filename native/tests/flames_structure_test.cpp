@@ -23,6 +23,7 @@ FlameParams quietParams() {
   p.diffusion = 0.0;
   p.heightIntermittent = 900.0;
   p.heightMax = 1000.0;
+  p.spineNoise.amplitude = 0.0;  // still air: no Kolmogorov noise either
   return p;
 }
 

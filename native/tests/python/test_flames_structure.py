@@ -144,3 +144,55 @@ def test_breakaway_statistics():
     assert st["breakaways"] > 2500
     assert st["breakaways"] / st["eligible_time"] == pytest.approx(5.0, rel=0.1)
     assert st["forced_breakaways"] == 0
+
+
+def test_noise_bounds_are_the_ones_setting_ranges_gives():
+    """The noises' ranges the add-on reads (setting_ranges) are the ones the core enforces: the
+    spine's Kolmogorov velocity through FlameParams, the render noises through FlameShaper. A
+    scale's lower bound (0) is excluded, a drift's bounds are per component."""
+    every = _native.setting_ranges()
+    profiles = [_native.FlameProfile.library("torch")]
+
+    def spine(name, value):
+        p = _native.FlameParams()
+        setattr(p, "spine_noise_amplitude" if name == "spine_noise" else name,
+                (0.0, 0.0, value) if name.endswith("drift") else value)
+        p.validate()
+
+    def shaper(name, value):
+        key = {"kolmogorov": "kolmogorov_amplitude", "flow_noise": "flow_noise_amplitude"}.get(
+            name, name)
+        _native.FlameShaper(profiles, **{key: (0.0, 0.0, value) if name.endswith("drift")
+                                         else value}, kolmogorov_resolution=8)
+
+    for name in ("spine_noise", "spine_noise_scale", "spine_noise_frequency",
+                 "spine_noise_drift", "flow_noise", "flow_noise_scale", "flow_noise_frequency",
+                 "flow_noise_rotation", "kolmogorov", "kolmogorov_scale",
+                 "kolmogorov_frequency", "kolmogorov_drift"):
+        lo, hi = every["flames." + name]
+        check = spine if name.startswith("spine") else shaper
+        check(name, hi)
+        with pytest.raises(ValueError, match=name.split("_")[0]):
+            check(name, hi * 1.001)
+        if name.endswith("scale"):
+            with pytest.raises(ValueError, match=r"\(0, "):
+                check(name, lo)
+        else:
+            check(name, lo)
+            with pytest.raises(ValueError):
+                check(name, lo - 1e-3 if lo == 0 else lo * 1.001)
+
+
+def test_spine_noise_moves_the_flames_and_is_seeded():
+    """§4.2: v_K has the RMS of its amplitude; off, the flames of eq. 1 without it."""
+    p = _native.FlameParams()
+    s = _native.FlameSystem(p, 3)
+    x = np.random.default_rng(0).uniform(-1.0, 1.0, (4000, 3))
+    v = s.spine_noise_velocity(x, 0.5)
+    rms = float(np.sqrt((v ** 2).sum(axis=1).mean()))
+    # Off the lattice, trilinear reading lowers the variance a little: within 25%.
+    assert 0.75 * p.spine_noise_amplitude < rms <= 1.05 * p.spine_noise_amplitude
+    np.testing.assert_array_equal(v, _native.FlameSystem(p, 3).spine_noise_velocity(x, 0.5))
+    assert not np.array_equal(v, _native.FlameSystem(p, 4).spine_noise_velocity(x, 0.5))
+    p.spine_noise_amplitude = 0.0
+    assert not _native.FlameSystem(p, 3).spine_noise_velocity(x, 0.5).any()
