@@ -17,7 +17,7 @@ MANIFEST_NAME = "flames_manifest.json"
 #: §6.1 obstacles: voxel size (m) of their signed distance and the band around them.
 OBSTACLE_VOXEL = 0.005
 OBSTACLE_PADDING = 0.05
-FORMAT_VERSION = 2  # 2: emission grid (eq. 6 power), density = §5.3 opacity
+FORMAT_VERSION = 1  # files/manifest.py checks it: the cache format shared by every pipeline
 #: k of eq. 5 (Blender watts per watt of E), calibrated once: the Candle defaults' flame (r = 5
 #: mm, its measured mean |v_c| and h) gives 1 cd = 4π lm = 4π/683 W in Blender's units (683 lm/W,
 #: the convention of Blender's glTF exporter). See README "Structural flames: light units".
