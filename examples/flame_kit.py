@@ -9,10 +9,12 @@ strip. Builds on scene_kit. Imported by the examples in examples/flames/::
 """
 
 import json
+import math
 import os
 import time
 
 import bpy
+import numpy as np
 
 import scene_kit
 
@@ -51,11 +53,14 @@ def wax(ob, color=(0.9, 0.82, 0.68), depth=0.01, name="Wax"):
     deep (warm), so the wax glows under its flame as real wax does instead of reading black."""
     mat = solid(ob, color, roughness=0.35, name=name)
     bsdf = mat.node_tree.nodes["Principled BSDF"]
-    weight = bsdf.inputs.get("Subsurface Weight") or bsdf.inputs["Subsurface"]  # 4.0+ / 3.x
-    weight.default_value = 1.0 if weight.name == "Subsurface Weight" else depth
-    bsdf.inputs["Subsurface Radius"].default_value = (1.0, 0.45, 0.2)
-    if "Subsurface Scale" in bsdf.inputs:
+    radius = (1.0, 0.45, 0.2)
+    if "Subsurface Weight" in bsdf.inputs:  # 4.0+: weight, radius x scale
+        bsdf.inputs["Subsurface Weight"].default_value = 1.0
         bsdf.inputs["Subsurface Scale"].default_value = depth
+    else:  # 3.x: the mix, and the radius in metres
+        bsdf.inputs["Subsurface"].default_value = 1.0
+        radius = tuple(depth * r for r in radius)
+    bsdf.inputs["Subsurface Radius"].default_value = radius
     if "Subsurface Color" in bsdf.inputs:  # 3.x: the colour scattered below the surface
         bsdf.inputs["Subsurface Color"].default_value = (*color, 1.0)
     return mat
@@ -104,14 +109,48 @@ def bake_flames(scene, tag):
     return per, flames, particles
 
 
+def _has_denoiser():
+    """Whether this Blender's Cycles has OpenImageDenoise (the bpy 4.5 / 5.x wheels do)."""
+    try:
+        import _cycles
+        return bool(getattr(_cycles, "with_openimagedenoise", False))
+    except ImportError:
+        return False
+
+
+#: The metering of the examples: the candle example's light (its flame and the short pieces of its
+#: tip: 0.025 W over flames 2.5 cm long on average) exposed +2 stops.
+#: Every flame's light is physical (Light Unit's default), and eq. 5 grows as r^7: a torch is
+#: ~10^4 candles, a dragon's breath ~10^10. A photographer exposes for the light falling on
+#: what the flames light, ~P / h² at a flame's length h from them; so do the examples.
+METER_IRRADIANCE, METER_EXPOSURE = 0.025 / 0.025 ** 2, 2.0
+
+
+def metered_exposure(scene, frames, offset=0.0):
+    """The exposure (stops) metering the flames' light over `frames`: P the mean total power
+    of the flame lights (E × Light Unit), h the mean flame length (3 × light radius), so that
+    P / h² reads as the candle's, plus `offset` stops of taste. Prints the light."""
+    folder = scene_kit.addon_module("snapshot").flames_cache_folder(scene)
+    unit = scene.plume_flames.light_unit
+    powers, lengths = [], []
+    for frame in frames:
+        d = np.load(os.path.join(folder, f"spines_{frame:04d}.npz"))
+        powers.append(float(np.sum(d["light_energy"])) * unit)
+        lengths.extend(3.0 * np.asarray(d["light_radii"], np.float64))
+    p, h = float(np.mean(powers)), float(np.mean(lengths)) if lengths else 1.0
+    stops = METER_EXPOSURE + math.log2(METER_IRRADIANCE / max(p / h ** 2, 1e-30)) + offset
+    print(f"light: {p:.4g} W ({p * 683 / (4 * math.pi):.4g} cd), flames {h * 100:.1f} cm long: "
+          f"exposure {stops:+.1f} stops", flush=True)
+    return stops
+
+
 def flame_look(scene, tag, out_dir, width=640, height=360, samples=64,
                world=(0.0015, 0.0015, 0.002), exposure=0.0):
     """Cycles on a near-black world (the flames and their lights light the scene), Filmic so
-    bright flame cores keep their colour, `exposure` stops as a photographer sets it for the
-    scene's light (the flames' light is physical: Light Unit's default), the denoiser where the
-    Blender has one (Debian's 3.4.1 has none)."""
+    bright flame cores keep their colour, `exposure` stops (flame_example meters it), the
+    denoiser where the Blender has one (Debian's 3.4.1 has none)."""
     scene_kit.cycles(scene, width, height, samples, os.path.join(out_dir, tag + "_"))
-    if getattr(bpy.app.build_options, "openimagedenoise", False):
+    if _has_denoiser():
         scene.cycles.use_denoising = True
         scene.cycles.denoiser = 'OPENIMAGEDENOISE'
     scene_kit.plain_world(scene, world)
@@ -123,10 +162,11 @@ def flame_look(scene, tag, out_dir, width=640, height=360, samples=64,
     scene.cycles.volume_step_rate = 2.0  # steps of two voxels through the soft flames
 
 
-def flame_example(tag, usage, default_frames, setup, show, **look):
+def flame_example(tag, usage, default_frames, setup, show, exposure_offset=0.0, **look):
     """A flames example from the command line: OUT_DIR [FRAMES]. setup(scene, frames) builds the
     scene (Flame Sources, settings, camera); `look`: keywords of flame_look. Then the .blend is
-    saved to OUT_DIR/TAG.blend, Bake Flames runs, the frames at fractions `show` of the shot are
+    saved to OUT_DIR/TAG.blend, Bake Flames runs, the exposure is metered on the flames' light
+    (metered_exposure, + exposure_offset), the frames at fractions `show` of the shot are
     rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are printed.
     Returns (scene, flames per frame)."""
     out_dir, frames = scene_kit.parse_args(usage, default_frames)
@@ -136,6 +176,8 @@ def flame_example(tag, usage, default_frames, setup, show, **look):
     scene.frame_start, scene.frame_end = 1, frames
     scene_kit.save_blend(out_dir, tag)
     bake_s, flames, particles = bake_flames(scene, tag)
+    scene.view_settings.exposure = metered_exposure(
+        scene, scene_kit.shown_frames(show, frames), exposure_offset)
     bpy.ops.wm.save_mainfile()
     t0 = time.perf_counter()
     seconds, paths = scene_kit.render_frames_timed(

@@ -30,9 +30,6 @@ USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py 
 DEFAULT_FRAMES = 32
 SHOW = (0.4, 0.6, 0.8, 1.0)
 LOG_RADIUS, LOG_LENGTH = 0.05, 0.55
-#: §5.2 light: eq. 5's E grows as r^7, a median 1e-2 for these r = 4 cm flames: 150 gives each
-#: flame about 2 W (the default 1e5, sized for 2 cm torch flames, burns the scene out to white).
-LIGHT_WATTS = 150.0
 #: (x, y, z, angle about Z in degrees) of each log: two crossed layers.
 LOGS = ((0.0, -0.09, LOG_RADIUS, 0.0), (0.0, 0.09, LOG_RADIUS, 0.0),
         (-0.09, 0.0, 3 * LOG_RADIUS, 90.0), (0.09, 0.0, 3 * LOG_RADIUS, 90.0))
@@ -64,14 +61,12 @@ def setup(scene, frames):
         scene, frames, points=14, height_persistent=0.2, height_intermittent=0.4,
         height_max=0.65, lifespan_scale=0.5, buoyancy=0.5, diffusion=5e-4, kolmogorov=0.01,
         voxel_size=0.008, particles_per_pixel=4.0,
-        max_particles=20000, emission=20.0, temperature_scale=1600.0,
-        light_watts=LIGHT_WATTS)
+        max_particles=20000, temperature_scale=1600.0)
     scene_kit.camera(scene, (0.0, -3.0, 1.0), lens=40.0, target=(0.05, 0.0, 0.55))
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, width=400, height=260,
-                            samples=32)
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":

@@ -51,14 +51,13 @@ def setup(scene, frames):
     flame_kit.flames_settings(
         scene, frames, points=12, height_persistent=0.024, height_intermittent=0.03,
         height_max=0.042, breakaway_frequency=0.7, lifespan_scale=1.0 / 24.0,
-        buoyancy=0.4, diffusion=2e-6, flow_noise=0.04, kolmogorov=0.0001, voxel_size=0.0005,
-        particles_per_pixel=10.0)
+        buoyancy=0.4, diffusion=2e-6, flow_noise=0.04, kolmogorov=0.0001, spine_noise=0.003,
+        voxel_size=0.0005, particles_per_pixel=10.0)
     scene_kit.camera(scene, (0.0, -0.34, 0.1), lens=50.0, target=(0.0, 0.0, 0.095))
 
 
 def main():
-    # A candle lights a room dimly (1 cd): exposed as a photograph of one is, +2 stops.
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64, exposure=2.0)
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":

@@ -34,8 +34,6 @@ USAGE = f"usage: blender -b --factory-startup --python examples/flames/{TAG}.py 
 DEFAULT_FRAMES = 60
 SHOW = (0.25, 0.5, 0.75, 1.0)
 MOUTH = (-1.2, 0.0, 1.0)
-#: §5.2 light: eq. 5's E grows as r^7 (median 3 for these r = 8 cm flames): ~2.5 W a flame.
-LIGHT_WATTS = 0.8
 
 
 def head():
@@ -61,14 +59,12 @@ def setup(scene, frames):
         scene, frames, points=12, height_persistent=0.15, height_intermittent=0.3,
         height_max=0.5, lifespan_scale=2.0, breakaway_frequency=20.0, buoyancy=0.08,
         wind=(2.5, 0.0, 0.0), merging=False, kolmogorov=0.02, particles_per_pixel=4.0,
-        max_particles=15000, voxel_size=0.012, emission=20.0, temperature_scale=1700.0,
-        light_watts=LIGHT_WATTS)
+        max_particles=15000, voxel_size=0.012, temperature_scale=1700.0)
     scene_kit.camera(scene, (0.7, -5.0, 1.3), lens=35.0, target=(0.7, 0.0, 1.2))
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, width=400, height=220,
-                            samples=32)
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":

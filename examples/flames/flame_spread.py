@@ -86,14 +86,12 @@ def setup(scene, frames):
     flame_kit.flames_settings(
         scene, frames, points=12, height_persistent=0.08, height_intermittent=0.15,
         height_max=0.25, lifespan_scale=0.25, buoyancy=0.5, kolmogorov=0.005,
-        voxel_size=0.005, emission=30.0, temperature_scale=1700.0, particles_per_pixel=6.0,
-        light_watts=300.0)  # §5.2: eq. 5's E is ~5e-4 for r = 2.5 cm: 0.15 W a flame
+        voxel_size=0.005, temperature_scale=1700.0, particles_per_pixel=6.0)
     scene_kit.camera(scene, (0.0, -2.3, 0.75), lens=35.0, target=(0.0, 0.0, 0.22))
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, width=400, height=220,
-                            samples=32)
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":

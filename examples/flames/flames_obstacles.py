@@ -69,9 +69,7 @@ def setup(scene, frames):
     flame_kit.floor(6.0)
     flame_kit.flames_settings(
         scene, frames, points=14, height_persistent=0.25, height_intermittent=0.4,
-        height_max=0.6, lifespan_scale=0.4, buoyancy=0.3, kolmogorov=0.006, voxel_size=0.005,
-        emission=25.0, temperature_scale=1700.0, wind_domain=dom, use_obstacles=True,
-        light_watts=1e3)  # §5.2: eq. 5's E is ~1e-3 for r = 3 cm: 1 W a flame
+        height_max=0.6, lifespan_scale=0.4, buoyancy=0.3, kolmogorov=0.006, voxel_size=0.005, temperature_scale=1700.0, wind_domain=dom, use_obstacles=True)
     scene_kit.camera(scene, (0.0, -2.2, 0.55), lens=40.0, target=(0.0, 0.0, 0.4))
     scene_kit.save_blend(os.path.dirname(scene.render.filepath), TAG)  # '//' caches
     scene_kit.select([dom], dom)
@@ -84,8 +82,7 @@ def setup(scene, frames):
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, width=320, height=240,
-                            samples=48)
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":

@@ -57,14 +57,12 @@ def setup(scene, frames):
     flame_kit.floor(6.0, color=(0.06, 0.05, 0.045))
     flame_kit.flames_settings(
         scene, frames, points=14, height_persistent=0.08, height_intermittent=0.16,
-        height_max=0.3, lifespan_scale=0.3, buoyancy=0.5, kolmogorov=0.006, voxel_size=0.004,
-        emission=30.0, temperature_scale=1700.0)
+        height_max=0.3, lifespan_scale=0.3, buoyancy=0.5, kolmogorov=0.006, voxel_size=0.004, temperature_scale=1700.0)
     scene_kit.camera(scene, (0.0, -2.2, 1.1), lens=40.0, target=(0.0, 0.0, 1.0))
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, width=400, height=220,
-                            samples=48)
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":
