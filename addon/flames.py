@@ -37,7 +37,7 @@ __all__ = ["SMOKE_ARRAYS", "SPINE_ARRAYS", "buoyancy_lift", "clear_folder", "rea
            "OBSTACLE_PADDING", "OBSTACLE_VOXEL", "POINTS_RANGE", "PROFILES", "SUBSTEPS_RANGE",
            "CameraInput", "FlameBakeSnapshot", "FlameSettings", "FlameSourceInput",
            "ObstacleInput", "WindInput", "spines_path", "validate_settings", "validate_snapshot",
-           "validate_source_values", "volume_path", "FlameNative", "shape_key", "FlameBakeResult",
+           "validate_source_values", "volume_path", "FlameNative", "add_carried_velocity", "shape_key", "FlameBakeResult",
            "FlameBakeRunner"]
 
 
@@ -87,6 +87,26 @@ def shape_key(s: FlameSettings):
     """The settings the FlameShaper is built from: a change rebuilds it."""
     return (s.particles_per_pixel, s.max_particles, s.merging, s.flow_noise, s.kolmogorov,
             s.heat_of_combustion)
+
+
+def add_carried_velocity(shaped, live, source_velocities):
+    """The motion-blur velocity of the flame particles (the VDB's `velocity` grid, §5.3). The
+    core gives each particle eq. 1's velocity of its spine, in the world frame: for a flame
+    attached to a source moving at V that is w + c (still air: buoyancy only), because the
+    V_p = -V of eq. 1 cancels the source carrying the flame frame along (§4.2). That is how the
+    gas moves, but an attached flame's shape is re-emitted at the source every step and moves
+    with it: a torch swung at 4 m/s moves its flames at 4 m/s, which the blur must show. So
+    particles of attached flames get their source's V added (nothing changes for still sources
+    or separated flames, which drift freely with eq. 1). In place; `live` is
+    FlameSystem.flames(), `source_velocities` V (m/s) per system source."""
+    v = np.asarray(shaped["velocities"])
+    if v.size == 0 or not np.any(source_velocities):
+        return
+    carried = np.zeros((len(live), 3), v.dtype)
+    for f, flame in enumerate(live):
+        if not flame["separated"]:
+            carried[f] = source_velocities[flame["source"]]
+    shaped["velocities"] = v + carried[np.asarray(shaped["flame"], np.intp)]
 
 
 @dataclass
@@ -244,11 +264,10 @@ class FlameBakeRunner:
             self._wind(system, i)
             for sub in range(snap.substeps):
                 alpha = (sub + 1) / snap.substeps
-                j = 0
-                for src in snap.sources:
-                    for k in range(src.count):
-                        system.set_source(j, self._source_at(src, k, i, alpha, dt_frame))
-                        j += 1
+                sources = [self._source_at(src, k, i, alpha, dt_frame)
+                           for src in snap.sources for k in range(src.count)]
+                for j, fs in enumerate(sources):
+                    system.set_source(j, fs)
                 system.step(dt)
             t1 = time.perf_counter()
             has_camera = snap.cameras[i] is not None
@@ -258,6 +277,7 @@ class FlameBakeRunner:
                 key = (shape_key(s), has_camera)
             live = system.flames()
             shaped = shaper.shape(live, system.time, self._camera(i))
+            add_carried_velocity(shaped, live, [fs.velocity for fs in sources])
             t2 = time.perf_counter()
             n.write_flames_vdb(volume_path(snap.folder, frame), shaped,
                                voxel_size=float(s.voxel_size),
