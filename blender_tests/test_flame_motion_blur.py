@@ -32,6 +32,8 @@ SPEED = 4.0
 FRAMES = 8
 #: The rendered frame; the torch passes x = 0 there, in front of the camera.
 RENDER_FRAME = FRAMES
+#: Frames of each flow-graph fire state (two short fire bakes at 16³).
+GRAPH_FRAMES = 40
 #: Render Properties > Motion Blur > Shutter (frames): a whole frame, SPEED / FPS of blur.
 SHUTTER = 1.0
 #: The front of the flames (m behind the torch) holding attached flames only.
@@ -164,7 +166,8 @@ class FlameMotionBlurTest(unittest.TestCase):
         vol = ob.data
         self.assertEqual(vol.velocity_unit, 'SECOND')
         self.assertEqual(vol.velocity_scale, 1.0)
-        self.assertEqual(vol.velocity_grid, "velocity" if has_grid else "")
+        if has_grid:  # (without one the name is Blender's default, cleared on each frame)
+            self.assertEqual(vol.velocity_grid, "velocity")
         bpy.context.scene.frame_set(frame)
         ev = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
         names = {g.name for g in ev.grids}
@@ -257,6 +260,44 @@ class FlameMotionBlurTest(unittest.TestCase):
         self.check_volume_settings(ob, FRAMES)
         self.check_solver_velocity(cache.volume_path(folder, FRAMES))
 
+
+    def test_flowgraph_fire(self):
+        """The synthesized fire's Volume has the settings, but its VDBs (write_fire_vdb of the
+        core: density, temperature, flame) hold no velocity grid: it renders unblurred, and
+        Blender leaves velocity_grid empty on its frames."""
+        from plume import flowgraph
+        reset_scene()
+        src = add_sphere_source(radius=0.3, location=(0.0, 0.0, 0.4), name="Burner")
+        src.plume.source.fuel, src.plume.source.density = 1.0, 0.0
+        doms = []
+        for name, wind in (("Calm", (0.0, 0.0, 0.0)), ("Windy", (1.0, 0.0, 0.0))):
+            dom = add_domain(resolution=16, frame_end=GRAPH_FRAMES,
+                             cache_directory=os.path.join(self.tmp, "graph") + "/", name=name)
+            d = dom.plume.domain
+            d.combustion = d.pathlines = True
+            d.pathline_nodes_per_frame, d.pathline_lifetime = 2, 0.5
+            d.wind, d.wind_strength = wind, 2.0 if any(wind) else 0.0
+            select_only(dom)
+            self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+            doms.append(dom)
+        bpy.ops.object.select_all(action='DESELECT')
+        for dom in doms:
+            dom.select_set(True)
+        bpy.context.view_layer.objects.active = doms[1]
+        g = doms[1].plume.domain.flowgraph
+        g.block_size = 8
+        self.assertEqual(bpy.ops.plume.flowgraph_build(), {'FINISHED'})
+        g.frame_start, g.frame_end = 1, FRAMES
+        select_only(doms[1])
+        self.assertEqual(bpy.ops.plume.fire_synthesize(), {'FINISHED'})
+        ob = bpy.data.objects[g.fire_object]
+        path = flowgraph.fire_path(os.path.join(self.tmp, "graph", "Windy"), FRAMES)
+        names = native().vdb_grid_names(path)
+        print(f"  {os.path.basename(path)} grids: {names}")
+        self.assertNotIn("velocity", names)
+        with self.assertRaises(RuntimeError):
+            native().read_vdb_grid(path, "velocity")
+        self.check_volume_settings(ob, FRAMES, has_grid=False)
 
 if __name__ == "__main__":
     run(FlameMotionBlurTest)
