@@ -8,7 +8,8 @@ Flame Sources (settings and validation in flame_settings, cache files in flame_f
 Every frame: the sources follow their objects (position, and velocity V from the motion between
 frames, §4.2), the wind is rebuilt (§4.2, §6, §6.1), the FlameSystem steps `substeps` times
 (§4.1-4.3), the FlameShaper samples the flames for the scene camera (§4.4-4.5, §5), and the
-particles are rasterized into a VDB (density, temperature, flame, color, velocity); the spines
+particles are rasterized into a VDB (density, temperature, flame, color, velocity: eq. 1 plus
+an attached flame's carriage by its source, for motion blur, add_carried_velocity); the spines
 and the lights (§5.2) go to an .npz. Files are written to a temporary name and renamed, so a
 cancelled or killed bake never leaves a half file.
 """
@@ -37,8 +38,8 @@ __all__ = ["SMOKE_ARRAYS", "SPINE_ARRAYS", "buoyancy_lift", "clear_folder", "rea
            "OBSTACLE_PADDING", "OBSTACLE_VOXEL", "POINTS_RANGE", "PROFILES", "SUBSTEPS_RANGE",
            "CameraInput", "FlameBakeSnapshot", "FlameSettings", "FlameSourceInput",
            "ObstacleInput", "WindInput", "spines_path", "validate_settings", "validate_snapshot",
-           "validate_source_values", "volume_path", "FlameNative", "add_carried_velocity", "shape_key", "FlameBakeResult",
-           "FlameBakeRunner"]
+           "validate_source_values", "volume_path", "FlameNative", "add_carried_velocity",
+           "shape_key", "FlameBakeResult", "FlameBakeRunner"]
 
 
 class FlameNative:
