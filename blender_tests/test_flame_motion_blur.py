@@ -1,7 +1,7 @@
 """Motion blur of every Plume Volume (structural_flames.txt §5.3: "the particles are then motion
 blurred using the instantaneous velocities given by Eq (1)"). Cycles blurs a Volume by its
-velocity grid when Render Properties > Motion Blur is on; Plume's Volumes name the grid
-"velocity", in m/s ('SECOND').
+velocity grid when Render Properties > Motion Blur is on; Plume's Volumes read it in m/s
+(velocity_unit 'SECOND', scale 1) and Blender names it ("velocity") from each frame it loads.
 
 test_torch: a fast torch (a Flame Source keyed along x) baked with plume.flames_bake; the VDB's
 velocity grid is read and compared with the flames' visible motion (density centroid between

@@ -118,22 +118,17 @@ def play_sequence(ob, path, frame_start, frames, mat):
         vol.materials[0] = mat
 
 
-#: The vec3 grid Plume's VDBs hold for motion blur (world space, m/s): the smoke solver's
-#: cell-centred velocity, the flames' particle velocity of eq. 1 (structural_flames.txt §5.3).
-VELOCITY_GRID = "velocity"
-
-
 def set_motion_blur(vol):
     """Cycles motion-blurs a Volume by its velocity grid when Render Properties > Motion Blur is
-    on (Blender 3.4.1, 4.5 and 5.0 alike). The grid is in m/s: velocity_unit 'SECOND' (the
-    default 'FRAME' would read it as metres per frame, a blur fps times too long), scale 1.
-    velocity_grid only accepts a grid of the loaded frame (else Blender clears it) and Blender
-    sets it again from the grids of every frame it loads ("velocity" found: kept, else cleared),
-    so it is set here from the current frame when that frame holds the grid."""
+    on; Blender 3.4.1, 4.5 and 5.0 have the same three settings. The grid is in m/s: unit
+    'SECOND' (the default 'FRAME' would read it as metres per frame, a blur fps times too long),
+    scale 1. The grid's name is not set here: Blender names it itself from every frame it loads
+    ("velocity" found: velocity_grid = "velocity", else ""), its setter refuses (and clears) a
+    name the loaded frame lacks, and loading a frame from here, before the datablock's frame is
+    evaluated, leaves Blender reading the wrong file afterwards. A new datablock already holds
+    "velocity"; the tests check the evaluated one on a baked frame."""
     vol.velocity_unit = 'SECOND'
     vol.velocity_scale = 1.0
-    if vol.grids.load() and any(g.name == VELOCITY_GRID for g in vol.grids):
-        vol.velocity_grid = VELOCITY_GRID
 
 
 def remove_volume(domain):
