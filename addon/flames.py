@@ -8,7 +8,8 @@ Flame Sources (settings and validation in flame_settings, cache files in flame_f
 Every frame: the sources follow their objects (position, and velocity V from the motion between
 frames, §4.2), the wind is rebuilt (§4.2, §6, §6.1), the FlameSystem steps `substeps` times
 (§4.1-4.3), the FlameShaper samples the flames for the scene camera (§4.4-4.5, §5), and the
-particles are rasterized into a VDB (density, temperature, flame, color, velocity); the spines
+particles are rasterized into a VDB (density, temperature, flame, color, velocity: eq. 1 plus
+an attached flame's carriage by its source, for motion blur, add_carried_velocity); the spines
 and the lights (§5.2) go to an .npz. Files are written to a temporary name and renamed, so a
 cancelled or killed bake never leaves a half file.
 """
@@ -38,8 +39,8 @@ __all__ = ["SMOKE_ARRAYS", "SPINE_ARRAYS", "buoyancy_lift", "clear_folder", "rea
            "OBSTACLE_PADDING", "OBSTACLE_VOXEL", "POINTS_RANGE", "PROFILES", "SUBSTEPS_RANGE",
            "CameraInput", "FlameBakeSnapshot", "FlameSettings", "FlameSourceInput",
            "ObstacleInput", "WindInput", "spines_path", "validate_settings", "validate_snapshot",
-           "validate_source_values", "volume_path", "FlameNative", "shape_key", "FlameBakeResult",
-           "FlameBakeRunner"]
+           "validate_source_values", "volume_path", "FlameNative", "add_carried_velocity",
+           "shape_key", "FlameBakeResult", "FlameBakeRunner"]
 
 
 class FlameNative:
@@ -104,6 +105,26 @@ def shape_key(s: FlameSettings):
             s.flow_noise_frequency, s.flow_noise_rotation, s.kolmogorov, s.kolmogorov_scale,
             s.kolmogorov_frequency, tuple(s.kolmogorov_drift), s.heat_of_combustion,
             s.temperature_scale)
+
+
+def add_carried_velocity(shaped, live, source_velocities):
+    """The motion-blur velocity of the flame particles (the VDB's `velocity` grid, §5.3). The
+    core gives each particle eq. 1's velocity of its spine, in the world frame: for a flame
+    attached to a source moving at V that is w + c (still air: buoyancy only), because the
+    V_p = -V of eq. 1 cancels the source carrying the flame frame along (§4.2). That is how the
+    gas moves, but an attached flame's shape is re-emitted at the source every step and moves
+    with it: a torch swung at 4 m/s moves its flames at 4 m/s, which the blur must show. So
+    particles of attached flames get their source's V added (nothing changes for still sources
+    or separated flames, which drift freely with eq. 1). In place; `live` is
+    FlameSystem.flames(), `source_velocities` V (m/s) per system source."""
+    v = np.asarray(shaped["velocities"])
+    if v.size == 0 or not np.any(source_velocities):
+        return
+    carried = np.zeros((len(live), 3), v.dtype)
+    for f, flame in enumerate(live):
+        if not flame["separated"]:
+            carried[f] = source_velocities[flame["source"]]
+    shaped["velocities"] = v + carried[np.asarray(shaped["flame"], np.intp)]
 
 
 @dataclass
@@ -259,11 +280,10 @@ class FlameBakeRunner:
             self._wind(system, i)
             for sub in range(snap.substeps):
                 alpha = (sub + 1) / snap.substeps
-                j = 0
-                for src in snap.sources:
-                    for k in range(src.count):
-                        system.set_source(j, self._source_at(src, k, i, alpha, dt_frame))
-                        j += 1
+                sources = [self._source_at(src, k, i, alpha, dt_frame)
+                           for src in snap.sources for k in range(src.count)]
+                for j, fs in enumerate(sources):
+                    system.set_source(j, fs)
                 system.step(dt)
             t1 = time.perf_counter()
             has_camera = snap.cameras[i] is not None
@@ -273,6 +293,7 @@ class FlameBakeRunner:
                 key = (shape_key(s), has_camera)
             live = system.flames()
             shaped = shaper.shape(live, system.time, self._camera(i))
+            add_carried_velocity(shaped, live, [fs.velocity for fs in sources])
             t2 = time.perf_counter()
             n.write_flames_vdb(volume_path(snap.folder, frame), shaped,
                                voxel_size=float(s.voxel_size),

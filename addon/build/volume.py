@@ -110,12 +110,25 @@ def play_sequence(ob, path, frame_start, frames, mat):
     vol.frame_duration = frames
     vol.frame_offset = 0
     vol.sequence_mode = 'CLIP'
-    vol.velocity_unit = 'SECOND'  # the "velocity" grid (default name) is in m/s
+    set_motion_blur(vol)
     ob.matrix_world.identity()  # the VDB voxels are in world space
     if not vol.materials:
         vol.materials.append(mat)
     elif vol.materials[0] is None or vol.materials[0].name in (SMOKE_MATERIAL, FIRE_MATERIAL):
         vol.materials[0] = mat
+
+
+def set_motion_blur(vol):
+    """Cycles motion-blurs a Volume by its velocity grid when Render Properties > Motion Blur is
+    on; Blender 3.4.1, 4.5 and 5.0 have the same three settings. The grid is in m/s: unit
+    'SECOND' (the default 'FRAME' would read it as metres per frame, a blur fps times too long),
+    scale 1. The grid's name is not set here: Blender names it itself from every frame it loads
+    ("velocity" found: velocity_grid = "velocity", else ""), its setter refuses (and clears) a
+    name the loaded frame lacks, and loading a frame from here, before the datablock's frame is
+    evaluated, leaves Blender reading the wrong file afterwards. A new datablock already holds
+    "velocity"; the tests check the evaluated one on a baked frame."""
+    vol.velocity_unit = 'SECOND'
+    vol.velocity_scale = 1.0
 
 
 def remove_volume(domain):
