@@ -148,25 +148,27 @@ void bindSynthesizer(py::module_& m) {
           d["positions"] = rowsArray(p.positions);
           d["density"] = array1D(p.density);
           d["temperature"] = array1D(p.temperature);
+          d["velocity"] = rowsArray(p.velocity);
           return d;
         },
-        "dict(positions (N, 3), density (N,), temperature (N,)) float32 copies, oldest group first.");
+        "dict(positions (N, 3), density (N,), temperature (N,), velocity (N, 3)) float32 copies, oldest "
+        "group first.");
   s.def(
       "write_vdb",
       [](const Synthesizer& syn, const py::object& path, const FireRasterParams& params, int frame) {
         return rasterStats(withPath(path, [&](const std::string& p) {
           SynthParticles parts;
           syn.gather(parts);
-          const FireGrids grids = rasterizeFire(
-              {parts.positions.data(), parts.density.data(), parts.temperature.data(), parts.size()},
-              params);
+          const FireGrids grids = rasterizeFire({parts.positions.data(), parts.density.data(),
+                                                 parts.temperature.data(), parts.size(), parts.velocity.data()},
+                                                params);
           writeFireVdb(p, grids, frame);
           return grids;
         }));
       },
       py::arg("path"), py::arg("params"), py::arg("frame"),
-      "Rasterizes the live particles (write_fire_vdb) and writes them atomically; returns "
-      "dict(voxels=...).");
+      "Rasterizes the live particles (write_fire_vdb, with their velocity grid) and writes them "
+      "atomically; returns dict(voxels=...).");
 }
 
 void bindRaster(py::module_& m) {

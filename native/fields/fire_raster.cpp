@@ -9,6 +9,7 @@
 
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointDataGrid.h>
+#include <openvdb/points/PointRasterizeTrilinear.h>
 #include <openvdb/points/PointTransfer.h>
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/PointIndexGrid.h>
@@ -41,6 +42,16 @@ struct PositionArray {
   void getPos(std::size_t n, openvdb::Vec3R& xyz) const {
     xyz = openvdb::Vec3R(data[n].x, data[n].y, data[n].z);
   }
+};
+
+/// One vector per point, for populateAttribute().
+struct Vec3Array {
+  using value_type = openvdb::Vec3f;
+  const glm::vec3* data;
+  std::size_t count;
+  std::size_t size() const { return count; }
+  void get(openvdb::Vec3f& value, std::size_t n) const { value = openvdb::Vec3f(data[n].x, data[n].y, data[n].z); }
+  void get(openvdb::Vec3f& value, std::size_t n, Index) const { get(value, n); }
 };
 
 /// One float per point, for populateAttribute().
@@ -162,19 +173,23 @@ FireGrids rasterizeFire(const FireParticleView& in, const FireRasterParams& para
   const auto xform = cellCenteredTransform(h, params.origin);
   // Non-finite particles (a broken input) are left out; in the common case nothing is copied.
   FireParticleView view = in;
-  std::vector<glm::vec3> keptX;
+  std::vector<glm::vec3> keptX, keptU;
   std::vector<float> keptR, keptT;
+  auto usable = [&](std::size_t n) {
+    return finite(in.positions[n]) && std::isfinite(in.density[n]) && std::isfinite(in.temperature[n]) &&
+           (!in.velocities || finite(in.velocities[n]));
+  };
   bool allFinite = true;
-  for (std::size_t n = 0; n < in.count && allFinite; ++n)
-    allFinite = finite(in.positions[n]) && std::isfinite(in.density[n]) && std::isfinite(in.temperature[n]);
+  for (std::size_t n = 0; n < in.count && allFinite; ++n) allFinite = usable(n);
   if (!allFinite) {
     for (std::size_t n = 0; n < in.count; ++n)
-      if (finite(in.positions[n]) && std::isfinite(in.density[n]) && std::isfinite(in.temperature[n])) {
+      if (usable(n)) {
         keptX.push_back(in.positions[n]);
         keptR.push_back(in.density[n]);
         keptT.push_back(in.temperature[n]);
+        if (in.velocities) keptU.push_back(in.velocities[n]);
       }
-    view = {keptX.data(), keptR.data(), keptT.data(), keptX.size()};
+    view = {keptX.data(), keptR.data(), keptT.data(), keptX.size(), in.velocities ? keptU.data() : nullptr};
   }
 
   FireGrids out;
@@ -182,6 +197,7 @@ FireGrids rasterizeFire(const FireParticleView& in, const FireRasterParams& para
   auto density = std::make_shared<FloatTree>(0.f);
   auto temperature = std::make_shared<FloatTree>(ambient);
   auto flame = std::make_shared<FloatTree>(0.f);
+  openvdb::Vec3STree::Ptr velocity;
   if (view.count > 0) {
     namespace pts = openvdb::points;
     const PositionArray positions{view.positions, view.count};
@@ -238,10 +254,21 @@ FireGrids rasterizeFire(const FireParticleView& in, const FireRasterParams& para
     openvdb::tools::pruneInactive(*density);
     openvdb::tools::pruneInactive(*temperature);
     openvdb::tools::pruneInactive(*flame);
+    if (view.velocities) {
+      pts::appendAttribute<openvdb::Vec3f>(tree, "velocity");
+      pts::populateAttribute(tree, index->tree(), "velocity", Vec3Array{view.velocities, view.count});
+      velocity = pts::rasterizeTrilinear</*Staggered=*/false, openvdb::Vec3f>(tree, "velocity");
+    }
   }
   out.density = fogGrid(density, "density", xform);
   out.temperature = fogGrid(temperature, "temperature", xform);
   out.flame = fogGrid(flame, "flame", xform);
+  if (in.velocities) {
+    out.velocity = velocity ? openvdb::Vec3SGrid::create(velocity) : openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+    out.velocity->setName("velocity");
+    out.velocity->setTransform(xform);
+    out.velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  }
   return out;
 }
 
@@ -249,6 +276,7 @@ void writeFireVdb(const std::string& path, const FireGrids& grids, int frame) {
   if (!grids.density || !grids.temperature || !grids.flame)
     throw std::invalid_argument("fire VDB '" + path + "': missing grids");
   openvdb::GridPtrVec list{grids.density, grids.temperature, grids.flame};
+  if (grids.velocity) list.push_back(grids.velocity);
   openvdb::MetaMap meta;
   meta.insertMeta("creator", openvdb::StringMetadata("plume"));
   meta.insertMeta("frame", openvdb::Int32Metadata(frame));

@@ -20,6 +20,8 @@
 ///               itself divides by Σ w, which suits temperature but would not conserve density)
 ///   flame       f_v = clamp((T_v - T_ignition) / (T_max - T_ignition), 0, 1)
 ///               (temperature above the ignition threshold mapped to [0, 1])
+///   velocity    (when the particles have velocities) their mean around the voxel, m/s, by
+///               points::rasterizeTrilinear: Cycles' volume motion blur
 /// Voxel (i,j,k) is centred at origin + (i + 1/2, j + 1/2, k + 1/2) Δx, as in the bake's frames.
 /// Deterministic: every voxel sums its particles in the same order at any thread count.
 
@@ -53,11 +55,13 @@ struct FireParticleView {
   const float* density = nullptr;
   const float* temperature = nullptr;
   std::size_t count = 0;
+  const glm::vec3* velocities = nullptr;  ///< m/s, optional: the `velocity` grid
 };
 
 /// The three grids of one synthesized frame (fog volumes; background 0, T_amb for temperature).
 struct FireGrids {
   openvdb::FloatGrid::Ptr density, temperature, flame;
+  openvdb::Vec3SGrid::Ptr velocity;  ///< null when the particles have no velocities
 };
 
 /// Rasterizes the particles (see the file comment). Non-finite particles are skipped.

@@ -13,11 +13,12 @@ constexpr int kChunk = 512;
 }  // namespace
 
 std::size_t preparedGroupBytes(const PathlineLayout& layout) {
-  return layout.values() * (sizeof(glm::vec3) + 2 * sizeof(float));
+  return layout.values() * (2 * sizeof(glm::vec3) + 2 * sizeof(float));
 }
 
 std::size_t PreparedGroup::bytes() const {
-  return path.capacity() * sizeof(glm::vec3) + (density.capacity() + temperature.capacity()) * sizeof(float);
+  return (path.capacity() + velocity.capacity()) * sizeof(glm::vec3) +
+         (density.capacity() + temperature.capacity()) * sizeof(float);
 }
 
 void prepareGroup(const PathlineGroup& g, PreparedGroup& out) {
@@ -31,6 +32,7 @@ void prepareGroup(const PathlineGroup& g, PreparedGroup& out) {
   out.path.resize(values);  // no allocation when a buffer of this layout is reused
   out.density.resize(values);
   out.temperature.resize(values);
+  out.velocity.resize(values);
   const int chunks = (P + kChunk - 1) / kChunk;
   parallelFor(0, chunks, [&](int c) {
     const int begin = c * kChunk, end = std::min(P, begin + kChunk);
@@ -44,6 +46,7 @@ void prepareGroup(const PathlineGroup& g, PreparedGroup& out) {
         out.path[at] = x;
         out.density[at] = g.density[row + std::size_t(a)];
         out.temperature[at] = g.temperature[row + std::size_t(a)];
+        out.velocity[at] = u[a];
         // Eq. 13, pathline part, by the trapezoid rule between samples a and a + 1.
         if (a + 1 < L) x += half * (u[a] + u[a + 1]);
       }

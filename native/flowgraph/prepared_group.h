@@ -24,6 +24,7 @@ struct PreparedGroup {
   PathlineLayout layout;
   std::vector<glm::vec3> path;              ///< [age][particle]: x_0 + Σ trapezoids up to age
   std::vector<float> density, temperature;  ///< [age][particle]: the samples of that age
+  std::vector<glm::vec3> velocity;          ///< [age][particle]: u sample of that age (motion blur)
   /// Heap bytes held (what a cache of prepared groups budgets).
   std::size_t bytes() const;
 };
@@ -35,7 +36,7 @@ struct PreparedGroup {
 /// arrays must match its layout (the caller checks).
 void prepareGroup(const PathlineGroup& group, PreparedGroup& out);
 
-/// Bytes a prepared group of `layout` holds: |Ω| L (12 + 4 + 4).
+/// Bytes a prepared group of `layout` holds: |Ω| L (12 + 4 + 4 + 12).
 std::size_t preparedGroupBytes(const PathlineLayout& layout);
 
 }  // namespace plume

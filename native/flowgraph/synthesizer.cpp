@@ -124,6 +124,7 @@ void Synthesizer::advance(glm::vec3 uniform, const ExternalVelocity* field) {
   // emission below reuses their slot). The others age by one.
   const long long end = mSteps;
   const long long moving = std::max(first, end - (L - 1));
+  mExternal = field ? glm::vec3(0.f) : uniform;
   if (!field) {
     // A uniform u_ext moves every particle of a group alike: one vector per group.
     for (long long e = moving; e < end; ++e) slotOf(e).uniformOffset += h * uniform;
@@ -177,6 +178,7 @@ void Synthesizer::gather(SynthParticles& out) const {
   out.positions.resize(count);
   out.density.resize(count);
   out.temperature.resize(count);
+  out.velocity.resize(count);
   const long long first = firstLiveStep();
   const int chunks = (P + kChunk - 1) / kChunk;
   parallelFor(0, groups * chunks, [&](int task) {
@@ -192,6 +194,7 @@ void Synthesizer::gather(SynthParticles& out) const {
       out.positions[at + std::size_t(p)] = x;
       out.density[at + std::size_t(p)] = g.density[in + std::size_t(p)];
       out.temperature[at + std::size_t(p)] = g.temperature[in + std::size_t(p)];
+      out.velocity[at + std::size_t(p)] = g.velocity[in + std::size_t(p)] + mExternal;
     }
   });
 }

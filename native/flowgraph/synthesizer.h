@@ -48,6 +48,8 @@ struct SynthParticles {
   std::vector<glm::vec3> positions;
   std::vector<float> density;
   std::vector<float> temperature;
+  /// u of their pathline at their age plus the last step's uniform u_ext (m/s): motion blur.
+  std::vector<glm::vec3> velocity;
   std::size_t size() const { return positions.size(); }
 };
 
@@ -125,6 +127,7 @@ class Synthesizer {
   int mThreads;
   std::vector<Slot> mSlots;  ///< ring of L: the group emitted at step n lives in slot n mod L
   long long mSteps = 0;
+  glm::vec3 mExternal{0.f};  ///< the last step's uniform u_ext (a field's is not added)
   std::shared_ptr<PreparedGroupCache> mCache;
   PathlineGroup mRead;                   ///< buffers of stepNode()'s file reads
   std::shared_ptr<PreparedGroup> mSpare;  ///< a prepared group no slot or cache references

@@ -116,5 +116,29 @@ TEST(FireRaster, DeterministicAndWrittenAsAFrameVdb) {
   EXPECT_FALSE(fs::exists(path + ".tmp"));
 }
 
+TEST(FireRaster, VelocityGridIsTheParticlesMeanVelocityAndOnlyWhenGiven) {
+  Cloud c = randomCloud(4000);
+  FireRasterParams params;
+  params.voxelSize = 0.05f;
+  EXPECT_FALSE(rasterizeFire(c.view(), params).velocity);  // no velocities, no grid
+  // u = (1, 0, 2) + 3 x: a smooth field; the voxel mean of its particles stays within the
+  // kernel's reach (one voxel, Δx = 0.05: 3 Δx = 0.15) of u at the voxel centre.
+  std::vector<glm::vec3> u;
+  for (const glm::vec3& x : c.x) u.emplace_back(1.f + 3.f * x.x, 0.f, 2.f);
+  FireParticleView view = c.view();
+  view.velocities = u.data();
+  const FireGrids g = rasterizeFire(view, params);
+  ASSERT_TRUE(g.velocity);
+  EXPECT_EQ(g.velocity->getName(), "velocity");
+  int voxels = 0;
+  for (auto it = g.velocity->cbeginValueOn(); it; ++it, ++voxels) {
+    const openvdb::Vec3d centre = g.velocity->indexToWorld(it.getCoord());
+    if (g.density->tree().getValue(it.getCoord()) <= 0.f) continue;
+    EXPECT_NEAR((*it)[0], 1.0 + 3.0 * centre.x(), 0.16);
+    EXPECT_NEAR((*it)[2], 2.0, 1e-5);
+  }
+  EXPECT_GT(voxels, 100);
+}
+
 }  // namespace
 }  // namespace plume
