@@ -108,7 +108,7 @@ def test_step_node_cache_only_saves_reads(tmp_path):
     path, _, _ = recorded_bake(tmp_path)
     f = _native.PathlineFile.open(path)
     walk = [0, 1, 2, 3, 1, 2, 3, 4, 5, 2, 2, 6]  # revisits, one within a lifetime of L steps
-    group_bytes = f.layout.particles * f.layout.samples * 20  # path 12 B + density + temperature
+    group_bytes = f.layout.particles * f.layout.samples * 32  # path, velocity 12 B, density, temperature
     cached = _native.Synthesizer(f.layout, cache_bytes=3 * group_bytes)
     copies = _native.Synthesizer(f.layout)
     for n, k in enumerate(walk):
@@ -158,7 +158,7 @@ def test_rasterized_frame_vdb(tmp_path):
     out = tmp_path / "fire_0001.vdb"
     stats = synth.write_vdb(out, params, 1)
     assert stats["voxels"] > 0
-    assert sorted(_native.vdb_grid_names(str(out))) == ["density", "flame", "temperature"]
+    assert sorted(_native.vdb_grid_names(str(out))) == ["density", "flame", "temperature", "velocity"]
     p = synth.particles()
     # Mass: Σ ρ Δx³ = Σ R (Δx/2)³.
     density = _native.read_vdb_grid(str(out), "density")
