@@ -119,28 +119,34 @@ def _has_denoiser():
 
 
 #: The metering of the examples: the candle example's light (its flame and the short pieces of its
-#: tip: 0.025 W over flames 2.5 cm long on average) exposed +2 stops.
+#: tip: 0.025 W over a fire 3.9 cm across) exposed +2 stops.
 #: Every flame's light is physical (Light Unit's default), and eq. 5 grows as r^7: a torch is
 #: ~10^4 candles, a dragon's breath ~10^10. A photographer exposes for the light falling on
-#: what the flames light, ~P / h² at a flame's length h from them; so do the examples.
-METER_IRRADIANCE, METER_EXPOSURE = 0.025 / 0.025 ** 2, 2.0
+#: what the flames light, ~P / D² at the fire's size D from them; so do the examples.
+METER_IRRADIANCE, METER_EXPOSURE = 0.025 / 0.039 ** 2, 2.0
 
 
 def metered_exposure(scene, frames, offset=0.0):
     """The exposure (stops) metering the flames' light over `frames`: P the mean total power
-    of the flame lights (E × Light Unit), h the mean flame length (3 × light radius), so that
-    P / h² reads as the candle's, plus `offset` stops of taste. Prints the light."""
+    of the flame lights (E × Light Unit), D the fire's size — the mean flame length (3 × light
+    radius), or for many flames twice the RMS distance of their lights from their centroid if
+    larger — so that P / D² reads as the candle's, plus `offset` stops of taste. Prints it."""
     folder = scene_kit.addon_module("snapshot").flames_cache_folder(scene)
     unit = scene.plume_flames.light_unit
-    powers, lengths = [], []
+    powers, sizes = [], []
     for frame in frames:
         d = np.load(os.path.join(folder, f"spines_{frame:04d}.npz"))
+        if len(d["light_energy"]) == 0:
+            continue
         powers.append(float(np.sum(d["light_energy"])) * unit)
-        lengths.extend(3.0 * np.asarray(d["light_radii"], np.float64))
-    p, h = float(np.mean(powers)), float(np.mean(lengths)) if lengths else 1.0
-    stops = METER_EXPOSURE + math.log2(METER_IRRADIANCE / max(p / h ** 2, 1e-30)) + offset
-    print(f"light: {p:.4g} W ({p * 683 / (4 * math.pi):.4g} cd), flames {h * 100:.1f} cm long: "
-          f"exposure {stops:+.1f} stops", flush=True)
+        centres = np.asarray(d["light_centres"], np.float64)
+        spread = 2.0 * math.sqrt(float(np.mean(np.sum((centres - centres.mean(axis=0)) ** 2,
+                                                       axis=1))))
+        sizes.append(max(3.0 * float(np.mean(d["light_radii"])), spread))
+    p, size = (float(np.mean(powers)), float(np.mean(sizes))) if powers else (0.0, 1.0)
+    stops = METER_EXPOSURE + math.log2(METER_IRRADIANCE / max(p / size ** 2, 1e-30)) + offset
+    print(f"light: {p:.4g} W ({p * 683 / (4 * math.pi):.4g} cd), fire {size * 100:.1f} cm "
+          f"across: exposure {stops:+.1f} stops", flush=True)
     return stops
 
 
