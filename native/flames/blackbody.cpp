@@ -39,4 +39,15 @@ glm::vec3 blackbodyColor(double kelvin) {
   return y > 0.f ? c / y : glm::vec3(1.f);
 }
 
+BlackbodyRamp::BlackbodyRamp(double kelvin) : mTable(256) {
+  for (std::size_t k = 0; k < mTable.size(); ++k)
+    mTable[k] = blackbodyColor(kelvin * double(k) / double(mTable.size() - 1));
+}
+
+glm::vec3 BlackbodyRamp::operator()(double fraction) const {
+  const double x = std::clamp(fraction, 0.0, 1.0) * double(mTable.size() - 1);
+  const std::size_t k = std::min(std::size_t(x), mTable.size() - 2);
+  return glm::mix(mTable[k], mTable[k + 1], float(x - double(k)));
+}
+
 }  // namespace plume

@@ -9,10 +9,23 @@
 
 #include <glm/glm.hpp>
 
+#include <vector>
+
 namespace plume {
 
 /// Linear Rec. 709 colour of a blackbody at `kelvin` (clamped to [500, 40000] K), luminance 1.
 glm::vec3 blackbodyColor(double kelvin);
+
+/// blackbodyColor(f · kelvin) for f ∈ [0, 1], tabulated once (the spectral integral costs ~1 µs,
+/// too much per particle): 256 entries, linear between them (the colour changes smoothly in T).
+class BlackbodyRamp {
+ public:
+  explicit BlackbodyRamp(double kelvin);
+  glm::vec3 operator()(double fraction) const;
+
+ private:
+  std::vector<glm::vec3> mTable;
+};
 
 /// Rec. 709 luminance 0.2126 R + 0.7152 G + 0.0722 B.
 inline float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }

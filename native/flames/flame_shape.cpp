@@ -87,6 +87,7 @@ FlameShaper::FlameShaper(const std::vector<FlameProfile>& profiles, const FlameS
   for (const ColorImage& image : mImages) image.validate();
   for (const FlameProfile& p : profiles) mDensities.push_back(std::make_unique<ProfileDensity>(p, params.density));
   mKolmogorov = std::make_unique<KolmogorovNoise>(params.kolmogorov, params.seed);
+  mBlackbody = std::make_unique<BlackbodyRamp>(params.temperature);
 }
 
 int FlameShaper::profileIndex(const Flame& flame) const {
@@ -217,7 +218,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       // to tip; the glow outside takes the nearest edge's colour), else a blackbody.
       const double v = 1.0 - pieceShare * (1.0 - p.z / aspect);
       const glm::vec3 color = image && image->width > 0 ? image->sample(0.5 + 0.5 * p.x, v)
-                                                        : blackbodyColor(mParams.temperature * s.density);
+                                                        : (*mBlackbody)(s.density);
       p += mFlow.displacement(p, time - age, flame.radius);
       glm::dvec3 x = spine.map(p, aspect, radius);
       x += kolmogorov.displacement(x);

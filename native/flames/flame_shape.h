@@ -9,6 +9,7 @@
 /// out in input order and merging keeps that order, so the result is bit-identical at any
 /// thread count.
 
+#include "flames/blackbody.h"
 #include "flames/flame.h"
 #include "flames/flame_sampler.h"
 #include "flames/flow_noise.h"
@@ -98,6 +99,7 @@ class FlameShaper {
   std::vector<ColorImage> mImages;
   FlowNoise mFlow;
   std::unique_ptr<KolmogorovNoise> mKolmogorov;
+  std::unique_ptr<BlackbodyRamp> mBlackbody;  ///< colours of flames without an image
   std::shared_ptr<const ObstacleSet> mObstacles;
 };
 
