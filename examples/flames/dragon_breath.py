@@ -50,22 +50,24 @@ def head():
 
 def setup(scene, frames):
     head()
-    flame_kit.floor(12.0, color=(0.03, 0.027, 0.025))
+    flame_kit.floor(12.0, color=(0.12, 0.1, 0.09))
     bpy.ops.object.effector_add(type='TURBULENCE', location=(0.0, 0.0, 1.0))
     fld = bpy.context.active_object.field
-    fld.strength, fld.size, fld.flow = 1.5, 0.6, 0.0
+    # Figure 5: "a pre-calculated wind field based on random forces gives some good internal
+    # rotation to the fireball": large eddies that roll the breath as it slows and rises.
+    fld.strength, fld.size, fld.flow = 3.0, 1.2, 0.0
     fld.seed = 1  # Blender seeds a new field from the clock: fixed, the same flames every run
     flame_kit.flames_settings(
         scene, frames, points=12, height_persistent=0.15, height_intermittent=0.3,
-        height_max=0.5, lifespan_scale=2.0, breakaway_frequency=20.0, buoyancy=0.08,
-        wind=(2.5, 0.0, 0.0), merging=False, kolmogorov=0.02, particles_per_pixel=4.0,
+        height_max=0.5, lifespan_scale=2.0, breakaway_frequency=20.0, buoyancy=0.3,
+        wind=(2.0, 0.0, 0.0), merging=False, kolmogorov=0.06, flow_noise=0.3, particles_per_pixel=4.0,
         max_particles=15000, voxel_size=0.012, temperature_scale=1700.0)
     scene_kit.camera(scene, (0.7, -5.0, 1.3), lens=35.0, target=(0.7, 0.0, 1.2))
 
 
 def main():
     flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64,
-                            exposure_offset=-1.0)  # the flames' cores, not their glow
+                            exposure_offset=-3.5)  # the flames' cores, not their glow
 
 
 if __name__ == "__main__":

@@ -54,16 +54,19 @@ def torch(frames):
 
 def setup(scene, frames):
     torch(frames)
-    flame_kit.floor(6.0, color=(0.06, 0.05, 0.045))
+    flame_kit.floor(6.0, color=(0.2, 0.17, 0.14))
+    # A rough stone wall behind the swing: what the torch lights (0.6 m behind it).
+    bpy.ops.mesh.primitive_plane_add(size=6.0, location=(0.0, 0.6, 1.5), rotation=(1.5708, 0.0, 0.0))
+    flame_kit.solid(bpy.context.active_object, (0.3, 0.27, 0.24), roughness=0.95, name="Wall")
     flame_kit.flames_settings(
         scene, frames, points=14, height_persistent=0.08, height_intermittent=0.16,
         height_max=0.3, lifespan_scale=0.3, buoyancy=0.5, kolmogorov=0.006, voxel_size=0.004, temperature_scale=1700.0)
-    scene_kit.camera(scene, (0.0, -2.2, 1.1), lens=40.0, target=(0.0, 0.0, 1.0))
+    scene_kit.camera(scene, (0.0, -1.7, 1.1), lens=35.0, target=(0.0, 0.0, 1.05))
 
 
 def main():
     flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64,
-                            exposure_offset=-2.0)  # the flames' cores, not their glow
+                            exposure_offset=-3.0)  # the flames' cores, not their glow
 
 
 if __name__ == "__main__":
