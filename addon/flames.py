@@ -107,6 +107,21 @@ def shape_key(s: FlameSettings):
             s.temperature_scale)
 
 
+#: The motion blur the velocity grid is made for: a shutter of one frame (Blender's default 0.5
+#: frame, and up to 1), and at most this many metres (a runaway particle must not grow the grid).
+BLUR_SHUTTER_FRAMES, BLUR_MAX_REACH = 1.0, 2.0
+
+
+def blur_reach(shaped, fps):
+    """How far (m) the velocity grid must reach past the flames for Cycles to blur their outline
+    (fields/velocity_extend.h): the fastest particle's travel over a shutter of one frame."""
+    v = np.asarray(shaped["velocities"], np.float64)
+    if len(v) == 0:
+        return 0.0
+    fastest = float(np.sqrt((v * v).sum(axis=1).max()))
+    return min(BLUR_MAX_REACH, fastest * BLUR_SHUTTER_FRAMES / float(fps))
+
+
 def add_carried_velocity(shaped, live, source_velocities):
     """The motion-blur velocity of the flame particles (the VDB's `velocity` grid, §5.3). The
     core gives each particle eq. 1's velocity of its spine, in the world frame: for a flame
@@ -299,7 +314,7 @@ class FlameBakeRunner:
                                voxel_size=float(s.voxel_size),
                                temperature_scale=float(s.temperature_scale),
                                light_unit=float(s.light_unit), opacity=float(s.opacity),
-                               frame=frame)
+                               blur_reach=blur_reach(shaped, snap.fps), frame=frame)
             write_spines(spines_path(snap.folder, frame), live, shaped["lights"],
                          self.params[i])
             result.step_seconds += t1 - t0

@@ -193,8 +193,9 @@ void bindFlamesShape(py::module_& m) {
   m.def(
       "write_flames_vdb",
       [](const py::object& path, const py::dict& particles, float voxelSize, const py::object& origin,
-         float temperatureScale, float lightUnit, float opacity, int frame, int threads) {
+         float temperatureScale, float lightUnit, float opacity, float blurReach, int frame, int threads) {
         FlameRasterParams r;
+        r.blurReach = blurReach;
         r.emissionScale = lightUnit;
         r.opacity = opacity;
         r.voxelSize = voxelSize;
@@ -210,10 +211,11 @@ void bindFlamesShape(py::module_& m) {
         });
       },
       py::arg("path"), py::arg("particles"), py::arg("voxel_size"), py::arg("origin") = py::make_tuple(0, 0, 0),
-      py::arg("temperature_scale") = 1500.f, py::arg("light_unit") = 1.f, py::arg("opacity") = 1.f,
+      py::arg("temperature_scale") = 1500.f, py::arg("light_unit") = 1.f, py::arg("opacity") = 1.f, py::arg("blur_reach") = 0.f,
       py::arg("frame") = 0, py::arg("threads") = 0,
       "Rasterizes a FlameShaper.shape() result into grids emission (W/m^3: light_unit x the particles' "
-      "power), color, density (opacity x d^2, §5.3), temperature, flame, velocity and writes them "
+      "power), color, density (opacity x d^2, §5.3), temperature, flame, velocity (blur_reach > 0: "
+      "4x coarser, extended blur_reach m past the particles for motion blur) and writes them "
       "atomically; returns the active voxel count of the density grid.");
 }
 

@@ -5,6 +5,7 @@
 
 #include "core/parallel.h"
 #include "fields/fire_raster.h"
+#include "fields/velocity_extend.h"
 #include "io/vdb_grids.h"
 
 #include <openvdb/points/PointAttribute.h>
@@ -60,6 +61,8 @@ void FlameRasterParams::validate() const {
                                 std::to_string(emissionScale) + ")");
   if (!(opacity >= 0.f && opacity <= 1e4f))
     throw std::invalid_argument("opacity must be in [0, 10000] (got " + std::to_string(opacity) + ")");
+  if (!(blurReach >= 0.f && blurReach <= 1e3f))
+    throw std::invalid_argument("blur_reach must be in [0, 1000] m (got " + std::to_string(blurReach) + ")");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all cores)");
 }
 
@@ -127,6 +130,13 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
   }
   out.emission = vectorGrid(emission, "emission", xform, openvdb::VEC_INVARIANT);
   out.velocity = vectorGrid(velocity, "velocity", xform, openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  if (params.blurReach > 0.f) {
+    VelocityExtendParams extend;
+    extend.voxelSize = 4.f * h;
+    extend.origin = params.origin;
+    extend.reach = params.blurReach;
+    out.velocity = extendedVelocity(parts.positions, parts.velocities, extend);
+  }
   return out;
 }
 

@@ -38,6 +38,9 @@ struct FlameRasterParams {
   float temperatureScale = 1500.f;  ///< K at d = I
   float emissionScale = 1.f;        ///< U: Blender watts per watt of eq. 5 (the light unit)
   float opacity = 1.f;              ///< density where d = I (§5.3)
+  /// m the velocity grid reaches past the particles, for motion blur (fields/velocity_extend.h):
+  /// 0 keeps it on the particles' voxels; > 0 builds it 4× coarser, extended this far.
+  float blurReach = 0.f;
   int threads = 0;                  ///< 0: all cores
   /// Throws std::invalid_argument naming the setting and its accepted range.
   void validate() const;
