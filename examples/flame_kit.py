@@ -161,7 +161,7 @@ def flame_look(scene, tag, out_dir, width=640, height=360, samples=64,
         scene.cycles.denoiser = 'OPENIMAGEDENOISE'
     scene_kit.plain_world(scene, world)
     scene.view_settings.view_transform = 'Filmic'
-    scene.view_settings.exposure = exposure
+    scene.cycles.film_exposure = 2.0 ** exposure
     scene.cycles.volume_bounces = 0  # the flames emit; scattering in them is not worth its cost
     # no fireflies from the bright, small flames (the clamp scaled with the exposure)
     scene.cycles.sample_clamp_indirect = 1.0 / 2.0 ** max(exposure, 0.0)
@@ -182,7 +182,9 @@ def flame_example(tag, usage, default_frames, setup, show, exposure_offset=0.0, 
     scene.frame_start, scene.frame_end = 1, frames
     scene_kit.save_blend(out_dir, tag)
     bake_s, flames, particles = bake_flames(scene, tag)
-    scene.view_settings.exposure = metered_exposure(
+    # Cycles' film exposure scales the render itself, before the denoiser: a dragon's 10⁹ W
+    # would overflow OpenImageDenoise's half floats (it turns the flames green).
+    scene.cycles.film_exposure = 2.0 ** metered_exposure(
         scene, scene_kit.shown_frames(show, frames), exposure_offset)
     bpy.ops.wm.save_mainfile()
     t0 = time.perf_counter()
