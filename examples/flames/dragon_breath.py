@@ -59,10 +59,10 @@ def setup(scene, frames):
     fld.seed = 1  # Blender seeds a new field from the clock: fixed, the same flames every run
     flame_kit.flames_settings(
         scene, frames, points=12, height_persistent=0.15, height_intermittent=0.3,
-        height_max=0.5, lifespan_scale=2.0, breakaway_frequency=20.0, buoyancy=0.3,
+        height_max=0.5, lifespan_scale=2.0, breakaway_frequency=20.0, buoyancy=0.15,
         wind=(2.0, 0.0, 0.0), merging=False, kolmogorov=0.06, flow_noise=0.3, particles_per_pixel=4.0,
         max_particles=15000, voxel_size=0.012, temperature_scale=1700.0)
-    scene_kit.camera(scene, (0.7, -5.0, 1.3), lens=35.0, target=(0.7, 0.0, 1.2))
+    scene_kit.camera(scene, (0.9, -6.0, 1.5), lens=30.0, target=(0.9, 0.0, 1.5))
 
 
 def main():
