@@ -4,6 +4,8 @@
 
 #include "fields/fire_raster.h"
 
+#include "fields/point_arrays.h"
+
 #include "core/parallel.h"
 #include "io/vdb_grids.h"
 
@@ -31,28 +33,6 @@ using openvdb::Index;
 using openvdb::points::PointDataTree;
 
 bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-/// Positions as OpenVDB's point converters read them (PointAttributeVector's interface).
-struct PositionArray {
-  using PosType = openvdb::Vec3R;
-  using value_type = openvdb::Vec3R;
-  const glm::vec3* data;
-  std::size_t count;
-  std::size_t size() const { return count; }
-  void getPos(std::size_t n, openvdb::Vec3R& xyz) const {
-    xyz = openvdb::Vec3R(data[n].x, data[n].y, data[n].z);
-  }
-};
-
-/// One vector per point, for populateAttribute().
-struct Vec3Array {
-  using value_type = openvdb::Vec3f;
-  const glm::vec3* data;
-  std::size_t count;
-  std::size_t size() const { return count; }
-  void get(openvdb::Vec3f& value, std::size_t n) const { value = openvdb::Vec3f(data[n].x, data[n].y, data[n].z); }
-  void get(openvdb::Vec3f& value, std::size_t n, Index) const { get(value, n); }
-};
 
 /// One float per point, for populateAttribute().
 struct FloatArray {
@@ -200,7 +180,7 @@ FireGrids rasterizeFire(const FireParticleView& in, const FireRasterParams& para
   openvdb::Vec3STree::Ptr velocity;
   if (view.count > 0) {
     namespace pts = openvdb::points;
-    const PositionArray positions{view.positions, view.count};
+    const Vec3Points<openvdb::Vec3R> positions{view.positions, view.count};
     auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *xform);
     auto points = pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, positions, *xform);
     PointDataTree& tree = points->tree();
@@ -256,7 +236,7 @@ FireGrids rasterizeFire(const FireParticleView& in, const FireRasterParams& para
     openvdb::tools::pruneInactive(*flame);
     if (view.velocities) {
       pts::appendAttribute<openvdb::Vec3f>(tree, "velocity");
-      pts::populateAttribute(tree, index->tree(), "velocity", Vec3Array{view.velocities, view.count});
+      pts::populateAttribute(tree, index->tree(), "velocity", Vec3Points<openvdb::Vec3f>{view.velocities, view.count});
       velocity = pts::rasterizeTrilinear</*Staggered=*/false, openvdb::Vec3f>(tree, "velocity");
     }
   }

@@ -3,6 +3,7 @@
 
 #include "fields/velocity_extend.h"
 
+#include "fields/point_arrays.h"
 #include "io/vdb_grids.h"
 
 #include <openvdb/points/PointAttribute.h>
@@ -16,23 +17,6 @@
 #include <cmath>
 
 namespace plume {
-namespace {
-
-template <typename ValueT>
-struct GlmArray {
-  using PosType = ValueT;
-  using value_type = ValueT;
-  const std::vector<glm::vec3>* data;
-  std::size_t size() const { return data->size(); }
-  void getPos(std::size_t n, ValueT& xyz) const { get(xyz, n); }
-  void get(ValueT& value, std::size_t n) const {
-    const glm::vec3& v = (*data)[n];
-    value = ValueT(v.x, v.y, v.z);
-  }
-  void get(ValueT& value, std::size_t n, openvdb::Index) const { get(value, n); }
-};
-
-}  // namespace
 
 openvdb::Vec3SGrid::Ptr extendedVelocity(const std::vector<glm::vec3>& positions,
                                          const std::vector<glm::vec3>& velocities,
@@ -42,11 +26,11 @@ openvdb::Vec3SGrid::Ptr extendedVelocity(const std::vector<glm::vec3>& positions
   openvdb::Vec3STree::Ptr tree;
   if (!positions.empty()) {
     namespace pts = openvdb::points;
-    const GlmArray<openvdb::Vec3R> at{&positions};
+    const Vec3Points<openvdb::Vec3R> at{positions.data(), positions.size()};
     auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(at, *xform);
     auto points = pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, at, *xform);
     pts::appendAttribute<openvdb::Vec3f>(points->tree(), "velocity");
-    pts::populateAttribute(points->tree(), index->tree(), "velocity", GlmArray<openvdb::Vec3f>{&velocities});
+    pts::populateAttribute(points->tree(), index->tree(), "velocity", Vec3Points<openvdb::Vec3f>{velocities.data(), velocities.size()});
     tree = pts::rasterizeTrilinear</*Staggered=*/false, openvdb::Vec3f>(points->tree(), "velocity");
     const int layers = std::min(params.maxLayers, int(std::ceil(params.reach / params.voxelSize)));
     for (int layer = 0; layer < layers; ++layer) {

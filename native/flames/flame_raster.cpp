@@ -5,6 +5,7 @@
 
 #include "core/parallel.h"
 #include "fields/fire_raster.h"
+#include "fields/point_arrays.h"
 #include "fields/velocity_extend.h"
 #include "io/vdb_grids.h"
 
@@ -20,22 +21,6 @@
 
 namespace plume {
 namespace {
-
-/// A glm::vec3 array as OpenVDB's point converters read it: positions (getPos, ValueT = Vec3R)
-/// or a Vec3f attribute (get).
-template <typename ValueT>
-struct Vec3Array {
-  using PosType = ValueT;
-  using value_type = ValueT;
-  const std::vector<glm::vec3>* data;
-  std::size_t size() const { return data->size(); }
-  void getPos(std::size_t n, ValueT& xyz) const { get(xyz, n); }
-  void get(ValueT& value, std::size_t n) const {
-    const glm::vec3& v = (*data)[n];
-    value = ValueT(v.x, v.y, v.z);
-  }
-  void get(ValueT& value, std::size_t n, openvdb::Index) const { get(value, n); }
-};
 
 openvdb::Vec3SGrid::Ptr vectorGrid(openvdb::Vec3STree::Ptr tree, const char* name,
                                    const openvdb::math::Transform::Ptr& xform, openvdb::VecType type) {
@@ -105,14 +90,14 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
   openvdb::Vec3STree::Ptr color, velocity;
   if (n > 0) {
     namespace pts = openvdb::points;
-    const Vec3Array<openvdb::Vec3R> positions{&parts.positions};
+    const Vec3Points<openvdb::Vec3R> positions{parts.positions.data(), parts.size()};
     auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *xform);
     auto points = pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, positions, *xform);
     auto& tree = points->tree();
     pts::appendAttribute<openvdb::Vec3f>(tree, "color");
     pts::appendAttribute<openvdb::Vec3f>(tree, "velocity");
-    pts::populateAttribute(tree, index->tree(), "color", Vec3Array<openvdb::Vec3f>{&parts.colors});
-    pts::populateAttribute(tree, index->tree(), "velocity", Vec3Array<openvdb::Vec3f>{&parts.velocities});
+    pts::populateAttribute(tree, index->tree(), "color", Vec3Points<openvdb::Vec3f>{parts.colors.data(), parts.size()});
+    pts::populateAttribute(tree, index->tree(), "velocity", Vec3Points<openvdb::Vec3f>{parts.velocities.data(), parts.size()});
     color = pts::rasterizeTrilinear</*Staggered=*/false, openvdb::Vec3f>(tree, "color");
     velocity = pts::rasterizeTrilinear</*Staggered=*/false, openvdb::Vec3f>(tree, "velocity");
   }
