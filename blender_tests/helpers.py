@@ -183,6 +183,27 @@ MIN_MEAN_ABS_DIFF = 0.002
 MIN_CHANGED_SHARE = 0.01
 
 
+def flame_studio(scene, location, width, height, samples):
+    """A camera at `location` looking along +y (level), Cycles on the CPU at width x height and
+    `samples` without denoising, a black world: the flames and their lights alone show."""
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    scene.collection.objects.link(cam)
+    cam.location = location
+    cam.rotation_euler = (np.pi / 2, 0.0, 0.0)
+    scene.camera = cam
+    r = scene.render
+    r.engine = 'CYCLES'
+    r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
+    scene.cycles.device = 'CPU'
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    if scene.world is None:
+        scene.world = bpy.data.worlds.new("World")
+    scene.world.use_nodes = True
+    scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
+    return cam
+
+
 def smoke_studio(scene, samples):
     """Camera 3.6 m in front of a 2 m domain on the floor, a sun, Cycles CPU at 160 x 120."""
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))

@@ -12,7 +12,6 @@ flow-graph fire give Volumes whose velocity settings are set and whose VDBs hold
 Run: /usr/bin/python3 blender_tests/run.py --blender all blender_tests/test_flame_motion_blur.py
 """
 
-import math
 import os
 import sys
 import unittest
@@ -22,8 +21,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (OUT_DIR, add_domain, add_sphere_source, compat, image_pixels,  # noqa: E402
-                     native, reset_scene, rmtree, run, select_only, temp_dir)
+from helpers import (OUT_DIR, add_domain, add_sphere_source, compat, flame_studio,  # noqa: E402
+                     image_pixels, native, reset_scene, rmtree, run, select_only, temp_dir)
 
 FPS = 24
 #: The torch's speed along +x (m/s): 1/6 m per frame.
@@ -89,23 +88,10 @@ def torch_scene(folder):
     # Few, short-lived separated flames: the picture is mostly the five attached flames.
     f.lifespan_scale, f.breakaway_frequency = 1.0 / 24.0, 0.2
     scn.frame_start, scn.frame_end = 1, FRAMES
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    scn.collection.objects.link(cam)
-    cam.location = (-0.12, -0.9, 0.02)  # the flames trail behind the torch (-x), flat
-    cam.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    scn.camera = cam
-    r = scn.render
-    r.engine = 'CYCLES'
-    r.resolution_x, r.resolution_y, r.resolution_percentage = 160, 90, 100
-    r.image_settings.file_format = 'PNG'
-    scn.cycles.device = 'CPU'
-    scn.cycles.samples = 16
+    # the flames trail behind the torch (-x), seen flat
+    flame_studio(scn, (-0.12, -0.9, 0.02), 160, 90, 16)
+    scn.render.image_settings.file_format = 'PNG'
     scn.cycles.seed = 0
-    scn.cycles.use_denoising = False
-    if scn.world is None:
-        scn.world = bpy.data.worlds.new("World")
-    scn.world.use_nodes = True
-    scn.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
     src.hide_render = True
     select_only(src)
     return src

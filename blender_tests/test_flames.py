@@ -21,8 +21,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (OUT_DIR, compat, assert_reports_error, image_pixels, native,  # noqa: E402
-                     reset_scene, rmtree, run, run_cancelled, select_only, temp_dir,
+from helpers import (OUT_DIR, compat, assert_reports_error, flame_studio, image_pixels,  # noqa: E402
+                     native, reset_scene, rmtree, run, run_cancelled, select_only, temp_dir,
                      tree_listing)
 
 FRAMES = 12
@@ -62,21 +62,8 @@ def flame_scene(tmp, flames=1, profile='CANDLE'):
     else:
         f.height_persistent, f.height_intermittent, f.height_max = 0.08, 0.16, 0.3
         f.voxel_size = 0.003
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    scn.collection.objects.link(cam)
     dist = 0.35 if flames == 1 else 1.0
-    cam.location = (0.0, -dist, 0.04 if flames == 1 else 0.12)
-    cam.rotation_euler = (np.pi / 2, 0.0, 0.0)
-    scn.camera = cam
-    r = scn.render
-    r.engine = 'CYCLES'
-    r.resolution_x, r.resolution_y, r.resolution_percentage = 120, 160, 100
-    scn.cycles.samples = 8
-    scn.cycles.use_denoising = False
-    if scn.world is None:
-        scn.world = bpy.data.worlds.new("World")
-    scn.world.use_nodes = True
-    scn.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
+    flame_studio(scn, (0.0, -dist, 0.04 if flames == 1 else 0.12), 120, 160, 8)
     src.hide_render = True
     select_only(src)
     return src

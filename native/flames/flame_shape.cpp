@@ -18,8 +18,8 @@
 namespace plume {
 namespace {
 
-constexpr int kChunk = 2048;
-constexpr double kPi = 3.14159265358979323846;  ///< particles per parallel task
+constexpr int kChunk = 2048;  ///< particles per parallel task
+constexpr double kPi = 3.14159265358979323846;
 
 /// A run of particles of one flame.
 struct Chunk {
@@ -129,7 +129,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     glm::dvec3 meanVelocity(0.0);
     for (const SpinePoint& p : flame.points) meanVelocity += p.v;
     meanVelocity /= double(flame.points.size());
-    // Eq. 5; a separated piece: its share h / h_split of the flame it broke from (flame.h).
+    // Eq. 5; a separated piece: its share h / h_split of the flame it broke from (Flame::splitLength).
     const bool piece = flame.separated && flame.splitLength > length;
     const double energy =
         flame.intensity *
