@@ -256,10 +256,26 @@ void bindGraph(py::module_& m) {
 
 void bindWalk(py::module_& m) {
   py::class_<RandomWalk> w(m, "RandomWalk", "A seeded random walk on a FlowGraph (§5.1).");
-  w.def(py::init<const FlowGraph&, std::uint64_t, WalkBias, double, int>(), py::arg("graph"), py::arg("seed"),
+  w.def(py::init<const FlowGraph&, std::uint64_t, WalkBias, double, int, int>(), py::arg("graph"), py::arg("seed"),
         py::arg("bias") = WalkBias::Uniform, py::arg("gamma") = 0.875, py::arg("start_state") = 0,
-        py::keep_alive<1, 2>(), "Starts at the first node of start_state.");
+        py::arg("transition_hold") = 0, py::keep_alive<1, 2>(),
+        "Starts at the first node of start_state. transition_hold: node steps on temporal edges "
+        "after each transition (the transition state; the pathlines' lifetime L; 0: none).");
   w.def_property_readonly("current", &RandomWalk::current, "The node visited now.");
+  w.def_property_readonly("transition_hold", &RandomWalk::transitionHold, "H, node steps (0: none).");
+  w.def_property_readonly("hold_remaining", &RandomWalk::holdRemaining,
+                          "Temporal steps left before the walk may take a transition (0: free).");
+  w.def_property_readonly("forced_transitions", &RandomWalk::forcedTransitions,
+                          "Transitions taken inside a hold (the node had no temporal edge nor long transition).");
+  w.def(
+      "temporal_run",
+      [](const RandomWalk& walk, int node) {
+        if (node < 0 || node >= walk.graph().nodeCount())
+          throw py::value_error("node must be in [0, " + std::to_string(walk.graph().nodeCount() - 1) + "]");
+        return walk.temporalRun(node);
+      },
+      py::arg("node"),
+        "Temporal edges that follow node before its state's time line ends.");
   w.def("next", &RandomWalk::next, py::arg("target_state") = -1,
         "Follows one edge (steered to target_state unless -1) and returns the new node.");
   w.def(

@@ -3,6 +3,7 @@
 
 #include "flowgraph/random_walk.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -19,8 +20,9 @@ void requireTarget(const FlowGraph& graph, int targetState) {
 
 }  // namespace
 
-RandomWalk::RandomWalk(const FlowGraph& graph, std::uint64_t seed, WalkBias bias, double gamma, int startState)
-    : mGraph(&graph), mRng(seed), mBias(bias), mGamma(gamma), mCurrent(0) {
+RandomWalk::RandomWalk(const FlowGraph& graph, std::uint64_t seed, WalkBias bias, double gamma, int startState,
+                       int transitionHold)
+    : mGraph(&graph), mRng(seed), mBias(bias), mGamma(gamma), mCurrent(0), mHold(transitionHold) {
   if (graph.nodeCount() == 0) throw std::invalid_argument("graph: the flow graph has no node (build it first)");
   if (startState < 0 || startState >= graph.stateCount())
     throw std::invalid_argument("start_state must be in [0, " + std::to_string(graph.stateCount() - 1) + "] (got " +
@@ -32,6 +34,18 @@ RandomWalk::RandomWalk(const FlowGraph& graph, std::uint64_t seed, WalkBias bias
   }
   if (bias != WalkBias::Uniform && bias != WalkBias::Temporal)
     throw std::invalid_argument("bias must be UNIFORM or TEMPORAL");
+  int shortest = graph.stateNodeCount(0);
+  for (int s = 1; s < graph.stateCount(); ++s) shortest = std::min(shortest, graph.stateNodeCount(s));
+  if (transitionHold < 0 || transitionHold > shortest - 1)
+    throw std::invalid_argument("transition_hold must be in [0, " + std::to_string(shortest - 1) +
+                                "] node steps, less than the shortest state's " + std::to_string(shortest) +
+                                " nodes (got " + std::to_string(transitionHold) + ")");
+  // Temporal runs, from the end of each state backwards: run(n) = run(n + 1) + 1 along a
+  // temporal edge n -> n + 1, 0 where the time line ends.
+  mRun.assign(std::size_t(graph.nodeCount()), 0);
+  for (int n = graph.nodeCount() - 1; n >= 0; --n)
+    for (const FlowEdge& e : graph.outEdges(n))
+      if (e.temporal) mRun[std::size_t(n)] = mRun[std::size_t(e.to)] + 1;
   mCurrent = graph.node(startState, 0);
   if (graph.pruned(mCurrent))
     throw std::invalid_argument("start_state " + std::to_string(startState) + ": its first node was pruned");
@@ -39,32 +53,38 @@ RandomWalk::RandomWalk(const FlowGraph& graph, std::uint64_t seed, WalkBias bias
 
 void RandomWalk::probabilities(int node, int targetState, std::vector<double>& p) const {
   const FlowGraph::EdgeRange edges = mGraph->outEdges(node);
-  const int d = edges.size();
-  p.assign(std::size_t(d), 0.0);
+  const int all = edges.size();
+  p.assign(std::size_t(all), 0.0);
+  // The edges a free step may take: under a hold, not the short transitions (unless all are).
+  int d = 0;
+  for (const FlowEdge& e : edges) d += longEnough(e);
+  const bool filter = mHold > 0 && d > 0;
+  if (!filter) d = all;
+  auto allowed = [&](const FlowEdge& e) { return !filter || longEnough(e); };
   if (targetState >= 0) {
     // §5.1 target state W: uniform over the edges into W (those that can stay in W first).
     for (bool mustStay : {true, false}) {
+      auto aims = [&](const FlowEdge& e) {
+        return allowed(e) && mGraph->state(e.to) == targetState && (!mustStay || mGraph->staysInState(e.to));
+      };
       int k = 0;
-      for (const FlowEdge& e : edges)
-        k += mGraph->state(e.to) == targetState && (!mustStay || mGraph->staysInState(e.to));
+      for (const FlowEdge& e : edges) k += aims(e);
       if (k == 0) continue;
-      for (int n = 0; n < d; ++n) {
-        const FlowEdge& e = edges.first[n];
-        if (mGraph->state(e.to) == targetState && (!mustStay || mGraph->staysInState(e.to)))
-          p[std::size_t(n)] = 1.0 / k;
-      }
+      for (int n = 0; n < all; ++n)
+        if (aims(edges.first[n])) p[std::size_t(n)] = 1.0 / k;
       return;
     }
   }
   int temporal = -1;
-  for (int n = 0; n < d; ++n)
+  for (int n = 0; n < all; ++n)
     if (edges.first[n].temporal) temporal = n;
-  if (mBias == WalkBias::Uniform || temporal < 0 || d == 1) {
-    for (double& q : p) q = 1.0 / d;
-    return;
+  for (int n = 0; n < all; ++n) {
+    if (!allowed(edges.first[n])) continue;
+    if (mBias == WalkBias::Uniform || temporal < 0 || d == 1)
+      p[std::size_t(n)] = 1.0 / d;
+    else  // eq. 12
+      p[std::size_t(n)] = n == temporal ? mGamma : (1.0 - mGamma) / (d - 1);
   }
-  for (double& q : p) q = (1.0 - mGamma) / (d - 1);  // eq. 12
-  p[std::size_t(temporal)] = mGamma;
 }
 
 std::vector<double> RandomWalk::edgeProbabilities(int node, int targetState) const {
@@ -79,8 +99,14 @@ std::vector<double> RandomWalk::edgeProbabilities(int node, int targetState) con
 
 int RandomWalk::next(int targetState) {
   requireTarget(*mGraph, targetState);
-  probabilities(mCurrent, targetState, mScratch);
   const FlowGraph::EdgeRange edges = mGraph->outEdges(mCurrent);
+  if (mHoldLeft > 0) {  // the transition state: the temporal edge, no draw
+    --mHoldLeft;
+    for (const FlowEdge& e : edges)
+      if (e.temporal) return mCurrent = e.to;
+    ++mForced;  // the time line ends here: a transition after all (below)
+  }
+  probabilities(mCurrent, targetState, mScratch);
   // One uniform draw per step; the last edge with p > 0 takes what rounding leaves above Σ p.
   const double u = mRng.uniform();
   double sum = 0.0;
@@ -92,6 +118,7 @@ int RandomWalk::next(int targetState) {
     if (u < sum) break;
   }
   mCurrent = edges.first[chosen].to;  // the graph is pruned: every node has an out-edge
+  if (!edges.first[chosen].temporal) mHoldLeft = mHold;
   return mCurrent;
 }
 

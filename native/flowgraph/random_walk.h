@@ -19,20 +19,43 @@ enum class WalkBias {
 };
 
 /// A walk V_1, V_2, ... on a FlowGraph (§5.1). The graph must outlive the walk.
+///
+/// Transition state (§5, results: "When the synthesizer reaches a transition edge, it enters the
+/// transition state ... [it] will not leave the transition state until these existing particles
+/// are dissipated"). With a hold of H > 0 node steps (the synthesis passes the pathlines'
+/// lifetime L), the H steps after a transition follow temporal edges only, so the particles
+/// emitted before a transition are gone before the next one: transitions are more than H steps
+/// apart. To make the hold possible, a free step also drops the transitions into a node whose
+/// temporal run (the temporal edges that follow it) is shorter than H, whenever the node has
+/// another edge; eq. 12 and the target rule then apply to the edges left (d(V_i) counts them).
+/// Only a node without temporal edge whose every transition is short forces an early transition
+/// (counted by forcedTransitions()).
 class RandomWalk {
  public:
   /// Starts at the first node of `startState` (§5.1 "starting at node k = 0"). Throws
-  /// std::invalid_argument for a start state out of range or γ outside [0, 1] (the paper's
+  /// std::invalid_argument for a start state out of range, γ outside [0, 1] (the paper's
   /// 0 < γ < 1 plus the two limits: γ = 1 always follows the temporal edge where there is one,
-  /// γ = 0 never unless it is the only edge).
+  /// γ = 0 never unless it is the only edge) or a transition hold outside [0, K − 1], K the
+  /// node count of the shortest state (a longer hold could never be kept).
   RandomWalk(const FlowGraph& graph, std::uint64_t seed, WalkBias bias = WalkBias::Uniform, double gamma = 0.875,
-             int startState = 0);
+             int startState = 0, int transitionHold = 0);
+
+  const FlowGraph& graph() const { return *mGraph; }
+  /// H, node steps (0: transitions may follow each other at any step).
+  int transitionHold() const { return mHold; }
+  /// Temporal steps still to take before the walk may leave its state's time line (0: free).
+  int holdRemaining() const { return mHoldLeft; }
+  /// Transitions taken while holding, because the node had no temporal edge nor long transition.
+  long long forcedTransitions() const { return mForced; }
+  /// Temporal edges that follow `node` before its state's time line ends (or is pruned).
+  int temporalRun(int node) const { return mRun[std::size_t(node)]; }
 
   /// The node visited now.
   int current() const { return mCurrent; }
 
-  /// Probability of each out-edge of `node` (in FlowGraph::outEdges order) when steering to
-  /// `targetState` (−1: none). With a target state W (§5.1): if some edge leads into W, those
+  /// Probability of each out-edge of `node` (in FlowGraph::outEdges order) for a free step (not
+  /// holding; with a hold, short transitions are dropped first, see the class comment) when
+  /// steering to `targetState` (−1: none). With a target state W (§5.1): if some edge leads into W, those
   /// edges share the probability uniformly (p = 1/k, k edges into W), otherwise the biased rule
   /// below applies. Plume narrows "into W" to the nodes of W from which a walk can stay in W
   /// forever (FlowGraph::staysInState) whenever such an edge exists, so that "once a target
@@ -43,19 +66,25 @@ class RandomWalk {
   /// uniformly among its transitions).
   std::vector<double> edgeProbabilities(int node, int targetState = -1) const;
 
-  /// Follows one edge drawn with edgeProbabilities(current(), targetState) and returns the new
-  /// node. The target may change at every step (the artist keys it). Throws
+  /// Follows one edge drawn with edgeProbabilities(current(), targetState), or the temporal edge
+  /// while holding, and returns the new node. The target may change at every step (the artist keys it). Throws
   /// std::invalid_argument for a target state outside [−1, states − 1].
   int next(int targetState = -1);
 
  private:
   void probabilities(int node, int targetState, std::vector<double>& p) const;
+  /// False for an edge a free step drops under the hold (a transition with a short run).
+  bool longEnough(const FlowEdge& e) const { return e.temporal || mRun[std::size_t(e.to)] >= mHold; }
 
   const FlowGraph* mGraph;
   Rng mRng;
   WalkBias mBias;
   double mGamma;
   int mCurrent;
+  int mHold = 0;
+  int mHoldLeft = 0;
+  long long mForced = 0;
+  std::vector<int> mRun;  ///< temporalRun() of every node
   std::vector<double> mScratch;
 };
 

@@ -1,8 +1,8 @@
 /// \file flowgraph_graph_test.cpp
 /// The flow graph of graph_fire_synthesis.txt §4.3-5.1: the cost matrix (eq. 9-10) against a
 /// brute-force double implementation and across thread counts, the block candidates and ε
-/// (eq. 11), pruning of dead ends, random walks (uniform, eq. 12, target states), the Figure 4
-/// picture and the errors on bad input.
+/// (eq. 11), pruning of dead ends, the Figure 4 picture and the errors on bad input (the walks:
+/// flowgraph_walk_test.cpp).
 
 #include "flowgraph/cost_matrix.h"
 #include "flowgraph/cost_matrix_image.h"
@@ -10,7 +10,7 @@
 #include "flowgraph/random_walk.h"
 #include "flowgraph/state_nodes.h"
 #include "flowgraph/transitions.h"
-#include "tests/flowgraph_groups.h"
+#include "tests/flowgraph_graphs.h"
 
 #include <gtest/gtest.h>
 
@@ -23,19 +23,12 @@
 namespace plume {
 namespace {
 
+using testing::expectInvalid;
 using testing::oscillatingGroups;
+using testing::params;
 using testing::pointers;
 using testing::randomCosts;
-
-/// Expects fn() to throw std::invalid_argument whose message contains every one of `words`.
-void expectInvalid(const std::function<void()>& fn, std::initializer_list<const char*> words) {
-  try {
-    fn();
-    ADD_FAILURE() << "no exception; expected one naming " << *words.begin();
-  } catch (const std::invalid_argument& e) {
-    for (const char* w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what();
-  }
-}
+using testing::walkGraph;
 
 /// Eq. 9-10 in double, term by term, with the rectangle rule over the L samples.
 double bruteCost(const PathlineGroup& a, const PathlineGroup& b, double alpha, double beta) {
@@ -52,15 +45,6 @@ double bruteCost(const PathlineGroup& a, const PathlineGroup& b, double alpha, d
     sum += double(a.layout.sampleDt) * (u * inv + alpha * r * inv + beta * t * inv);
   }
   return std::sqrt(sum);
-}
-
-FlowGraphParams params(int blockSize, int threads = 0) {
-  FlowGraphParams p;
-  p.alpha = 0.7;
-  p.beta = 1.3;
-  p.blockSize = blockSize;
-  p.threads = threads;
-  return p;
 }
 
 TEST(FlowGraphCost, MatchesBruteForceAcrossTilesAndStates) {
@@ -223,7 +207,6 @@ TEST(FlowGraphTransitions, ExplicitEpsilonMustLieBetweenAAndB) {
 }
 
 /// A graph with many transitions: three states of random costs, B = 8.
-FlowGraph walkGraph() { return FlowGraph::build(randomCosts(360, 11), {140, 120, 100}, params(8)); }
 
 /// Every node left has an out-edge, every edge joins nodes left, temporal edges join k -> k+1.
 void expectNoDeadEnd(const FlowGraph& g) {
@@ -326,86 +309,6 @@ TEST(FlowGraphBuild, FirstNodePrunedIsAnError) {
   expectInvalid([&] { FlowGraph::build(c, {20}, params(10)); },
                 {"first node of state 0", "Add states", "block_size", "epsilon"});
   expectInvalid([&] { FlowGraph::build(c, {20}, params(0)); }, {"block_size"});
-}
-
-TEST(FlowGraphWalk, TemporalBiasMatchesEquation12) {
-  const FlowGraph g = walkGraph();
-  for (WalkBias bias : {WalkBias::Temporal, WalkBias::Uniform}) {
-    RandomWalk walk(g, 42, bias, 0.875, 0);
-    const int steps = 100000;
-    double expected = 0.0;
-    int taken = 0;
-    for (int k = 0; k < steps; ++k) {
-      const int from = walk.current();
-      const std::vector<double> p = walk.edgeProbabilities(from);
-      const FlowGraph::EdgeRange edges = g.outEdges(from);
-      for (int e = 0; e < edges.size(); ++e)
-        if (edges.first[e].temporal) expected += p[std::size_t(e)];  // p(temporal | node)
-      const int to = walk.next();
-      for (const FlowEdge& edge : g.outEdges(from)) taken += edge.to == to && edge.temporal;
-    }
-    // A Bernoulli fraction over 10^5 steps has a standard deviation below 0.0016 (p(1-p) <= 1/4);
-    // the walk's steps are correlated through the nodes but 0.02 is still > 10 of them.
-    EXPECT_NEAR(double(taken) / steps, expected / steps, 0.02);
-    if (bias == WalkBias::Temporal) EXPECT_GT(expected / steps, 0.8);  // most nodes have d > 1
-  }
-}
-
-TEST(FlowGraphWalk, SameSeedSameWalk) {
-  const FlowGraph g = walkGraph();
-  RandomWalk a(g, 5, WalkBias::Temporal, 0.5), b(g, 5, WalkBias::Temporal, 0.5), c(g, 6, WalkBias::Temporal, 0.5);
-  bool differs = false;
-  for (int k = 0; k < 2000; ++k) {
-    const int target = (k / 500) % 2 ? 2 : -1;
-    const int na = a.next(target);
-    EXPECT_EQ(na, b.next(target));
-    differs |= na != c.next(target);
-  }
-  EXPECT_TRUE(differs);
-}
-
-TEST(FlowGraphWalk, TargetStateIsReachedAndKept) {
-  const FlowGraph g = walkGraph();
-  RandomWalk walk(g, 3, WalkBias::Temporal, 0.875, 0);
-  for (int target : {2, 1, 0}) {
-    int reached = -1;
-    for (int k = 0; k < 5000; ++k) {
-      const int n = walk.next(target);
-      if (reached < 0 && g.state(n) == target) reached = k;
-      if (reached >= 0) EXPECT_EQ(g.state(n), target) << "left state " << target << " at step " << k;
-    }
-    EXPECT_GE(reached, 0) << "state " << target << " never reached";
-  }
-}
-
-TEST(FlowGraphWalk, TargetPrefersNodesThatCanStay) {
-  // States A = 0..19 and B = 20..39, B = 10: costs 3 inside a state, 5 across, 0.1 on the pairs
-  // giving the edges 15 -> 4 (loop in A), 35 -> 24 (loop in B), 23 -> 36 (into B's tail),
-  // 5 -> 37, 36 -> 6 and 39 -> 13 (between the states). A's tail 16..19 is pruned; B's tail
-  // 36..39 survives (39 -> 13) but cannot stay in B.
-  CostMatrix c(40);
-  for (int i = 0; i < 40; ++i)
-    for (int j = i + 1; j < 40; ++j) c.set(i, j, (i < 20) == (j < 20) ? 3.0 : 5.0);
-  for (auto [i, j] : {std::pair{3, 15}, {23, 35}, {5, 36}, {39, 12}}) c.set(i, j, 0.1);
-  const FlowGraph g = FlowGraph::build(c, {20, 20}, params(10));
-  EXPECT_EQ(g.prunedPerState(), (std::vector<int>{4, 0}));
-  for (int n = 20; n < 40; ++n) EXPECT_EQ(g.staysInState(n), n < 36) << n;
-  RandomWalk walk(g, 9, WalkBias::Uniform, 0.875, 1);
-  EXPECT_EQ(walk.edgeProbabilities(23), (std::vector<double>{0.5, 0.5}));    // 24, 36
-  EXPECT_EQ(walk.edgeProbabilities(23, 1), (std::vector<double>{1.0, 0.0}));  // only 24 stays
-  for (int k = 0; k < 10000; ++k) {
-    const int n = walk.next(1);
-    ASSERT_TRUE(n >= 20 && n < 36) << "step " << k << " visited " << n;
-  }
-}
-
-TEST(FlowGraphWalk, BadInputsNameTheSetting) {
-  const FlowGraph g = walkGraph();
-  expectInvalid([&] { RandomWalk(g, 1, WalkBias::Temporal, 1.5); }, {"gamma"});
-  expectInvalid([&] { RandomWalk(g, 1, WalkBias::Temporal, 0.5, 3); }, {"start_state", "[0, 2]"});
-  RandomWalk w(g, 1);
-  expectInvalid([&] { w.next(3); }, {"target_state", "[-1, 2]"});
-  expectInvalid([&] { w.edgeProbabilities(360); }, {"node"});
 }
 
 TEST(FlowGraphImage, Figure4Marks) {

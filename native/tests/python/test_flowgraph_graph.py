@@ -129,6 +129,24 @@ def test_walks_are_seeded_and_reach_their_target(data):
         walk.next(5)
 
 
+def test_transition_hold_from_python(data):
+    """The transition state through the binding: a held walk keeps its transitions more than H
+    steps apart (the C++ tests check it at 10^5 steps), and a hold no state can keep is refused."""
+    _, cost = data
+    graph = _native.FlowGraph.build(cost, [40, 32], params())
+    walk = _native.RandomWalk(graph, 3, _native.WalkBias.UNIFORM, transition_hold=8)
+    assert walk.transition_hold == 8 and walk.hold_remaining == 0
+    nodes = np.concatenate([[walk.current], walk.run(np.full(3000, -1))])
+    states, steps = graph.node_states[nodes], graph.node_steps[nodes]
+    jumps = np.flatnonzero((states[1:] != states[:-1]) | (steps[1:] != steps[:-1] + 1))
+    assert jumps.size > 20 and np.diff(jumps).min() > 8
+    assert walk.temporal_run(0) >= 8
+    with pytest.raises(ValueError, match=r"transition_hold must be in \[0, 31\]"):
+        _native.RandomWalk(graph, 1, transition_hold=32)
+    with pytest.raises(ValueError, match="node"):
+        walk.temporal_run(72)
+
+
 def test_cost_matrix_image(data):
     _, cost = data
     graph = _native.FlowGraph.build(cost, [40, 32], params())
