@@ -124,6 +124,19 @@ void bindSynthesizer(py::module_& m) {
       "step() emitting node `node` of `file` (the pathline file of state `state`): from the cache "
       "of prepared groups (a hit, no copy) or read from the file (a miss, then cached). Keep one "
       "file per state: (state, node) is the cache key. Same particles with or without the cache.");
+  s.def_property(
+      "emitter_transform",
+      [](const Synthesizer& syn) {
+        DoubleArrayC a({4, 4});
+        const glm::mat4& m = syn.emitterTransform();
+        for (int row = 0; row < 4; ++row)
+          for (int col = 0; col < 4; ++col) a.mutable_at(row, col) = m[col][row];
+        return a;
+      },
+      [](Synthesizer& syn, const DoubleArrayC& m) { syn.setEmitterTransform(matrixArg(m, "emitter_transform")); },
+      "E, 4x4 row-major: the placement of the groups emitted from now on (the fire attached to a "
+      "moving object, §5.2's fire blade): they start at E x_0 and keep their pathlines' world-space "
+      "motion. Identity: where they were recorded. ValueError unless finite and affine.");
   s.def_property_readonly("cache_hits", [](const Synthesizer& syn) { return syn.cache().hits(); },
                           "step_node() calls that found their group in the cache.");
   s.def_property_readonly("cache_misses", [](const Synthesizer& syn) { return syn.cache().misses(); },

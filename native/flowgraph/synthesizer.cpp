@@ -54,6 +54,16 @@ void Synthesizer::checkGroup(const PathlineGroup& g) const {
     throw std::invalid_argument("pathline group arrays do not match its layout");
 }
 
+void Synthesizer::setEmitterTransform(const glm::mat4& placement) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(placement[c][r]))
+        throw std::invalid_argument("emitter transform must be finite");
+  if (placement[0][3] != 0.f || placement[1][3] != 0.f || placement[2][3] != 0.f || placement[3][3] != 1.f)
+    throw std::invalid_argument("emitter transform must be affine (last row 0, 0, 0, 1)");
+  mPlacement = placement;
+}
+
 void Synthesizer::step(const PathlineGroup& emitted, glm::vec3 externalVelocity) {
   checkGroup(emitted);
   ThreadLimit limit(mThreads);
@@ -152,7 +162,7 @@ void Synthesizer::advance(glm::vec3 uniform, const ExternalVelocity* field) {
     const glm::vec3* now = s.group->path.data() + age * std::size_t(P) + std::size_t(begin);
     const glm::vec3* next = now + P;
     glm::vec3* offset = s.fieldOffset.data() + begin;
-    for (int m = 0; m < n; ++m) x[m] = now[m] + s.uniformOffset + offset[m];
+    for (int m = 0; m < n; ++m) x[m] = now[m] + s.uniformOffset + offset[m] + placementOffset(s, begin + m);
     field->evaluate(x, n, t0, u0);
     for (int m = 0; m < n; ++m) x[m] += (next[m] - now[m]) + h * u0[m];
     field->evaluate(x, n, t0 + double(h), u1);
@@ -167,6 +177,8 @@ void Synthesizer::emit(std::shared_ptr<const PreparedGroup> g) {
   s.group = std::move(g);
   s.emittedAt = mSteps - 1;
   s.uniformOffset = glm::vec3(0.f);
+  s.placement = mPlacement;
+  s.placed = mPlacement != glm::mat4(1.f);
   if (s.hasField) std::fill(s.fieldOffset.begin(), s.fieldOffset.end(), glm::vec3(0.f));
 }
 
@@ -191,6 +203,7 @@ void Synthesizer::gather(SynthParticles& out) const {
     for (int p = begin; p < end; ++p) {
       glm::vec3 x = g.path[in + std::size_t(p)] + s.uniformOffset;
       if (s.hasField) x += s.fieldOffset[std::size_t(p)];
+      x += placementOffset(s, p);
       out.positions[at + std::size_t(p)] = x;
       out.density[at + std::size_t(p)] = g.density[in + std::size_t(p)];
       out.temperature[at + std::size_t(p)] = g.temperature[in + std::size_t(p)];

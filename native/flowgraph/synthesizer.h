@@ -83,6 +83,16 @@ class Synthesizer {
   /// anything changes.
   void stepNode(const PathlineFile& file, int node, int state, glm::vec3 externalVelocity = glm::vec3(0.f));
   void stepNode(const PathlineFile& file, int node, int state, const ExternalVelocity& field);
+  /// The placement of the groups emitted from now on (§5.2's fire attached to a moving object,
+  /// the paper's fire blade): an affine map E applied to the start positions x_0 of a group at
+  /// its emission; the particles then keep their pathline's world-space motion,
+  ///   x(a) = E x_0 + (path(a) − x_0) + ∫ u_ext,
+  /// so a moving source trails fire (each group stays where it was emitted) and a tilted one
+  /// still burns upwards. Identity by default (groups emitted where they were recorded). Throws
+  /// std::invalid_argument unless finite with a last row (0, 0, 0, 1).
+  void setEmitterTransform(const glm::mat4& placement);
+  const glm::mat4& emitterTransform() const { return mPlacement; }
+
   /// The cache stepNode() uses: its hits, misses (file reads) and bytes.
   const PreparedGroupCache& cache() const { return *mCache; }
 
@@ -106,7 +116,15 @@ class Synthesizer {
     glm::vec3 uniformOffset{0.f};          ///< ∫ of the uniform u_ext since emission
     std::vector<glm::vec3> fieldOffset;    ///< ∫ of field u_ext since emission, per particle
     bool hasField = false;
+    glm::mat4 placement{1.f};  ///< E at emission (setEmitterTransform())
+    bool placed = false;       ///< E is not the identity
   };
+  /// E x_0 − x_0 of particle p of slot s: what the placement adds to its pathline position.
+  static glm::vec3 placementOffset(const Slot& s, int p) {
+    if (!s.placed) return glm::vec3(0.f);
+    const glm::vec3 x0 = s.group->path[std::size_t(p)];
+    return glm::vec3(s.placement * glm::vec4(x0, 1.f)) - x0;
+  }
   void advance(glm::vec3 uniform, const ExternalVelocity* field);
   /// The group to emit at step `node` of `file`: cached, or read into mRead (nullptr: a miss).
   std::shared_ptr<const PreparedGroup> findOrRead(const PathlineFile& file, int node, int state);
@@ -128,6 +146,7 @@ class Synthesizer {
   std::vector<Slot> mSlots;  ///< ring of L: the group emitted at step n lives in slot n mod L
   long long mSteps = 0;
   glm::vec3 mExternal{0.f};  ///< the last step's uniform u_ext (a field's is not added)
+  glm::mat4 mPlacement{1.f};  ///< E for the next emissions
   std::shared_ptr<PreparedGroupCache> mCache;
   PathlineGroup mRead;                   ///< buffers of stepNode()'s file reads
   std::shared_ptr<PreparedGroup> mSpare;  ///< a prepared group no slot or cache references
