@@ -22,11 +22,13 @@ import numpy as np
 from . import cache, files
 from .settings import BakeError
 # Build Flow Graph's and Synthesize Fire's settings, also reachable as flowgraph.<name>.
-from .flowgraph_settings import (PREVIEW_POINTS_RANGE, TRAVERSALS, FlowGraphSettings,
-                                 SynthesisSettings, validate_graph_settings, validate_synthesis)
+from .flowgraph_settings import (PREVIEW_POINTS_RANGE, TRANSITION_HOLDS, TRAVERSALS,
+                                 FlowGraphSettings, SynthesisSettings, transition_hold_steps,
+                                 validate_graph_settings, validate_synthesis)
 
-__all__ = ["PREVIEW_POINTS_RANGE", "TRAVERSALS", "FlowGraphSettings", "SynthesisSettings",
-           "validate_graph_settings", "validate_synthesis"]
+__all__ = ["PREVIEW_POINTS_RANGE", "TRANSITION_HOLDS", "TRAVERSALS", "FlowGraphSettings",
+           "SynthesisSettings", "transition_hold_steps", "validate_graph_settings",
+           "validate_synthesis"]
 
 GRAPH_NAME = "flowgraph.npz"
 IMAGE_NAME = "flowgraph_cost.png"
@@ -43,6 +45,11 @@ def image_path(folder):
 
 def fire_path(folder, frame):
     return os.path.join(folder, FIRE_FOLDER, f"fire_{frame:04d}.vdb")
+
+
+def walk_path(folder):
+    """The walk of the last synthesis: fire/walk.npz (see SynthesisRunner.run)."""
+    return os.path.join(folder, FIRE_FOLDER, "walk.npz")
 
 
 def points_path(folder, frame):
@@ -337,6 +344,11 @@ class SynthesisResult:
     last_frame: int
     nodes_visited: List[int] = field(default_factory=list)
     transitions_taken: int = 0
+    transition_steps: List[int] = field(default_factory=list)  # node step of each transition
+    transition_hold: int = 0    # H, node steps (the transition state)
+    #: (frame, state) where a keyed target state could no longer be reached (the graph does not
+    #: lead back to it from where the walk was), or None
+    unreachable_target: Optional[Tuple[int, int]] = None
     cancelled: bool = False
     step_seconds: float = 0.0   # the walk, reading the groups and integrating eq. 13
     write_seconds: float = 0.0  # rasterizing the particles and writing the frame VDBs
@@ -346,11 +358,18 @@ class SynthesisResult:
 class SynthesisRunner:
     """Walks the graph (§5.1) and integrates the visited nodes' particles (§5.2, eq. 13), one
     node per node step, nodes_per_frame steps per frame; writes fire/fire_<frame>.vdb (density,
-    temperature, flame) after each frame, and fire/points_<frame>.npz with point_preview.
-    progress(done, total) and cancel() are optional."""
+    temperature, flame) after each frame, fire/points_<frame>.npz with point_preview, and at the
+    end fire/walk.npz: the node of every step (nodes, states, steps: node n's state and step in
+    it), the steps at which a transition led to a new time line (transitions), the hold H,
+    nodes_per_frame and frame_start (step k belongs to frame frame_start + k // nodes_per_frame)
+    and unreachable_target ((frame, state), or (-1, -1): see SynthesisResult).
+    progress(done, total) and cancel() are optional. After a transition the walk holds for
+    transition_hold_steps() node steps (the transition state of §5). With emitter_transforms
+    each node step's group is placed by its E (Synthesizer.emitter_transform: the fire source).
+    BakeError (naming `owner`) for a hold no state can keep or transforms of the wrong count."""
 
     def __init__(self, native, graph, states: List[State], settings: SynthesisSettings,
-                 out_folder, progress=None, cancel=None):
+                 out_folder, progress=None, cancel=None, owner="flow graph"):
         self.native, self.graph, self.states, self.s = native, graph, states, settings
         self.out_folder = out_folder
         self.progress, self.cancel = progress, cancel
@@ -360,11 +379,19 @@ class SynthesisRunner:
             voxel_size=float(f.cell_size), origin=tuple(f.origin),
             ignition_temperature=settings.ignition_temperature,
             max_temperature=settings.max_temperature)
+        self.hold = transition_hold_steps(settings, f.layout, self.steps_per_frame,
+                                          [(st.name, st.file.node_count) for st in states], owner)
         self.walk = native.RandomWalk(
             graph, int(settings.seed),
             bias=(native.WalkBias.TEMPORAL if settings.traversal == 'BIASED'
                   else native.WalkBias.UNIFORM),
-            gamma=float(settings.gamma), start_state=int(settings.start_state))
+            gamma=float(settings.gamma), start_state=int(settings.start_state),
+            transition_hold=self.hold)
+        self.placements = settings.emitter_transforms
+        steps = (settings.frame_end - settings.frame_start + 1) * self.steps_per_frame
+        if self.placements is not None and np.shape(self.placements) != (steps, 4, 4):
+            raise BakeError(f"Plume: {owner}: the fire source's transforms cover "
+                            f"{np.shape(self.placements)} node steps, not ({steps}, 4, 4)")
         self.node_states = np.asarray(graph.node_states)
         self.node_steps = np.asarray(graph.node_steps)
 
@@ -386,7 +413,8 @@ class SynthesisRunner:
         groups = session_cache(native, self.states, s.group_cache_mb)
         misses = groups.misses
         syn = native.Synthesizer(self.states[0].file.layout, 0, groups)
-        result = SynthesisResult(frame_start=s.frame_start, last_frame=s.frame_start - 1)
+        result = SynthesisResult(frame_start=s.frame_start, last_frame=s.frame_start - 1,
+                                 transition_hold=self.hold)
         fire_dir = os.path.join(self.out_folder, FIRE_FOLDER)
         os.makedirs(fire_dir, exist_ok=True)
         for name in os.listdir(fire_dir):  # frames of an older synthesis would mix in
@@ -400,15 +428,21 @@ class SynthesisRunner:
                 result.cancelled = True
                 break
             target = s.targets[i] if i < len(s.targets) else -1
+            if (target >= 0 and result.unreachable_target is None
+                    and self.walk.target_distance(node, target) < 0):
+                result.unreachable_target = (s.frame_start + i, target)
             wind = self.external_velocity(i)
             t0 = time.perf_counter()
-            for _ in range(self.steps_per_frame):
+            for j in range(self.steps_per_frame):
                 state = int(self.node_states[node])
+                if self.placements is not None:
+                    syn.emitter_transform = self.placements[i * self.steps_per_frame + j]
                 syn.step_node(self.states[state].file, int(self.node_steps[node]), state, wind)
                 result.nodes_visited.append(int(node))
                 nxt = self.walk.next(target)
                 if nxt != node + 1 or self.node_states[nxt] != state:
                     result.transitions_taken += 1
+                    result.transition_steps.append(len(result.nodes_visited))
                 node = nxt
             frame = s.frame_start + i
             t1 = time.perf_counter()
@@ -422,4 +456,14 @@ class SynthesisRunner:
             if self.progress is not None:
                 self.progress(i + 1, total)
         result.group_reads = groups.misses - misses
+        visited = np.asarray(result.nodes_visited, np.int64)
+        files.save_npz(walk_path(self.out_folder), nodes=visited.astype(np.int32),
+                       states=self.node_states[visited].astype(np.int32),
+                       steps=self.node_steps[visited].astype(np.int32),
+                       transitions=np.asarray(result.transition_steps, np.int64),
+                       transition_hold=np.int64(self.hold),
+                       nodes_per_frame=np.int64(self.steps_per_frame),
+                       frame_start=np.int64(s.frame_start),
+                       unreachable_target=np.asarray(result.unreachable_target or (-1, -1),
+                                                     np.int64))
         return result

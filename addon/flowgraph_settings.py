@@ -3,12 +3,16 @@ Synthesize Fire's (§5), and their validation (BakeError naming the setting)."""
 
 import math
 from dataclasses import dataclass, field
-from typing import List, Tuple
+from typing import List, Optional, Tuple
+
+import numpy as np
 
 from .ranges import RANGES
 from .settings import BakeError
 
 TRAVERSALS = ('UNIFORM', 'BIASED')
+#: The transition state of §5: hold for the pathlines' lifetime, for transition_hold_frames, or not.
+TRANSITION_HOLDS = ('LIFETIME', 'CUSTOM', 'OFF')
 #: Range of SynthesisSettings.preview_points (points per frame of the preview).
 PREVIEW_POINTS_RANGE = RANGES["flowgraph.preview_points"]
 
@@ -36,6 +40,8 @@ class SynthesisSettings:
     traversal: str = 'BIASED'   # UNIFORM: p = 1/d(V_i); BIASED: eq. 12 with γ
     gamma: float = 0.875        # γ of eq. 12
     start_state: int = 0
+    transition_hold: str = 'LIFETIME'   # TRANSITION_HOLDS
+    transition_hold_frames: float = 1.0  # with 'CUSTOM'
     targets: List[int] = field(default_factory=list)
     winds: List[Tuple[float, float, float]] = field(default_factory=list)
     ignition_temperature: float = 1.0
@@ -45,6 +51,9 @@ class SynthesisSettings:
     #: also write fire/points_<frame>.npz: at most preview_points live particles per frame
     point_preview: bool = False
     preview_points: int = 20000
+    #: E per node step (frame f's steps at (f - frame_start) * nodes_per_frame ...): the fire
+    #: source's transform relative to its pose at frame_start, (K, 4, 4); None: no fire source
+    emitter_transforms: Optional[np.ndarray] = None
     #: MB of prepared pathline groups the native Synthesizer keeps between visits of the walk
     #: (least recently used out); 0 reads every visit from its file
     group_cache_mb: int = 2048
@@ -64,6 +73,27 @@ def validate_graph_settings(s: FlowGraphSettings, owner):
             raise BakeError(f"Plume: {owner}: {name} must be >= 0 (got {v})")
 
 
+def transition_hold_steps(s: SynthesisSettings, layout, nodes_per_frame, state_nodes, owner):
+    """H of the transition state in node steps: the pathlines' lifetime L ('LIFETIME'),
+    transition_hold_frames x nodes per frame ('CUSTOM', rounded) or 0 ('OFF'). BakeError when
+    no state is long enough to keep it: a hold must end inside the shortest state's bake
+    (state_nodes: (name, node count) per state)."""
+    if s.transition_hold == 'OFF':
+        return 0
+    hold = (int(layout.samples) if s.transition_hold == 'LIFETIME'
+            else int(round(s.transition_hold_frames * nodes_per_frame)))
+    name, nodes = min(state_nodes, key=lambda sn: sn[1])
+    if hold > nodes - 1:
+        what = ("the pathline lifetime" if s.transition_hold == 'LIFETIME'
+                else f"Hold Frames {s.transition_hold_frames:g}")
+        raise BakeError(f"Plume: {owner}: Transition Hold ({what} = {hold} node steps, "
+                        f"{hold / nodes_per_frame:.2f} frames) is longer than the bake of state "
+                        f"'{name}' ({nodes} node steps): choose at most "
+                        f"{(nodes - 1) / nodes_per_frame:.2f} Hold Frames, or bake the states "
+                        "longer")
+    return hold
+
+
 def validate_synthesis(s: SynthesisSettings, state_count, owner):
     if s.frame_end < s.frame_start:
         raise BakeError(f"Plume: {owner}: synthesis frame_end must be >= frame_start "
@@ -72,6 +102,13 @@ def validate_synthesis(s: SynthesisSettings, state_count, owner):
         raise BakeError(f"Plume: {owner}: traversal must be one of {', '.join(TRAVERSALS)}")
     if not (0.0 < s.gamma < 1.0):
         raise BakeError(f"Plume: {owner}: gamma (γ) must be in (0, 1) (got {s.gamma})")
+    if s.transition_hold not in TRANSITION_HOLDS:
+        raise BakeError(f"Plume: {owner}: transition_hold must be one of "
+                        f"{', '.join(TRANSITION_HOLDS)} (got {s.transition_hold!r})")
+    if s.transition_hold == 'CUSTOM' and not (math.isfinite(s.transition_hold_frames)
+                                              and s.transition_hold_frames >= 0.0):
+        raise BakeError(f"Plume: {owner}: Hold Frames (transition_hold_frames) must be >= 0 "
+                        f"(got {s.transition_hold_frames})")
     if not (0 <= s.start_state < state_count):
         raise BakeError(f"Plume: {owner}: start_state must be in [0, {state_count - 1}] "
                         f"(got {s.start_state})")

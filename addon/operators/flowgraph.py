@@ -16,8 +16,9 @@ from ..build import fire_points, fire_volume
 from ..jobs import JobOperator, JobProgress, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
-from ..snapshot.flowgraph import (frame_inputs, graph_settings,  # noqa: F401  (scripts)
-                                 state_domains, synthesis_settings)
+from ..snapshot.flowgraph import (fire_source, frame_inputs,  # noqa: F401  (scripts)
+                                 graph_settings, source_transforms, state_domains,
+                                 synthesis_settings)
 from .bake import domain_key
 
 #: Image datablock showing the cost matrix (Figure 4) in the panel.
@@ -132,12 +133,19 @@ class SynthesisJob(JobRunner):
         graph, states = flowgraph.load_graph(_native, folder, owner)
         settings = synthesis_settings(domain)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)
+        source = fire_source(domain, owner)
+        steps_per_frame = int(states[0].file.nodes_per_frame)
+        flowgraph.transition_hold_steps(settings, states[0].file.layout, steps_per_frame,
+                                        [(st.name, st.file.node_count) for st in states], owner)
         settings.targets, settings.winds, settings.turbulence = frame_inputs(
             context, domain, settings.frame_start, settings.frame_end)
+        if source is not None:
+            settings.emitter_transforms = source_transforms(
+                context, source, settings.frame_start, settings.frame_end, steps_per_frame)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)
         self.synthesis = flowgraph.SynthesisRunner(_native, graph, states, settings, folder,
                                                    progress=self._frame_done,
-                                                   cancel=lambda: self.cancelled)
+                                                   cancel=lambda: self.cancelled, owner=owner)
         self.settings, self.states = settings, states
         self.set_progress(0, settings.frame_end - settings.frame_start + 1, "frame")
 
@@ -165,9 +173,17 @@ class SynthesisJob(JobRunner):
                                      settings.max_temperature)
         else:
             fire_points.remove_object(domain)
-        return 'INFO', (f"Plume: synthesized {frames} frames of fire into '{ob.name}' "
-                        f"({len(result.nodes_visited)} nodes, {result.transitions_taken} "
-                        f"transitions, {time.perf_counter() - self.t0:.1f} s)")
+        text = (f"Plume: synthesized {frames} frames of fire into '{ob.name}' "
+                f"({len(result.nodes_visited)} nodes, {result.transitions_taken} transitions, "
+                f"held {result.transition_hold} node steps after each, "
+                f"{time.perf_counter() - self.t0:.1f} s)")
+        if result.unreachable_target is not None:
+            frame, state = result.unreachable_target
+            return 'WARNING', (f"{text}; from frame {frame} the keyed Target State {state} "
+                               "could not be reached: the flow graph does not lead back to it "
+                               "from where the walk was. Build the graph with a smaller Block "
+                               "Size or a larger ε, or bake longer states")
+        return 'INFO', text
 
     def error_text(self, exc):
         if isinstance(exc, BakeError):

@@ -4,7 +4,7 @@ Soft limits only: the operators validate with messages naming the setting and it
 
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
-                       IntProperty, StringProperty)
+                       IntProperty, PointerProperty, StringProperty)
 
 from ..ranges import RANGES
 
@@ -44,6 +44,26 @@ class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
     gamma: FloatProperty(name="γ", default=0.875, min=0.0, max=1.0,
                          description="γ of eq. 12: probability of following the temporal edge; "
                                      "in (0, 1)")
+    transition_hold: EnumProperty(
+        name="Transition Hold", default='LIFETIME',
+        items=(('LIFETIME', "Lifetime", "After a transition, follow the simulation (temporal "
+                                        "edges only) until the particles emitted before it have "
+                                        "died, t_max: the paper's transition state (§5)"),
+               ('CUSTOM', "Custom", "Hold for Hold Frames after each transition"),
+               ('OFF', "Off", "A transition may follow another at any node step (§5.1 alone)")),
+        description="The transition state of §5: after a transition the walk holds to the "
+                    "simulation's time line, so the old particles never mix with a second jump")
+    transition_hold_frames: FloatProperty(
+        name="Hold Frames", default=1.0, min=0.0, soft_max=100.0,
+        description="Frames the walk holds after a transition (Custom); less than the shortest "
+                    "state's bake")
+    fire_source: PointerProperty(
+        name="Fire Source", type=bpy.types.Object,
+        description="A mesh the synthesized fire is attached to (the paper's fire blade): each "
+                    "pathline group is emitted in this object's transform at its emission time, "
+                    "relative to its pose at the first synthesized frame, and then rises in "
+                    "world space, so a moving object trails fire. Empty: the fire burns where it "
+                    "was baked")
     start_state: IntProperty(name="Start State", default=0, min=0,
                              description="The walk starts at node 0 of this state")
     target_state: IntProperty(

@@ -5,7 +5,7 @@ records, the states and settings of Build Flow Graph, and the settings and per-f
 import numpy as np
 
 from .. import flowgraph
-from ..settings import PathlineSettings
+from ..settings import BakeError, PathlineSettings
 from .scene import from_properties
 
 
@@ -37,6 +37,8 @@ def synthesis_settings(domain):
     return flowgraph.SynthesisSettings(
         frame_start=int(g.frame_start), frame_end=int(g.frame_end), seed=int(g.seed),
         traversal=g.traversal, gamma=float(g.gamma), start_state=int(g.start_state),
+        transition_hold=g.transition_hold,
+        transition_hold_frames=float(g.transition_hold_frames),
         max_temperature=float(d.max_temperature),
         point_preview=bool(g.point_preview), preview_points=int(g.preview_points),
         group_cache_mb=int(g.group_cache))
@@ -71,3 +73,42 @@ def frame_inputs(context, domain, frame_start, frame_end):
     finally:
         scene.frame_set(current, subframe=subframe)
     return targets, winds, turbulence
+
+
+def fire_source(domain, owner):
+    """The flow graph's Fire Source object (the paper's fire blade), or None. BakeError when it is
+    not a mesh."""
+    ob = domain.plume.domain.flowgraph.fire_source
+    if ob is None:
+        return None
+    if ob.type != 'MESH':
+        raise BakeError(f"Plume: {owner}: Fire Source '{ob.name}' must be a mesh (its type is "
+                        f"{ob.type}): choose a mesh object, the fire is attached to it, or clear "
+                        "the setting")
+    return ob
+
+
+def source_transforms(context, ob, frame_start, frame_end, steps_per_frame):
+    """E of every node step of the synthesis, (K, 4, 4) row-major: the object's world matrix at
+    the step's time relative to its pose at frame_start, M(t) M(frame_start)^-1. Frame f's S
+    steps run from f - 1 + 1/S to f (the frame written after its last step), each evaluated at
+    its subframe, so any animation (keys, constraints, parents) is followed. The current frame
+    is restored."""
+    scene = context.scene
+    current, subframe = scene.frame_current, scene.frame_subframe
+    s = int(steps_per_frame)
+    out = np.empty(((frame_end - frame_start + 1) * s, 4, 4), np.float64)
+    try:
+        scene.frame_set(frame_start)
+        rest = np.linalg.inv(np.array(ob.matrix_world, dtype=np.float64))
+        for i, f in enumerate(range(frame_start, frame_end + 1)):
+            for j in range(s):
+                t = (j + 1) / s  # step j of frame f happens at f - 1 + t
+                if t >= 1.0:
+                    scene.frame_set(f)
+                else:
+                    scene.frame_set(f - 1, subframe=t)
+                out[i * s + j] = np.array(ob.matrix_world, dtype=np.float64) @ rest
+    finally:
+        scene.frame_set(current, subframe=subframe)
+    return out

@@ -319,8 +319,13 @@ class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
         row = col.row(align=True)
         row.prop(g, "frame_start")
         row.prop(g, "frame_end")
-        for name in ("seed", "traversal", "gamma", "start_state", "target_state", "wind",
-                     "use_force_fields", "point_preview"):
+        for name in ("seed", "traversal", "gamma", "transition_hold"):
+            col.prop(g, name)
+        sub = col.column()
+        sub.active = g.transition_hold == 'CUSTOM'
+        sub.prop(g, "transition_hold_frames")
+        for name in ("start_state", "target_state", "fire_source", "wind", "use_force_fields",
+                     "point_preview"):
             col.prop(g, name)
         sub = col.column()
         sub.active = g.point_preview

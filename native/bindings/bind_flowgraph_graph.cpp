@@ -268,6 +268,17 @@ void bindWalk(py::module_& m) {
   w.def_property_readonly("forced_transitions", &RandomWalk::forcedTransitions,
                           "Transitions taken inside a hold (the node had no temporal edge nor long transition).");
   w.def(
+      "target_distance",
+      [](const RandomWalk& walk, int node, int state) {
+        if (node < 0 || node >= walk.graph().nodeCount())
+          throw py::value_error("node must be in [0, " + std::to_string(walk.graph().nodeCount() - 1) + "]");
+        if (state < 0 || state >= walk.graph().stateCount())
+          throw py::value_error("state must be in [0, " + std::to_string(walk.graph().stateCount() - 1) + "]");
+        return walk.targetDistance(node, state);
+      },
+      py::arg("node"), py::arg("state"),
+      "Fewest edges from node to the nodes of `state` a walk can stay in (-1: unreachable).");
+  w.def(
       "temporal_run",
       [](const RandomWalk& walk, int node) {
         if (node < 0 || node >= walk.graph().nodeCount())

@@ -8,6 +8,7 @@
 #include "flowgraph/flow_graph.h"
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace plume {
@@ -28,8 +29,9 @@ enum class WalkBias {
 /// apart. To make the hold possible, a free step also drops the transitions into a node whose
 /// temporal run (the temporal edges that follow it) is shorter than H, whenever the node has
 /// another edge; eq. 12 and the target rule then apply to the edges left (d(V_i) counts them).
-/// Only a node without temporal edge whose every transition is short forces an early transition
-/// (counted by forcedTransitions()).
+/// Only a node without temporal edge whose every transition is short, a target state reachable
+/// through short transitions only, or a time line that would leave the target state's goal
+/// (see edgeProbabilities()) forces an early transition (counted by forcedTransitions()).
 class RandomWalk {
  public:
   /// Starts at the first node of `startState` (§5.1 "starting at node k = 0"). Throws
@@ -47,6 +49,12 @@ class RandomWalk {
   int holdRemaining() const { return mHoldLeft; }
   /// Transitions taken while holding, because the node had no temporal edge nor long transition.
   long long forcedTransitions() const { return mForced; }
+  /// δ(node) for target state `state`: the fewest edges to W' (see edgeProbabilities()), −1
+  /// where W' cannot be reached.
+  int targetDistance(int node, int state) const {
+    const int d = mDistance[std::size_t(state)][std::size_t(node)];
+    return d == std::numeric_limits<int>::max() ? -1 : d;
+  }
   /// Temporal edges that follow `node` before its state's time line ends (or is pruned).
   int temporalRun(int node) const { return mRun[std::size_t(node)]; }
 
@@ -55,15 +63,22 @@ class RandomWalk {
 
   /// Probability of each out-edge of `node` (in FlowGraph::outEdges order) for a free step (not
   /// holding; with a hold, short transitions are dropped first, see the class comment) when
-  /// steering to `targetState` (−1: none). With a target state W (§5.1): if some edge leads into W, those
-  /// edges share the probability uniformly (p = 1/k, k edges into W), otherwise the biased rule
-  /// below applies. Plume narrows "into W" to the nodes of W from which a walk can stay in W
-  /// forever (FlowGraph::staysInState) whenever such an edge exists, so that "once a target
-  /// state is reached, the traversal will remain there" holds on any graph: from such a node an
-  /// edge to another one always exists. Without a target: WalkBias::Uniform gives 1/d(V_i);
-  /// WalkBias::Temporal gives eq. 12 (γ on the temporal edge, (1 − γ)/(d − 1) on the others;
-  /// d = 1 gives 1; a node without temporal edge, e.g. the last of its state, shares 1
-  /// uniformly among its transitions).
+  /// steering to `targetState` (−1: none).
+  ///
+  /// Target state W (§5.1: "the edge probabilities are computed depending on how far the
+  /// current visited node is from the target state"). The goal is W' = the nodes of W from which
+  /// a walk can stay in W forever (FlowGraph::staysInState; all of W if none can), so that "once
+  /// a target state is reached, the traversal will remain there" holds on any graph. With
+  /// δ(n) the fewest edges from n to W': outside W' the walk takes, uniformly, one of the edges
+  /// on a shortest path (δ(to) = δ(node) − 1), so it reaches W' in δ steps wherever it starts
+  /// (taking only edges straight into W, a walk can wander for ever in a part of the graph
+  /// whose exits to W are several edges away); inside W' it takes the edges that stay in W'
+  /// (δ = 0) with the bias below (eq. 12 or uniform) among them. Where W cannot be reached
+  /// (δ = ∞), the target is ignored.
+  ///
+  /// Without a target: WalkBias::Uniform gives 1/d(V_i); WalkBias::Temporal gives eq. 12 (γ on
+  /// the temporal edge, (1 − γ)/(d − 1) on the others; d = 1 gives 1; a node without temporal
+  /// edge, e.g. the last of its state, shares 1 uniformly among its transitions).
   std::vector<double> edgeProbabilities(int node, int targetState = -1) const;
 
   /// Follows one edge drawn with edgeProbabilities(current(), targetState), or the temporal edge
@@ -73,6 +88,12 @@ class RandomWalk {
 
  private:
   void probabilities(int node, int targetState, std::vector<double>& p) const;
+  /// Eq. 12 (or uniform) over the edges `take` admits: the others get 0.
+  template <class Take>
+  void biased(const FlowGraph::EdgeRange& edges, const Take& take, std::vector<double>& p) const;
+  /// False when a held step from → to would leave the target's goal W' or put it out of reach:
+  /// the hold then ends early (a forced transition), since the artist's key comes first.
+  bool keepsTarget(int from, int to, int targetState) const;
   /// False for an edge a free step drops under the hold (a transition with a short run).
   bool longEnough(const FlowEdge& e) const { return e.temporal || mRun[std::size_t(e.to)] >= mHold; }
 
@@ -85,6 +106,8 @@ class RandomWalk {
   int mHoldLeft = 0;
   long long mForced = 0;
   std::vector<int> mRun;  ///< temporalRun() of every node
+  /// δ of every node to the goal W' of each target state (kFar where W' cannot be reached).
+  std::vector<std::vector<int>> mDistance;
   std::vector<double> mScratch;
 };
 

@@ -149,6 +149,29 @@ TEST(FlowGraphWalk, TransitionStateStillReachesTheTarget) {
   EXPECT_EQ(walk.forcedTransitions(), 0);
 }
 
+TEST(FlowGraphWalk, TargetIsReachedAlongAShortestPath) {
+  // §5.1: the probabilities depend on how far the node is from the target state. Steered,
+  // every step brings the walk one edge nearer: it reaches W' in exactly δ(start) steps, from
+  // wherever an unsteered walk left it (200 trials, each target state).
+  const FlowGraph g = walkGraph();
+  RandomWalk walk(g, 11, WalkBias::Temporal, 0.875, 0);
+  int far = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    for (int k = 0; k < 37; ++k) walk.next();
+    const int target = trial % 3;
+    const int start = walk.current();
+    const int delta = walk.targetDistance(start, target);
+    ASSERT_GE(delta, 0);
+    far = std::max(far, delta);
+    for (int k = 0; k < delta; ++k) {
+      walk.next(target);
+      EXPECT_EQ(walk.targetDistance(walk.current(), target), delta - k - 1);
+    }
+    EXPECT_EQ(g.state(walk.current()), target);
+  }
+  EXPECT_GE(far, 2);  // some starts were more than one edge away
+}
+
 TEST(FlowGraphWalk, TemporalRuns) {
   const FlowGraph g = walkGraph();
   RandomWalk walk(g, 1);
