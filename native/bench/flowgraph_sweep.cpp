@@ -5,8 +5,10 @@
 ///   files of 100 nodes per state; wall seconds of each part, the peak resident set, reads;
 /// - "synthesis": one frame of synthesis, i.e. nodes_per_frame = 2 node steps (step_node from a
 ///   file, prepared groups cached as in the add-on) + gathering the live particles +
-///   rasterizing them into VDB grids at Δx = 1/48 m, on fire-like groups (bench_fire_groups.h)
-///   with a full ring of L live groups; it does not depend on N;
+///   rasterizing them into VDB grids at the cell size 1/n of the matching simulation below, on
+///   fire-like groups (bench_fire_groups.h: a 1 m burner, flames up to 2.5 m, so more voxels
+///   than the simulated 1 m box: the comparison favours simulation) with a full ring of L live
+///   groups; it does not depend on N;
 /// - "simulation": one simulated frame of the fire that would record |Ω| seeds per node step: a
 ///   burner of s × s × 2 cells (8 seeds a cell, s = round(√(|Ω|/16))) in an n³ grid with
 ///   n = round(s / 0.22) (the burner covers the same share of the floor), after sim_warmup
@@ -34,6 +36,7 @@
 #include <exception>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace plume::bench {
@@ -118,6 +121,12 @@ void build(const Options& o, const std::vector<PathlineFile>& files, int states,
   std::fflush(stdout);
 }
 
+/// The burner side s and grid n of the fire that records about `pathlines` seeds a node step.
+std::pair<int, int> matchingFire(int pathlines) {
+  const int side = std::max(1, int(std::lround(std::sqrt(pathlines / 16.0))));
+  return {side, int(std::lround(side / 0.22))};
+}
+
 /// One synthesized frame: kNodesPerFrame node steps, gather, rasterize (mean of o.frames).
 void synthesis(const Options& o, int pathlines) {
   const std::vector<PathlineGroup> groups = fireGroups(8, pathlines, o.samples, kNodeDt);
@@ -137,7 +146,7 @@ void synthesis(const Options& o, int pathlines) {
   int n = 0;
   for (; n < 2 * o.samples; ++n) s.stepNode(file, n % 8, 0, glm::vec3(0.2f, 0.f, 0.f));  // a full ring
   FireRasterParams raster;
-  raster.voxelSize = 1.f / 48.f;
+  raster.voxelSize = 1.f / float(matchingFire(pathlines).second);
   raster.threads = o.threads;
   SynthParticles out;
   double step = 0.0, gather = 0.0, rasterize = 0.0;
@@ -157,16 +166,16 @@ void synthesis(const Options& o, int pathlines) {
   const double f = double(o.frames);
   std::printf(
       "{\"kind\": \"synthesis\", \"pathlines\": %d, \"samples\": %d, \"nodes_per_frame\": %d, "
-      "\"particles\": %zu, \"step_s\": %.5f, \"gather_s\": %.5f, \"raster_s\": %.5f, \"frame_s\": %.5f}\n",
-      pathlines, o.samples, kNodesPerFrame, out.size(), step / f, gather / f, rasterize / f,
+      "\"particles\": %zu, \"voxel_size\": %.5g, \"step_s\": %.4g, \"gather_s\": %.4g, \"raster_s\": %.4g, "
+      "\"frame_s\": %.4g}\n",
+      pathlines, o.samples, kNodesPerFrame, out.size(), double(raster.voxelSize), step / f, gather / f, rasterize / f,
       (step + gather + rasterize) / f);
   std::fflush(stdout);
 }
 
 /// One simulated frame of the fire recording about `pathlines` seeds per node step.
 void simulation(const Options& o, int pathlines) {
-  const int side = std::max(1, int(std::lround(std::sqrt(pathlines / 16.0))));
-  const int n = int(std::lround(side / 0.22));
+  const auto [side, n] = matchingFire(pathlines);
   SmokeSolver solver(testing::fireParams(n, o.threads));
   solver.addSource(testing::fireBurner(n, side), testing::fireFuel());
   for (int f = 0; f < o.simWarmup; ++f) solver.advanceFrame();

@@ -171,8 +171,8 @@ void bindParams(py::module_& m) {
         }
         return py::make_tuple(costArray(c), statsDict(stats));
       },
-      py::arg("files"), py::arg("params") = FlowGraphParams(), py::arg("row_block_mb") = 512.0,
-      py::arg("column_nodes") = 64,
+      py::arg("files"), py::arg("params") = FlowGraphParams(), py::arg("row_block_mb") = 600.0,
+      py::arg("column_nodes") = 32,
       "(C, stats): cost_matrix() of every group of the states' PathlineFiles (in state order), the "
       "same bits, streamed: rows in blocks of row_block_mb, columns in blocks of column_nodes. "
       "stats: row_nodes, column_nodes, group_reads, read_seconds, seconds.");
@@ -200,8 +200,8 @@ void bindJob(py::module_& m) {
         job->params = params;
         return job;
       },
-      py::arg("files"), py::arg("params") = FlowGraphParams(), py::arg("row_block_mb") = 512.0,
-      py::arg("column_nodes") = 64,
+      py::arg("files"), py::arg("params") = FlowGraphParams(), py::arg("row_block_mb") = 600.0,
+      py::arg("column_nodes") = 32,
       "A job streaming the groups of the states' PathlineFiles (see cost_matrix_of_files).");
   j.def(
       "run",

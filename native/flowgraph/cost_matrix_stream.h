@@ -14,15 +14,19 @@ namespace plume {
 
 /// How many groups the streamed build holds. Rows are taken in blocks of R nodes (held while
 /// every column after them streams past in blocks of `columnNodes`): each group is read once
-/// as a row and about (its index) / R times as a column, N + N²/(2R) reads in all, holding
-/// R + columnNodes groups (5 |Ω| L floats each).
+/// as a row and once per row block before it as a column, about N + N²/(2R) reads in all,
+/// holding R + columnNodes groups (5 |Ω| L floats each). For a given memory, a tall row block
+/// and a narrow column block read least. Measured at N = 1,000, |Ω| = 3,200, L = 48 (3.1 MB a
+/// group, 2 threads, a loaded 2-core machine): R = 160 and 64 columns held 712 MB at peak and
+/// spent 14% of the build reading 3,640 groups; the defaults hold as many groups (224) as that
+/// and read 3,120 (see examples/flowgraph_fire/README.md for the figures).
 struct CostStreamParams {
   /// Bytes for the row block: R = the largest multiple of kCostTile groups that fits (at least
-  /// kCostTile). 512 MiB holds R = 160 groups of |Ω| = 3,200 × L = 48.
-  std::size_t rowBlockBytes = std::size_t(512) << 20;
-  /// Column block, a multiple of kCostTile (rounded up): 64 groups give (R/32)·2 tasks per
-  /// block, enough to keep two threads busy; more only adds memory.
-  int columnNodes = 64;
+  /// kCostTile). 600 MiB holds R = 192 groups of |Ω| = 3,200 × L = 48.
+  std::size_t rowBlockBytes = std::size_t(600) << 20;
+  /// Column block, rounded up to a multiple of kCostTile: 32 groups give R/32 tasks per block
+  /// (6 at R = 192), enough for two threads; wider blocks only add memory.
+  int columnNodes = 32;
 };
 
 /// What a streamed build did (for benchmarks and reports).
