@@ -16,6 +16,8 @@
 /// build holds no group before it starts (the in-memory groups are freed first) and reports
 /// group_reads, read_share (the wall-time share spent reading groups) and weights_s (α, β of
 /// eq. 9 streamed the same way, two passes). BM_GraphBuild times FlowGraph::build on a ready C.
+/// For a clean peak run each in its own process (--benchmark_filter=BM_CostMatrixStreamed/1000/2):
+/// memory freed by an earlier benchmark may stay with the allocator and count as resident.
 
 #include "bench/bench_memory.h"
 #include "bench/flowgraph_sweep.h"
