@@ -192,21 +192,20 @@ def _params(native, s: FlowGraphSettings, alpha, beta):
 def cost_matrix(native, states: List[State], s: FlowGraphSettings,
                 on_job: Optional[Callable[[object], None]] = None):
     """C of eq. 9-10 over every group of every state, state by state: (cost, node counts per
-    state, FlowGraphParams with the weights α, β). BakeError on bad settings. on_job receives the
-    native CostMatrixJob before it runs (another thread may read its progress or cancel it)."""
-    groups = []
-    for index, st in enumerate(states):
-        groups.extend(st.file.read_group(k, index) for k in range(st.file.node_count))
+    state, FlowGraphParams with the weights α, β). BakeError on bad settings. The groups are
+    streamed from the states' pathline files (a bounded number in memory, never all of them).
+    on_job receives the native CostMatrixJob before it runs (another thread may read its
+    progress or cancel it)."""
+    pathline_files = [st.file for st in states]
     counts = [st.file.node_count for st in states]
-    alpha, beta = ((native.same_magnitude_weights(groups)) if s.auto_weights
+    alpha, beta = ((native.same_magnitude_weights_of_files(pathline_files)) if s.auto_weights
                    else (s.alpha, s.beta))
     try:
         params = _params(native, s, alpha, beta)
         params.validate()
-        job = native.CostMatrixJob(groups, params)
+        job = native.CostMatrixJob.of_files(pathline_files, params)
     except ValueError as e:
         raise BakeError(f"Plume: flow graph: {e}") from None
-    del groups  # the job holds them
     if on_job is not None:
         on_job(job)
     if not job.run():

@@ -9,6 +9,7 @@
 // - VDB rasterization of those ~150k particles per frame, timed separately;
 // - the pathline recorder's cost per solver step of a 64³ fire bake (3,200 seeds, L = 48).
 // Run: build/native/plume_bench_flowgraph
+#include "bench/bench_fire_groups.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "fields/fire_raster.h"
@@ -33,35 +34,6 @@ constexpr int kParticles = 3200;
 constexpr int kSamples = 48;
 constexpr float kNodeDt = 1.f / 48.f;
 
-/// Fire-like groups: seeds on a 1 m burner square at the bottom of a 2 m box, rising at 0.5 to
-/// 2.5 m/s with a swirl, density and temperature fading over the lifetime.
-std::vector<PathlineGroup> fireGroups(int count) {
-  const PathlineLayout layout{kParticles, kSamples, kNodeDt};
-  std::vector<PathlineGroup> groups(static_cast<std::size_t>(count));
-  Rng rng(9);
-  for (int k = 0; k < count; ++k) {
-    PathlineGroup& g = groups[std::size_t(k)];
-    g.step = k;
-    g.layout = layout;
-    g.start.resize(kParticles);
-    g.velocity.resize(layout.values());
-    g.density.resize(layout.values());
-    g.temperature.resize(layout.values());
-    for (int p = 0; p < kParticles; ++p) {
-      g.start[std::size_t(p)] = glm::vec3(0.5f + float(rng.uniform()), 0.5f + float(rng.uniform()), 0.05f);
-      const float rise = 0.5f + 2.f * float(rng.uniform()), phase = 6.28f * float(rng.uniform());
-      for (int s = 0; s < kSamples; ++s) {
-        const float t = float(s) * kNodeDt, life = 1.f - float(s) / kSamples;
-        const std::size_t i = g.index(p, s);
-        g.velocity[i] = glm::vec3(0.4f * std::cos(phase + 5.f * t), 0.4f * std::sin(phase + 5.f * t), rise);
-        g.density[i] = life;
-        g.temperature[i] = 4.f * life * life;
-      }
-    }
-  }
-  return groups;
-}
-
 /// u_ext = wind + a gentle shear, evaluated per particle (the field path of eq. 13).
 struct GustField final : ExternalVelocity {
   void evaluate(const glm::vec3* x, int n, double t, glm::vec3* out) const override {
@@ -71,7 +43,7 @@ struct GustField final : ExternalVelocity {
 };
 
 const std::vector<PathlineGroup>& groups() {
-  static const std::vector<PathlineGroup> g = fireGroups(8);
+  static const std::vector<PathlineGroup> g = bench::fireGroups(8, kParticles, kSamples, kNodeDt);
   return g;
 }
 

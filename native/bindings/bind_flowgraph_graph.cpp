@@ -9,13 +9,16 @@
 
 #include "flowgraph/cost_matrix.h"
 #include "flowgraph/cost_matrix_image.h"
+#include "flowgraph/cost_matrix_stream.h"
 #include "flowgraph/flow_graph.h"
+#include "flowgraph/magnitude_weights.h"
 #include "flowgraph/random_walk.h"
 
 #include <pybind11/stl.h>
 
 #include <algorithm>
 #include <cstring>
+#include <memory>
 
 namespace py = pybind11;
 
@@ -32,6 +35,39 @@ std::vector<const PathlineGroup*> groupPointers(const py::sequence& groups) {
     p.push_back(&groups[n].cast<const PathlineGroup&>());
   }
   return p;
+}
+
+/// A Python sequence of PathlineFile, one per state in order, as NodeFiles (the sequence must
+/// outlive its use). ValueError on other items or what NodeFiles() rejects.
+NodeFiles nodeFiles(const py::sequence& files) {
+  std::vector<const PathlineFile*> p;
+  for (std::size_t n = 0; n < py::len(files); ++n) {
+    if (!py::isinstance<PathlineFile>(files[n]))
+      throw py::value_error("files[" + std::to_string(n) + "] is not a PathlineFile");
+    p.push_back(&files[n].cast<const PathlineFile&>());
+  }
+  return NodeFiles(std::move(p));
+}
+
+/// CostStreamParams from row_block_mb and column_nodes (ValueError out of range).
+CostStreamParams streamParams(double rowBlockMb, int columnNodes) {
+  if (!(rowBlockMb >= 1.0 && rowBlockMb <= 1048576.0))
+    throw py::value_error("row_block_mb must be in [1, 1048576] MB (got " + std::to_string(rowBlockMb) + ")");
+  CostStreamParams s;
+  s.rowBlockBytes = std::size_t(rowBlockMb * 1048576.0);
+  s.columnNodes = columnNodes;
+  return s;
+}
+
+/// CostStreamStats as a dict.
+py::dict statsDict(const CostStreamStats& s) {
+  py::dict d;
+  d["row_nodes"] = s.rowNodes;
+  d["column_nodes"] = s.columnNodes;
+  d["group_reads"] = s.groupReads;
+  d["read_seconds"] = s.readSeconds;
+  d["seconds"] = s.seconds;
+  return d;
 }
 
 /// An (N, N) float64 array as a checked CostMatrix (ValueError otherwise).
@@ -52,10 +88,14 @@ py::array_t<double> costArray(const CostMatrix& c) {
   return a;
 }
 
-/// computeCostMatrix() run by a worker thread while another polls progress or cancels.
+/// computeCostMatrix() run by a worker thread while another polls progress or cancels: from
+/// PathlineGroups in memory, or streamed from the states' PathlineFiles (`files` set).
 struct CostMatrixJob {
-  py::object groups;  // keeps the PathlineGroups alive
+  py::object groups;  // keeps the PathlineGroups or PathlineFiles alive
   std::vector<const PathlineGroup*> pointers;
+  std::unique_ptr<NodeFiles> files;
+  CostStreamParams stream;
+  CostStreamStats stats;
   FlowGraphParams params;
   CostMatrixProgress progress;
   CostMatrix cost;
@@ -94,6 +134,17 @@ void bindParams(py::module_& m) {
       "(alpha, beta) of eq. 9 bringing the mean squared differences of velocity, density and "
       "temperature over all pairs of groups to the same magnitude (§4.3).");
   m.def(
+      "same_magnitude_weights_of_files",
+      [](const py::sequence& files, int threads) {
+        const NodeFiles nodes = nodeFiles(files);
+        py::gil_scoped_release release;
+        const FlowWeights w = sameMagnitudeWeights(nodes, threads);
+        return std::make_pair(w.alpha, w.beta);
+      },
+      py::arg("files"), py::arg("threads") = 0,
+      "same_magnitude_weights() of every group of the states' PathlineFiles (in state order), "
+      "the same bits, reading 32 groups at a time (two passes).");
+  m.def(
       "cost_matrix",
       [](const py::sequence& groups, const FlowGraphParams& params) {
         const auto p = groupPointers(groups);
@@ -107,6 +158,24 @@ void bindParams(py::module_& m) {
       py::arg("groups"), py::arg("params") = FlowGraphParams(),
       "C of eq. 9-10, (N, N) float64, for PathlineGroups ordered state by state and "
       "chronologically (all must share one layout). Uses params.alpha, beta and threads.");
+  m.def(
+      "cost_matrix_of_files",
+      [](const py::sequence& files, const FlowGraphParams& params, double rowBlockMb, int columnNodes) {
+        const NodeFiles nodes = nodeFiles(files);
+        const CostStreamParams stream = streamParams(rowBlockMb, columnNodes);
+        CostMatrix c;
+        CostStreamStats stats;
+        {
+          py::gil_scoped_release release;
+          c = computeCostMatrix(nodes, params, nullptr, stream, &stats);
+        }
+        return py::make_tuple(costArray(c), statsDict(stats));
+      },
+      py::arg("files"), py::arg("params") = FlowGraphParams(), py::arg("row_block_mb") = 600.0,
+      py::arg("column_nodes") = 32,
+      "(C, stats): cost_matrix() of every group of the states' PathlineFiles (in state order), the "
+      "same bits, streamed: rows in blocks of row_block_mb, columns in blocks of column_nodes. "
+      "stats: row_nodes, column_nodes, group_reads, read_seconds, seconds.");
 }
 
 void bindJob(py::module_& m) {
@@ -121,13 +190,27 @@ void bindJob(py::module_& m) {
           return job;
         }),
         py::arg("groups"), py::arg("params") = FlowGraphParams());
+  j.def_static(
+      "of_files",
+      [](const py::sequence& files, const FlowGraphParams& params, double rowBlockMb, int columnNodes) {
+        auto job = std::make_unique<CostMatrixJob>();
+        job->groups = files;
+        job->files = std::make_unique<NodeFiles>(nodeFiles(files));
+        job->stream = streamParams(rowBlockMb, columnNodes);
+        job->params = params;
+        return job;
+      },
+      py::arg("files"), py::arg("params") = FlowGraphParams(), py::arg("row_block_mb") = 600.0,
+      py::arg("column_nodes") = 32,
+      "A job streaming the groups of the states' PathlineFiles (see cost_matrix_of_files).");
   j.def(
       "run",
       [](CostMatrixJob& job) {
         CostMatrix c;
         {
           py::gil_scoped_release release;
-          c = computeCostMatrix(job.pointers, job.params, &job.progress);
+          c = job.files ? computeCostMatrix(*job.files, job.params, &job.progress, job.stream, &job.stats)
+                        : computeCostMatrix(job.pointers, job.params, &job.progress);
         }
         job.finished = !job.progress.cancel.load();
         if (job.finished) job.cost = std::move(c);
@@ -137,6 +220,8 @@ void bindJob(py::module_& m) {
   j.def("cancel", [](CostMatrixJob& job) { job.progress.cancel = true; }, "Thread-safe: run() stops early.");
   j.def_property_readonly("progress", [](const CostMatrixJob& job) { return job.progress.fraction(); },
                           "Finished fraction in [0, 1].");
+  j.def_property_readonly("stats", [](const CostMatrixJob& job) { return statsDict(job.stats); },
+                          "A streamed run's row_nodes, column_nodes, group_reads, read_seconds, seconds.");
   j.def_property_readonly(
       "cost",
       [](const CostMatrixJob& job) {

@@ -59,7 +59,9 @@ struct CostMatrixProgress {
 /// whose errors it throws, e.g. for states of different particle counts). Uses params.alpha,
 /// beta and threads; the values are the same bit for bit at any thread count and on any
 /// instruction set (see cost_matrix.cpp for the blocking and the accumulation). `progress`
-/// (optional) is updated as tiles finish and checked for cancellation.
+/// (optional) is updated as tiles finish and checked for cancellation. Every group must be in
+/// memory: for groups in the states' pathline files, computeCostMatrix(NodeFiles) of
+/// cost_matrix_stream.h holds a bounded number of them and gives the same bits.
 CostMatrix computeCostMatrix(const std::vector<const PathlineGroup*>& groups, const FlowGraphParams& params,
                              CostMatrixProgress* progress = nullptr);
 

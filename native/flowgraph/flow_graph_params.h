@@ -25,7 +25,7 @@ constexpr int kMaxFlowGraphThreads = 1024;
 struct FlowGraphParams {
   /// α of eq. 9: weight of the soot-density difference ‖R_i − R_j‖². The default 1 suits
   /// Plume's default units (velocity in m/s, soot and temperature of order 1); for other
-  /// data, sameMagnitudeWeights() gives the paper's "same order of magnitude" weights.
+  /// data, sameMagnitudeWeights() (magnitude_weights.h) gives the paper's "same order of magnitude" weights.
   double alpha = 1.0;
   /// β of eq. 9: weight of the temperature difference ‖T_i − T_j‖² (default 1, see alpha).
   double beta = 1.0;
@@ -52,23 +52,5 @@ struct FlowGraphParams {
   /// Throws std::invalid_argument naming the setting and its accepted range.
   void validate() const;
 };
-
-/// The weights α (density) and β (temperature) of eq. 9.
-struct FlowWeights {
-  double alpha = 1.0;
-  double beta = 1.0;
-};
-
-/// α and β of eq. 9 that bring the three terms to the same order of magnitude (§4.3: "α and β
-/// are set such that the differences of velocity, density and temperature are in the same order
-/// of magnitude"): α = mean ‖U_i − U_j‖² / mean ‖R_i − R_j‖² and β = mean ‖U_i − U_j‖² /
-/// mean ‖T_i − T_j‖², means over all pairs of groups and over the lifetime. They are computed
-/// without the pairs through mean_ij ‖X_i − X_j‖² = 2 mean_i ‖X_i − X̄‖² (X̄: the mean group),
-/// i.e. as ratios of variances. Differences rather than the fields' own norms mean ‖U‖²/‖R‖²:
-/// eq. 9 only ever sees differences, and a constant offset (an ambient temperature of 300 K)
-/// would inflate ‖T‖² and silence the temperature term. A field that never varies gets weight 1
-/// (its term is 0 whatever the weight); if velocity never varies, the reference is 1 instead of
-/// its variance. Throws std::invalid_argument on groups that do not share one layout.
-FlowWeights sameMagnitudeWeights(const std::vector<const PathlineGroup*>& groups, int threads = 0);
 
 }  // namespace plume

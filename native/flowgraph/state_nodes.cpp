@@ -21,16 +21,9 @@ std::string describe(std::size_t n, const PathlineGroup& g) {
 
 std::string seconds(float v) { return formatNumber(v) + " s"; }
 
-/// "state 1 has <a> <noun>, state 0 has <b>: <why>" when a state's layout differs from state 0's;
-/// "group n (...) has <a> <noun>, the state's first group has <b>" inside one state.
-void requireSameLayout(std::size_t n, const PathlineGroup& g, const PathlineGroup& first,
-                       const PathlineGroup& stateFirst) {
-  // A state's first group against group 0, the others against their state's first group.
-  const bool opensState = &g == &stateFirst;
-  const PathlineGroup& ref = opensState ? first : stateFirst;
-  const std::string who = opensState ? "state " + std::to_string(g.state) : describe(n, g);
-  const std::string other = opensState ? "state " + std::to_string(ref.state) : "the state's first group";
-  const PathlineLayout &a = g.layout, &b = ref.layout;
+/// "<who> has <a> <noun>, <other> has <b>: <why>" when layout a differs from b.
+void requireLayout(const std::string& who, const PathlineLayout& a, const std::string& other,
+                   const PathlineLayout& b) {
   if (a.particles != b.particles)
     throw std::invalid_argument(who + " has " + std::to_string(a.particles) + " particles per group, " +
                                 other + " has " + std::to_string(b.particles) +
@@ -42,6 +35,18 @@ void requireSameLayout(std::size_t n, const PathlineGroup& g, const PathlineGrou
   if (a.sampleDt != b.sampleDt)
     throw std::invalid_argument(who + " has node step " + seconds(a.sampleDt) + ", " + other + " has " +
                                 seconds(b.sampleDt) + ": the states' frame rates or nodes per frame differ");
+}
+
+/// "state 1 has <a> <noun>, state 0 has <b>: <why>" when a state's layout differs from state 0's;
+/// "group n (...) has <a> <noun>, the state's first group has <b>" inside one state.
+void requireSameLayout(std::size_t n, const PathlineGroup& g, const PathlineGroup& first,
+                       const PathlineGroup& stateFirst) {
+  // A state's first group against group 0, the others against their state's first group.
+  const bool opensState = &g == &stateFirst;
+  const PathlineGroup& ref = opensState ? first : stateFirst;
+  const std::string who = opensState ? "state " + std::to_string(g.state) : describe(n, g);
+  const std::string other = opensState ? "state " + std::to_string(ref.state) : "the state's first group";
+  requireLayout(who, g.layout, other, ref.layout);
 }
 
 void requireArrays(std::size_t n, const PathlineGroup& g) {
@@ -96,6 +101,10 @@ std::vector<int> stateNodeCounts(const std::vector<const PathlineGroup*>& groups
     ++counts.back();
   }
   return counts;
+}
+
+void requireStateLayout(int state, const PathlineLayout& layout, const PathlineLayout& first) {
+  requireLayout("state " + std::to_string(state), layout, "state 0", first);
 }
 
 std::vector<int> stateOffsets(const std::vector<int>& counts) {

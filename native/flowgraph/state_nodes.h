@@ -18,6 +18,11 @@ namespace plume {
 /// layout; states are not numbered 0, 1, 2, ... in order; or a state's steps are not consecutive.
 std::vector<int> stateNodeCounts(const std::vector<const PathlineGroup*>& groups);
 
+/// Throws std::invalid_argument with the message stateNodeCounts() gives (e.g. "state 1 has 3000
+/// particles per group, state 0 has 3217: ...") unless `layout`, state `state`'s, equals `first`,
+/// state 0's.
+void requireStateLayout(int state, const PathlineLayout& layout, const PathlineLayout& first);
+
 /// Checks counts (one positive node count per state, at least one state, total below 2^31) and
 /// returns the index of each state's first node, plus the total as last element (eq. 8 nodes).
 std::vector<int> stateOffsets(const std::vector<int>& counts);

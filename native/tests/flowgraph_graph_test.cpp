@@ -7,6 +7,7 @@
 #include "flowgraph/cost_matrix.h"
 #include "flowgraph/cost_matrix_image.h"
 #include "flowgraph/flow_graph.h"
+#include "flowgraph/magnitude_weights.h"
 #include "flowgraph/random_walk.h"
 #include "flowgraph/state_nodes.h"
 #include "flowgraph/transitions.h"

@@ -183,3 +183,38 @@ def test_reachable_states(data):
         graph.reachable_states(2)
     with pytest.raises(ValueError, match="node"):
         graph.out_degree(72)
+
+
+def test_streamed_cost_matrix_is_the_in_memory_one_bit_for_bit(tmp_path):
+    """The add-on's build streams the groups from the states' pathline files: the same C and
+    weights α, β, bit for bit, as with every group read into memory, at 1 and 2 threads."""
+    from test_flowgraph_synth import recorded_bake
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    path_a, _, _ = recorded_bake(tmp_path / "a", frames=24)
+    path_b, _, _ = recorded_bake(tmp_path / "b", frames=20, float16=True)
+    files = [_native.PathlineFile.open(path_a), _native.PathlineFile.open(path_b)]
+    groups = [f.read_group(k, s) for s, f in enumerate(files) for k in range(f.node_count)]
+    assert len(groups) == 38 + 30  # three tiles of 32 per side
+    alpha, beta = _native.same_magnitude_weights(groups)
+    assert _native.same_magnitude_weights_of_files(files, threads=1) == (alpha, beta)
+    assert _native.same_magnitude_weights_of_files(files, threads=2) == (alpha, beta)
+    p = params(alpha=alpha, beta=beta)
+    memory = _native.cost_matrix(groups, p)
+    for threads in (1, 2):
+        p.threads = threads
+        # 1 MB rows: the smallest row block (32 nodes), so rows and columns are both streamed.
+        streamed, stats = _native.cost_matrix_of_files(files, p, row_block_mb=1, column_nodes=32)
+        np.testing.assert_array_equal(streamed, memory)
+        assert stats["row_nodes"] == 32 and stats["group_reads"] == 68 + 36 + 4
+        job = _native.CostMatrixJob.of_files(files, p)
+        assert job.run() is True and job.progress == 1.0
+        np.testing.assert_array_equal(job.cost, memory)
+        assert job.stats["group_reads"] == 68  # one row block holds all: each group read once
+    cancelled = _native.CostMatrixJob.of_files(files, p)
+    cancelled.cancel()
+    assert cancelled.run() is False
+    with pytest.raises(ValueError, match="not a PathlineFile"):
+        _native.cost_matrix_of_files([files[0], groups[0]], p)
+    with pytest.raises(ValueError, match="row_block_mb"):
+        _native.cost_matrix_of_files(files, p, row_block_mb=0)
