@@ -359,7 +359,8 @@ class SynthesisRunner:
         self.raster = native.FireRasterParams(
             voxel_size=float(f.cell_size), origin=tuple(f.origin),
             ignition_temperature=settings.ignition_temperature,
-            max_temperature=settings.max_temperature)
+            max_temperature=settings.max_temperature,
+            sheet_interval=float(f.layout.sample_dt))  # a group is emitted every node step
         self.walk = native.RandomWalk(
             graph, int(settings.seed),
             bias=(native.WalkBias.TEMPORAL if settings.traversal == 'BIASED'

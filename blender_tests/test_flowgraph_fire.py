@@ -29,11 +29,13 @@ from helpers import (OUT_DIR, add_domain, add_sphere_source, assert_reports_erro
 FRAMES = 40
 SYNTH_FRAMES = 200
 RESOLUTION = 32
-#: The synthesized fire's render (160 x 120, 8 samples, lit: a channel > 0.05): share of the lit
-#: pixels in the largest 8-connected lit region at least LIT_REGION_MIN, share of lit pixels
-#: without a lit neighbour at most ISOLATED_MAX. Measured: TODO.
-LIT_REGION_MIN = 0.0
-ISOLATED_MAX = 1.0
+#: The synthesized fire's render (160 x 120, 8 samples, lit: a channel > 0.05) is one flame: at
+#: least LIT_REGION_MIN of the lit pixels in the largest 8-connected lit region, at most
+#: ISOLATED_MAX of them without a lit neighbour (speckle). Measured in 3.4.1: 100% and 0.2%
+#: (this 32³ column was one region with the one-voxel hat too: the speckle of old particles
+#: shows in the examples' gale, where the campfire's spread particles get wider splats).
+LIT_REGION_MIN = 0.9
+ISOLATED_MAX = 0.02
 
 
 def fire_state(name, cache_dir, wind=(0.0, 0.0, 0.0), size=2.0):

@@ -12,18 +12,20 @@ FIRE_MATERIAL = "Plume Fire"
 #: Principled Volume density multiplier of the smoke material (the solver's ρ is ~1 in sources).
 SMOKE_DENSITY = 5.0
 #: Fire material (a fire a compositor would take: bright orange-yellow flames, cooling to dark
-#: red and soot at the top, on black): T_max shows as a blackbody of FIRE_KELVIN (Filmic renders
-#: it orange-yellow, the hot core near white) and ambient (T = 0) as one of FIRE_KELVIN_COLD (deep
-#: red): the emission colour is the blackbody of a linear map between them (fire_points.py uses
-#: the same T_max -> FIRE_KELVIN); the flame grid (0..1) scaled by FIRE_EMISSION is the emission
-#: strength; the soot density is the density grid times FIRE_DENSITY · clamp(1 - FIRE_SOOT_FADE
-#: flame, 0, 1): none where the flame burns (real flames are nearly transparent, so the hot core
-#: is not dimmed by its own fuel), the whole where it has gone out, scattering little
-#: (FIRE_SOOT_COLOR) and absorbing the rest, so cooled smoke above the flames reads dark. The
-#: Principled Volume's own blackbody is off: the emission is the flame grid's alone.
-FIRE_KELVIN = 3000.0
-FIRE_KELVIN_COLD = 800.0
-FIRE_EMISSION = 30.0
+#: red and soot at the top, on black): T_max shows as a blackbody of FIRE_KELVIN (yellow under
+#: Filmic), ambient (T = 0) as one of FIRE_KELVIN_COLD (Blender's deepest red: it clamps below
+#: 965 K), a quarter of T_max (the default ignition) 1200 K red, 60% (the flames' usual heat)
+#: 2300 K orange: the emission colour is the blackbody of a linear map between them
+#: (fire_points.py uses T_max -> FIRE_KELVIN too); the flame grid (0..1) scaled by
+#: FIRE_EMISSION is the emission strength; the soot density is the density grid times
+#: FIRE_DENSITY · clamp(1 - FIRE_SOOT_FADE flame, 0, 1): none where the flame burns (real flames
+#: are nearly transparent, so the hot core is not dimmed by its own fuel), all of it where the
+#: flame has gone out, scattering little (FIRE_SOOT_COLOR) and absorbing the rest, so cooled
+#: smoke above the flames reads dark. The Principled Volume's own blackbody is off: the emission
+#: is the flame grid's alone.
+FIRE_KELVIN = 3600.0
+FIRE_KELVIN_COLD = 400.0
+FIRE_EMISSION = 16.0
 FIRE_DENSITY = 4.0
 FIRE_SOOT_FADE = 4.0
 FIRE_SOOT_COLOR = (0.05, 0.04, 0.035, 1.0)

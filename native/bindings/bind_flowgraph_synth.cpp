@@ -176,7 +176,7 @@ void bindRaster(py::module_& m) {
                                  "Particles to VDB grids density, temperature, flame (§5.3).");
   p.def(py::init([](float voxelSize, const py::object& origin, float particleVolume, float ambient,
                     float ignition, float maxTemperature, int threads, float spacingScale,
-                    float maxSplatRadius) {
+                    float maxSplatRadius, float sheetInterval) {
           FireRasterParams r;
           r.voxelSize = voxelSize;
           r.origin = vec3Arg(origin, "origin");
@@ -187,6 +187,7 @@ void bindRaster(py::module_& m) {
           r.threads = threads;
           r.spacingScale = spacingScale;
           r.maxSplatRadius = maxSplatRadius;
+          r.sheetInterval = sheetInterval;
           r.validate();
           return r;
         }),
@@ -194,17 +195,20 @@ void bindRaster(py::module_& m) {
         py::arg("particle_volume") = 0.f, py::arg("ambient_temperature") = 0.f,
         py::arg("ignition_temperature") = 1.f, py::arg("max_temperature") = 4.f,
         py::arg("threads") = 0, py::arg("spacing_scale") = 1.f, py::arg("max_splat_radius") = 4.f,
+        py::arg("sheet_interval") = 0.f,
         "voxel_size, origin: the bake's cell size and domain origin; particle_volume: m³ each "
         "particle stands for (0: (voxel_size/2)³); flame = clamp((T - ignition) / (max - "
         "ignition), 0, 1); spacing_scale: κ, the splat radius is κ times the local particle spacing "
-        "(at least one voxel, at most max_splat_radius voxels; 0: the trilinear hat). ValueError "
-        "on bad values.");
+        "(at least one voxel, at most max_splat_radius voxels; 0: the trilinear hat); "
+        "sheet_interval: Δt_n, s, between emitted sheets of particles: with velocities the "
+        "radius also covers |u| Δt_n. ValueError on bad values.");
   p.def_readonly("voxel_size", &FireRasterParams::voxelSize);
   p.def_readonly("particle_volume", &FireRasterParams::particleVolume);
   p.def_readonly("ignition_temperature", &FireRasterParams::ignitionTemperature);
   p.def_readonly("max_temperature", &FireRasterParams::maxTemperature);
   p.def_readonly("spacing_scale", &FireRasterParams::spacingScale);
   p.def_readonly("max_splat_radius", &FireRasterParams::maxSplatRadius);
+  p.def_readonly("sheet_interval", &FireRasterParams::sheetInterval);
 
   m.def(
       "write_fire_vdb",

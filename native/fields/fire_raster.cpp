@@ -108,6 +108,10 @@ struct FireTransfer
     // P is the point's offset from the centre of voxel ijk, in voxels ([-0.5, 0.5]).
     const openvdb::Vec3f p = mP->getUnsafe(id);
     const float radius = mRadius->getUnsafe(id);
+    // Most points a leaf visits lie in its search margin and miss it: reject them before
+    // building their kernels.
+    const Coord reach(int(std::ceil(radius)));
+    if (!bounds.hasOverlap(CoordBBox(ijk - reach, ijk + reach))) return;
     const Tent tx(p.x(), radius), ty(p.y(), radius), tz(p.z(), radius);
     CoordBBox box(ijk + Coord(tx.lo, ty.lo, tz.lo), ijk + Coord(tx.hi, ty.hi, tz.hi));
     box.intersect(bounds);
@@ -182,6 +186,8 @@ void FireRasterParams::validate() const {
   if (!(maxSplatRadius >= 1.f && maxSplatRadius <= 8.f))
     throw std::invalid_argument("max_splat_radius must be in [1, 8] voxels (got " +
                                 std::to_string(maxSplatRadius) + ")");
+  if (!(sheetInterval >= 0.f) || !std::isfinite(sheetInterval))
+    throw std::invalid_argument("sheet_interval must be >= 0 s (got " + std::to_string(sheetInterval) + ")");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all cores)");
 }
 
@@ -235,7 +241,7 @@ FireGrids rasterizeFire(const FireParticleView& in, const FireRasterParams& para
     }
     // r_p from the local spacing (fields/splat_radius.h), and ceil(max r_p) per point leaf.
     const std::vector<int> leafRange =
-        appendSplatRadius(tree, {params.spacingScale, params.maxSplatRadius}, "radius");
+        appendSplatRadius(tree, {params.spacingScale, params.maxSplatRadius, params.sheetInterval, h}, "radius");
 
     // Every voxel a kernel touches: the point voxels of each leaf dilated by its ceil(max r_p).
     openvdb::tree::LeafManager<PointDataTree> pointLeaves(tree);

@@ -13,7 +13,8 @@
 /// Each particle's kernel is a separable tent of half-width r_p voxels, r_p from the local
 /// particle spacing (fields/splat_radius.h: 1 voxel, the trilinear hat of
 /// points::rasterizeTrilinear, where particles are as dense as when seeded; up to r_max where
-/// they have spread apart, so old particles do not leave gaps):
+/// they have spread apart, or where the sheets flow-graph fire emits every node step have been
+/// drawn apart along a fast flow, so old particles do not leave gaps):
 ///   k_p(v) = Π_axes max(0, 1 - |v_a - x_a| / r_p)  (peak 1 at the particle)
 ///   w_p(v) = k_p(v) / Σ_v' k_p(v')                 (weights that sum to 1 over the voxels)
 ///   density     ρ_v = Σ_p w_p(v) R_p V_p / Δx³   (splatted, not averaged: Σ_v ρ_v Δx³ = Σ_p R_p V_p,
@@ -53,6 +54,9 @@ struct FireRasterParams {
   /// least one voxel; 0: the trilinear hat of one voxel for every particle.
   float spacingScale = 1.f;
   float maxSplatRadius = 4.f;       ///< r_max, voxels, in [1, 8]
+  /// Δt_n, s: the particles were emitted in sheets this far apart in time (flow-graph fire's
+  /// node step); with velocities, the splat radius also covers |u| Δt_n (0: not).
+  float sheetInterval = 0.f;
   int threads = 0;                  ///< worker threads (0: all cores)
   /// Throws std::invalid_argument naming the setting and its accepted range.
   void validate() const;

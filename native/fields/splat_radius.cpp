@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 
 namespace plume {
 namespace {
@@ -26,7 +27,7 @@ constexpr float kCoarseVolume = kCoarse * kCoarse * kCoarse;
 }  // namespace
 
 std::vector<int> appendSplatRadius(PointDataTree& tree, const SplatRadiusParams& params,
-                                   const std::string& name) {
+                                   const std::string& name, const std::string& velocity) {
   namespace pts = openvdb::points;
   pts::appendAttribute<float>(tree, name);
   openvdb::tree::LeafManager<PointDataTree> leaves(tree);
@@ -60,10 +61,15 @@ std::vector<int> appendSplatRadius(PointDataTree& tree, const SplatRadiusParams&
   }
 
   const float kappa = params.spacingScale, rMax = std::max(1.f, params.maxRadius);
+  const float sheet = kappa > 0.f ? params.sheetInterval / params.voxelSize : 0.f;  // Δt_n / Δx
   leaves.foreach([&](PointDataTree::LeafNodeType& leaf, std::size_t n) {
     const auto& descriptor = leaf.attributeSet().descriptor();
     pts::AttributeHandle<openvdb::Vec3f> position(leaf.constAttributeArray(descriptor.find("P")));
     pts::AttributeWriteHandle<float> radius(leaf.attributeArray(descriptor.find(name)));
+    const std::size_t u = descriptor.find(velocity);
+    std::unique_ptr<pts::AttributeHandle<openvdb::Vec3f>> speed;
+    if (sheet > 0.f && u != pts::AttributeSet::INVALID_POS)
+      speed = std::make_unique<pts::AttributeHandle<openvdb::Vec3f>>(leaf.constAttributeArray(u));
     openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(coarse);
     float largest = 1.f;
     for (auto voxel = leaf.beginValueOn(); voxel; ++voxel) {
@@ -83,7 +89,8 @@ std::vector<int> appendSplatRadius(PointDataTree& tree, const SplatRadiusParams&
             count += w * acc.getValue(c0 + Coord(dx, dy, dz));
           }
           const float spacing = count > 0.f ? std::cbrt(kCoarseVolume / count) : rMax;
-          r = std::min(rMax, std::max(1.f, kappa * spacing));
+          const float gap = speed ? speed->get(*id).length() * sheet : 0.f;
+          r = std::min(rMax, std::max({1.f, kappa * spacing, gap}));
         }
         radius.set(*id, r);
         largest = std::max(largest, r);

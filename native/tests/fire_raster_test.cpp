@@ -127,10 +127,48 @@ TEST(FireRaster, SparseParticlesLeaveNoGapsAndConserveMass) {
         ASSERT_NEAR(rho.getValue(openvdb::Coord(i, j, k)), 1.f / 512.f, 1e-4f / 512.f) << i << " " << j << " " << k;
         ASSERT_NEAR(g.temperature->tree().getValue(openvdb::Coord(i, j, k)), 2.f, 1e-4f);
       }
-  // The one-voxel hat on the same particles lights only the particles' own voxels: 1 in 64.
+  // The one-voxel hat on the same particles lights only the particles' own voxels, 1 in 64
+  // (their neighbours get float rounding of the positions: weights ~1e-6 of the peak 1/8).
   p.spacingScale = 0.f;
   const FireGrids hat = rasterizeFire(c.view(), p);
-  EXPECT_EQ(hat.density->activeVoxelCount(), openvdb::Index64(c.x.size()));
+  std::size_t lit = 0;
+  for (auto it = hat.density->cbeginValueOn(); it; ++it) lit += *it > 1e-4f;
+  EXPECT_EQ(lit, c.x.size());
+}
+
+TEST(FireRaster, SheetsDrawnApartByTheFlowAreJoined) {
+  // Six sheets as flow-graph fire emits them, one per node step Δt_n: particles Δx/2 apart in
+  // x and y over 16 x 16 voxels, the sheets 3 voxels apart in z, rising at u = 3 Δx / Δt_n.
+  // Each sheet is dense (the count estimate gives r = 1), so the hat leaves the two layers of
+  // voxels between sheets empty; with Δt_n the radius is |u| Δt_n / Δx = 3, and tents of
+  // half-width 3 at spacings 3 (z) and 1/2 (x, y) are partitions of unity: between the
+  // outermost particles (3 voxels in from the rim in x, y) every voxel holds the same density.
+  FireRasterParams p;
+  p.voxelSize = 0.1f;
+  const float dt = 0.01f;
+  Cloud c;
+  std::vector<glm::vec3> u;
+  for (int k = 0; k < 6; ++k)
+    for (int i = 0; i < 32; ++i)
+      for (int j = 0; j < 32; ++j) {
+        c.x.push_back(glm::vec3(0.25f + 0.5f * i, 0.25f + 0.5f * j, 3.f * k + 0.5f) * p.voxelSize);
+        c.r.push_back(1.f);
+        c.t.push_back(2.f);
+        u.emplace_back(0.f, 0.f, 3.f * p.voxelSize / dt);
+      }
+  FireParticleView view = c.view();
+  view.velocities = u.data();
+  const FireGrids hat = rasterizeFire(view, p);
+  p.sheetInterval = dt;
+  const FireGrids joined = rasterizeFire(view, p);
+  const float sheet = joined.density->tree().getValue(openvdb::Coord(8, 8, 6));
+  EXPECT_GT(sheet, 0.f);
+  for (int x = 3; x <= 12; ++x)
+    for (int z = 0; z <= 15; ++z) {
+      const openvdb::Coord ijk(x, 7, z);
+      ASSERT_NEAR(joined.density->tree().getValue(ijk), sheet, 1e-4f * sheet) << ijk;
+      if (z % 3 != 0) ASSERT_LT(hat.density->tree().getValue(ijk), 1e-4f * sheet) << ijk;
+    }
 }
 
 TEST(FireRaster, ALoneParticleSpreadsOverTheLargestKernelKeepingItsTemperature) {
