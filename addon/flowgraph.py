@@ -377,7 +377,8 @@ class SynthesisRunner:
         self.raster = native.FireRasterParams(
             voxel_size=float(f.cell_size), origin=tuple(f.origin),
             ignition_temperature=settings.ignition_temperature,
-            max_temperature=settings.max_temperature)
+            max_temperature=settings.max_temperature,
+            sheet_interval=float(f.layout.sample_dt))  # a group is emitted every node step
         self.hold = transition_hold_steps(settings, f.layout, self.steps_per_frame,
                                           [(st.name, st.file.node_count) for st in states], owner)
         self.walk = native.RandomWalk(

@@ -172,6 +172,29 @@ def image_pixels(path):
     return px.reshape(h, w, 4)
 
 
+def lit_components(lit):
+    """Connected regions (8-neighbours) of the boolean image `lit`: (share of the lit pixels in
+    the largest region, share of lit pixels with no lit neighbour). Labels spread by repeated
+    3 x 3 maxima until they settle (numpy only: Blender's Python has no scipy)."""
+    h, w = lit.shape
+    n = int(lit.sum())
+    if n == 0:
+        return 0.0, 0.0
+    labels = np.where(lit, np.arange(1, h * w + 1).reshape(h, w), 0)
+    while True:
+        pad = np.pad(labels, 1)
+        grown = np.max([pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
+                        for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+        grown = np.where(lit, grown, 0)
+        if np.array_equal(grown, labels):
+            break
+        labels = grown
+    largest = np.bincount(labels[lit]).max()
+    pad = np.pad(lit, 1).astype(np.int32)
+    neighbours = sum(pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
+                     for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx)
+    return float(largest) / n, float((lit & (neighbours == 0)).sum()) / n
+
 
 #: Smallest mean |rendered - rendered without the volume| over all pixels and RGB channels that
 #: counts as "the smoke shows". Both renders use the same Cycles seed, so pixels whose rays miss the

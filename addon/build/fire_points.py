@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from . import datablocks, frame_handlers, point_frames
-from .volume import FIRE_EMISSION, FIRE_KELVIN, _scaled_attribute
+from .volume import FIRE_KELVIN, _scaled_attribute
 from .. import blender_compat as compat
 from .. import flowgraph
 
@@ -23,6 +23,9 @@ TEMPERATURE_ATTRIBUTE = "plume_temperature"
 DENSITY_ATTRIBUTE = "plume_density"
 GROUP = "Plume Fire Points"
 MATERIAL = "Plume Fire Points"
+#: Surface emission strength of a point at T_max (a point is a small sphere, not a volume: its
+#: own scale, independent of the Volume's FIRE_EMISSION).
+POINT_EMISSION = 8.0
 
 _EMPTY = {"positions": np.zeros((0, 3), np.float32), "temperature": np.zeros(0, np.float32),
           "density": np.zeros(0, np.float32)}
@@ -102,7 +105,7 @@ def points_group():
 
 def points_material(max_temperature):
     """Emission coloured by the blackbody of the point's temperature (T_max -> FIRE_KELVIN, as
-    the fire Volume) of strength FIRE_EMISSION · T / T_max; created once, then left to the
+    the fire Volume) of strength POINT_EMISSION · T / T_max; created once, then left to the
     artist."""
     mat = bpy.data.materials.get(MATERIAL)
     if mat is not None:
@@ -116,7 +119,7 @@ def points_material(max_temperature):
     L(_scaled_attribute(nt, TEMPERATURE_ATTRIBUTE, FIRE_KELVIN / t_max, 0).outputs[0],
       blackbody.inputs["Temperature"])
     L(blackbody.outputs["Color"], emission.inputs["Color"])
-    L(_scaled_attribute(nt, TEMPERATURE_ATTRIBUTE, FIRE_EMISSION / t_max, -200).outputs[0],
+    L(_scaled_attribute(nt, TEMPERATURE_ATTRIBUTE, POINT_EMISSION / t_max, -200).outputs[0],
       emission.inputs["Strength"])
     L(emission.outputs["Emission"], out.inputs["Surface"])
     return mat

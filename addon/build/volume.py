@@ -11,13 +11,27 @@ SMOKE_MATERIAL = "Plume Smoke"
 FIRE_MATERIAL = "Plume Fire"
 #: Principled Volume density multiplier of the smoke material (the solver's ρ is ~1 in sources).
 SMOKE_DENSITY = 5.0
-#: Fire material: T_max shows as a blackbody of this many kelvin (emission colour and the
-#: Principled Volume's own blackbody), the flame grid (0..1) scaled by FIRE_EMISSION is the
-#: emission strength, the soot density is scaled by FIRE_DENSITY (lighter than smoke, so the
-#: flame behind it shows). Orange-yellow where T is near T_max, dark red as it cools.
-FIRE_KELVIN = 2800.0
-FIRE_EMISSION = 8.0
-FIRE_DENSITY = 2.0
+#: Fire material (a fire a compositor would take: bright orange-yellow flames, cooling to dark
+#: red and soot at the top, on black): T_max shows as a blackbody of FIRE_KELVIN (yellow under
+#: Filmic), ambient (T = 0) as one of FIRE_KELVIN_COLD (Blender's deepest red: it clamps below
+#: 965 K), a quarter of T_max (the default ignition) 1200 K red, 60% (the flames' usual heat)
+#: 2300 K orange: the emission colour is the blackbody of a linear map between them
+#: (fire_points.py uses T_max -> FIRE_KELVIN too); the flame grid (0..1) scaled by
+#: FIRE_EMISSION is the emission strength; the soot density is the density grid times
+#: FIRE_DENSITY · clamp(1 - FIRE_SOOT_FADE flame, 0, 1): none where the flame burns (real flames
+#: are nearly transparent, so the hot core is not dimmed by its own fuel), all of it where the
+#: flame has gone out, scattering little (FIRE_SOOT_COLOR) and absorbing the rest, so cooled
+#: smoke above the flames reads dark. The Principled Volume's own blackbody is off: the emission
+#: is the flame grid's alone.
+FIRE_KELVIN = 3600.0
+FIRE_KELVIN_COLD = 400.0
+FIRE_EMISSION = 16.0
+FIRE_DENSITY = 4.0
+FIRE_SOOT_FADE = 4.0
+FIRE_SOOT_COLOR = (0.05, 0.04, 0.035, 1.0)
+#: Layout version of "Plume Fire" (custom property "plume_version"): a Plume Fire made by an
+#: older Plume is rebuilt; a material the artist put in its place is left alone.
+FIRE_MATERIAL_VERSION = 2
 
 
 def volume_name(domain):
@@ -31,22 +45,45 @@ def _setup_material(nt, out, combustion, max_temperature):
     pv.inputs["Density Attribute"].default_value = "density"
     pv.inputs["Temperature Attribute"].default_value = "temperature"
     pv.inputs["Color"].default_value = (0.6, 0.6, 0.6, 1.0)
+    pv.inputs["Blackbody Intensity"].default_value = 0.0
     if combustion:
-        # Cycles multiplies the Temperature input by the attribute: T_max -> FIRE_KELVIN.
-        kelvin = FIRE_KELVIN / max(max_temperature, 1e-3)
-        pv.inputs["Density"].default_value = FIRE_DENSITY
-        pv.inputs["Blackbody Intensity"].default_value = 1.0
-        pv.inputs["Temperature"].default_value = kelvin
-        nt.links.new(_scaled_attribute(nt, "flame", FIRE_EMISSION, -300).outputs[0],
-                     pv.inputs["Emission Strength"])
-        blackbody = nt.nodes.new("ShaderNodeBlackbody")
-        blackbody.location = (-200, -100)
-        nt.links.new(_scaled_attribute(nt, "temperature", kelvin, -100).outputs[0],
-                     blackbody.inputs["Temperature"])
-        nt.links.new(blackbody.outputs["Color"], pv.inputs["Emission Color"])
-    else:
-        pv.inputs["Blackbody Intensity"].default_value = 0.0
+        _setup_fire(nt, pv, max_temperature)
     nt.links.new(pv.outputs["Volume"], out.inputs["Volume"])
+
+
+def _setup_fire(nt, pv, max_temperature):
+    """The fire's emission and soot on Principled Volume `pv` (see FIRE_KELVIN)."""
+    pv.inputs["Color"].default_value = FIRE_SOOT_COLOR
+    flame = _scaled_attribute(nt, "flame", FIRE_EMISSION, -300)
+    nt.links.new(flame.outputs[0], pv.inputs["Emission Strength"])
+    burnt = nt.nodes.new("ShaderNodeMath")  # 1 - FIRE_SOOT_FADE flame, clamped to [0, 1]
+    burnt.location = (-200, 150)
+    burnt.operation = 'MULTIPLY_ADD'
+    burnt.use_clamp = True
+    nt.links.new(flame.inputs[0].links[0].from_socket, burnt.inputs[0])  # the flame attribute
+    burnt.inputs[1].default_value = -FIRE_SOOT_FADE
+    burnt.inputs[2].default_value = 1.0
+    soot = nt.nodes.new("ShaderNodeMath")
+    soot.location = (-50, 150)
+    soot.operation = 'MULTIPLY'
+    nt.links.new(burnt.outputs[0], soot.inputs[0])
+    soot.inputs[1].default_value = FIRE_DENSITY
+    nt.links.new(soot.outputs[0], pv.inputs["Density"])
+    temperature = nt.nodes.new("ShaderNodeAttribute")
+    temperature.location = (-800, -100)
+    temperature.attribute_name = "temperature"
+    kelvin = nt.nodes.new("ShaderNodeMapRange")  # T in [0, T_max] -> kelvin, clamped
+    kelvin.location = (-400, -100)
+    kelvin.inputs["From Min"].default_value = 0.0
+    kelvin.inputs["From Max"].default_value = max(max_temperature, 1e-3)
+    kelvin.inputs["To Min"].default_value = FIRE_KELVIN_COLD
+    kelvin.inputs["To Max"].default_value = FIRE_KELVIN
+    kelvin.clamp = True
+    nt.links.new(temperature.outputs["Fac"], kelvin.inputs["Value"])
+    blackbody = nt.nodes.new("ShaderNodeBlackbody")
+    blackbody.location = (-200, -100)
+    nt.links.new(kelvin.outputs["Result"], blackbody.inputs["Temperature"])
+    nt.links.new(blackbody.outputs["Color"], pv.inputs["Emission Color"])
 
 
 def _scaled_attribute(nt, name, factor, y):
@@ -63,12 +100,22 @@ def _scaled_attribute(nt, name, factor, y):
 
 
 def material(combustion, max_temperature=4.0):
-    """The shared smoke (or fire) material; created once, then left to the artist."""
+    """The shared smoke (or fire) material; created once, then left to the artist (a Plume Fire
+    of an older FIRE_MATERIAL_VERSION is rebuilt)."""
     name = FIRE_MATERIAL if combustion else SMOKE_MATERIAL
     mat = bpy.data.materials.get(name)
     if mat is None:
         mat, nt, out = datablocks.node_material(name)
         _setup_material(nt, out, combustion, max_temperature)
+    elif combustion and mat.get("plume_version") != FIRE_MATERIAL_VERSION:
+        mat.use_nodes = True
+        nt = mat.node_tree
+        nt.nodes.clear()
+        out = nt.nodes.new("ShaderNodeOutputMaterial")
+        out.location = (300, 0)
+        _setup_material(nt, out, combustion, max_temperature)
+    if combustion:
+        mat["plume_version"] = FIRE_MATERIAL_VERSION
     return mat
 
 

@@ -129,6 +129,9 @@ void BM_SynthesisStepNode(benchmark::State& state) {
                                 double(s.cache().hits() - hits + s.cache().misses() - misses);
 }
 
+/// One synthesized frame rasterized (fields/fire_raster.h). Args: threads (0: all), sheets: 1
+/// as the synthesis does it (velocities, splats also spanning the node step's gap |u| Δt_n),
+/// 0 the particles alone (splats from the spacing only).
 void BM_FireRasterFrame(benchmark::State& state) {
   auto s = warmSynthesizer(0);
   SynthParticles out;
@@ -136,9 +139,13 @@ void BM_FireRasterFrame(benchmark::State& state) {
   FireRasterParams p;
   p.voxelSize = 1.f / 48.f;  // the particles fill about 1 x 1 x 2.5 m: 48 x 48 x 120 voxels
   p.threads = int(state.range(0));
+  const bool sheets = state.range(1) != 0;
+  if (sheets) p.sheetInterval = kNodeDt;
   std::size_t voxels = 0;
   for (auto _ : state) {
-    const FireGrids g = rasterizeFire({out.positions.data(), out.density.data(), out.temperature.data(), out.size()}, p);
+    const FireGrids g = rasterizeFire({out.positions.data(), out.density.data(), out.temperature.data(), out.size(),
+                                       sheets ? out.velocity.data() : nullptr},
+                                      p);
     voxels = g.density->activeVoxelCount();
   }
   state.counters["particles"] = double(out.size());
@@ -212,6 +219,12 @@ BENCHMARK(plume::BM_SynthesisStepNode)
     ->ArgNames({"threads", "cache"})->Args({1, 1})->Args({1, 0})->Args({0, 1})->Args({0, 0})
     ->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(plume::BM_PathlineReadGroup)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(plume::BM_FireRasterFrame)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(plume::BM_FireRasterFrame)
+    ->Args({1, 0})
+    ->Args({0, 0})
+    ->Args({1, 1})
+    ->Args({0, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(plume::BM_RecorderPerSolverStep64)->Arg(1)->Arg(0)->Iterations(6)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_MAIN();

@@ -188,7 +188,8 @@ void bindRaster(py::module_& m) {
   py::class_<FireRasterParams> p(m, "FireRasterParams",
                                  "Particles to VDB grids density, temperature, flame (§5.3).");
   p.def(py::init([](float voxelSize, const py::object& origin, float particleVolume, float ambient,
-                    float ignition, float maxTemperature, int threads) {
+                    float ignition, float maxTemperature, int threads, float spacingScale,
+                    float maxSplatRadius, float sheetInterval) {
           FireRasterParams r;
           r.voxelSize = voxelSize;
           r.origin = vec3Arg(origin, "origin");
@@ -197,20 +198,30 @@ void bindRaster(py::module_& m) {
           r.ignitionTemperature = ignition;
           r.maxTemperature = maxTemperature;
           r.threads = threads;
+          r.spacingScale = spacingScale;
+          r.maxSplatRadius = maxSplatRadius;
+          r.sheetInterval = sheetInterval;
           r.validate();
           return r;
         }),
         py::arg("voxel_size"), py::arg("origin") = py::make_tuple(0.f, 0.f, 0.f),
         py::arg("particle_volume") = 0.f, py::arg("ambient_temperature") = 0.f,
         py::arg("ignition_temperature") = 1.f, py::arg("max_temperature") = 4.f,
-        py::arg("threads") = 0,
+        py::arg("threads") = 0, py::arg("spacing_scale") = 1.f, py::arg("max_splat_radius") = 4.f,
+        py::arg("sheet_interval") = 0.f,
         "voxel_size, origin: the bake's cell size and domain origin; particle_volume: m³ each "
         "particle stands for (0: (voxel_size/2)³); flame = clamp((T - ignition) / (max - "
-        "ignition), 0, 1). ValueError on bad values.");
+        "ignition), 0, 1); spacing_scale: κ, the splat radius is κ times the local particle spacing "
+        "(at least one voxel, at most max_splat_radius voxels; 0: the trilinear hat); "
+        "sheet_interval: Δt_n, s, between emitted sheets of particles: with velocities the "
+        "radius also covers |u| Δt_n. ValueError on bad values.");
   p.def_readonly("voxel_size", &FireRasterParams::voxelSize);
   p.def_readonly("particle_volume", &FireRasterParams::particleVolume);
   p.def_readonly("ignition_temperature", &FireRasterParams::ignitionTemperature);
   p.def_readonly("max_temperature", &FireRasterParams::maxTemperature);
+  p.def_readonly("spacing_scale", &FireRasterParams::spacingScale);
+  p.def_readonly("max_splat_radius", &FireRasterParams::maxSplatRadius);
+  p.def_readonly("sheet_interval", &FireRasterParams::sheetInterval);
 
   m.def(
       "write_fire_vdb",
@@ -225,7 +236,7 @@ void bindRaster(py::module_& m) {
       },
       py::arg("path"), py::arg("positions"), py::arg("density"), py::arg("temperature"),
       py::arg("params"), py::arg("frame") = 0,
-      "Rasterizes particles with OpenVDB's point transfer (trilinear hat; density splatted so "
+      "Rasterizes particles with OpenVDB's point transfer (tent kernels sized by the particle spacing; density splatted so "
       "mass is conserved, temperature averaged, flame from temperature) and writes grids "
       "density, temperature, flame to `path` atomically. Returns dict(voxels=...).");
 }

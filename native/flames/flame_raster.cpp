@@ -76,6 +76,7 @@ FlameGrids rasterizeFlames(const FlameParticles& parts, const FlameRasterParams&
   fire.ignitionTemperature = 0.f;
   fire.maxTemperature = params.temperatureScale;
   fire.threads = params.threads;
+  fire.spacingScale = 0.f;  // the trilinear hat of one voxel, which the flames' look is tuned to
   const FireGrids scalars = rasterizeFire({parts.positions.data(), red.data(), temperature.data(), n}, fire);
   const FireGrids greens = rasterizeFire({parts.positions.data(), green.data(), none.data(), n}, fire);
   const FireGrids blues = rasterizeFire({parts.positions.data(), blue.data(), none.data(), n}, fire);
