@@ -31,6 +31,7 @@ __all__ = ["PREVIEW_POINTS_RANGE", "TRAVERSALS", "FlowGraphSettings", "Synthesis
 GRAPH_NAME = "flowgraph.npz"
 IMAGE_NAME = "flowgraph_cost.png"
 FIRE_FOLDER = "fire"
+WALK_NAME = "walk.npz"
 
 
 def graph_path(folder):
@@ -43,6 +44,47 @@ def image_path(folder):
 
 def fire_path(folder, frame):
     return os.path.join(folder, FIRE_FOLDER, f"fire_{frame:04d}.vdb")
+
+
+def walk_path(folder):
+    """The walk of the last synthesis (write_walk): which node each node step emitted."""
+    return os.path.join(folder, FIRE_FOLDER, WALK_NAME)
+
+
+def transition_indices(states, steps):
+    """Indices k >= 1 of a walk's node steps (read_walk: states, steps) that followed a
+    transition (§5.1), not a temporal edge: group steps[k] of state states[k] is not the group
+    after steps[k-1] in state states[k-1]."""
+    states, steps = np.asarray(states, np.int64), np.asarray(steps, np.int64)
+    jump = (steps[1:] != steps[:-1] + 1) | (states[1:] != states[:-1])
+    return np.flatnonzero(jump) + 1
+
+
+def write_walk(path, nodes, node_states, node_steps, frame_start, nodes_per_frame):
+    """Writes the walk atomically: nodes (the graph node of each node step, in order), their
+    states and steps (group index in the state's pathline file), frame_start and nodes_per_frame
+    (node step k is emitted in frame frame_start + k // nodes_per_frame)."""
+    nodes = np.asarray(nodes, np.int64)
+    files.save_npz(path, nodes=nodes, states=np.asarray(node_states, np.int64)[nodes],
+                   steps=np.asarray(node_steps, np.int64)[nodes],
+                   frame_start=np.int64(frame_start), nodes_per_frame=np.int64(nodes_per_frame))
+
+
+def read_walk(path):
+    """dict(nodes, states, steps, frame_start, nodes_per_frame) of a walk file; OSError or
+    ValueError when it cannot be read or its arrays do not match."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            w = {name: np.array(data[name]) for name in ("nodes", "states", "steps",
+                                                         "frame_start", "nodes_per_frame")}
+    except KeyError as e:
+        raise ValueError(f"{path}: no {e} array") from None
+    except zipfile.BadZipFile as e:
+        raise ValueError(f"{path}: {e}") from None
+    n = len(w["nodes"])
+    if w["states"].shape != (n,) or w["steps"].shape != (n,) or int(w["nodes_per_frame"]) < 1:
+        raise ValueError(f"{path}: arrays of mismatched sizes")
+    return w
 
 
 def points_path(folder, frame):
@@ -347,7 +389,8 @@ class SynthesisRunner:
     """Walks the graph (§5.1) and integrates the visited nodes' particles (§5.2, eq. 13), one
     node per node step, nodes_per_frame steps per frame; writes fire/fire_<frame>.vdb (density,
     temperature, flame) after each frame, and fire/points_<frame>.npz with point_preview.
-    progress(done, total) and cancel() are optional."""
+    Then fire/walk.npz records the walk (write_walk). progress(done, total) and cancel() are
+    optional."""
 
     def __init__(self, native, graph, states: List[State], settings: SynthesisSettings,
                  out_folder, progress=None, cancel=None):
@@ -391,7 +434,8 @@ class SynthesisRunner:
         os.makedirs(fire_dir, exist_ok=True)
         for name in os.listdir(fire_dir):  # frames of an older synthesis would mix in
             if ((name.startswith("fire_") and name.endswith(".vdb"))
-                    or (name.startswith("points_") and name.endswith(".npz"))):
+                    or (name.startswith("points_") and name.endswith(".npz"))
+                    or name == WALK_NAME):
                 os.remove(os.path.join(fire_dir, name))
         total = s.frame_end - s.frame_start + 1
         node = self.walk.current
@@ -422,4 +466,6 @@ class SynthesisRunner:
             if self.progress is not None:
                 self.progress(i + 1, total)
         result.group_reads = groups.misses - misses
+        write_walk(walk_path(self.out_folder), result.nodes_visited, self.node_states,
+                   self.node_steps, s.frame_start, self.steps_per_frame)
         return result
