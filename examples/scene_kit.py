@@ -301,29 +301,28 @@ def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
     return src
 
 
-def flicker(src, speed, fuel_share, period, seed=0):
-    """Keys a fuel Source's feed to repeat every `period` frames: random horizontal velocity
-    within ±`speed` m/s and fuel within ±`fuel_share` of itself, a key every 2 frames, cycled
-    (a log pile does not burn evenly; a fire puffs at a near-constant rate, ~1.5/√D Hz for a
-    pool fire of diameter D m). The uneven feed breaks the symmetry of the flame, which then
-    flickers as a fire does; its repetition lets groups of pathlines recur, so the flow graph
-    finds transitions (§4.3: the exemplars "can be carefully designed ... to provide enough
-    transitions")."""
+def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
+    """Keys a fuel Source's feed with smooth noise over frames 1 .. frames + 1: a key every
+    `key_every` frames with a random horizontal velocity within ±`speed` m/s and fuel within
+    ±`fuel_share` of itself, drawn independently by a generator seeded with `seed`, Bézier in
+    between (the first key is the still, even feed). Nothing repeats: the feed has no period, so
+    no group of pathlines recurs by construction and every transition the flow graph finds is a
+    similarity of the fire itself (§4.3). Keys half a puff apart put the feed's energy near the
+    puffing rate of a fire (~1.5/√D Hz for a pool fire of diameter D m): give `key_every` half
+    the puff period in frames. A log pile does not burn evenly: the uneven feed breaks the
+    symmetry of the flame, which then flickers as a fire does."""
     import random
     rng = random.Random(seed)
     s = src.plume.source
     fuel = s.fuel
-    for frame in range(1, period + 2, 2):
-        last = frame > period
-        s.velocity = (0.0, 0.0, 0.0) if last or frame == 1 else (
-            rng.uniform(-speed, speed), rng.uniform(-speed, speed), 0.0)
-        s.fuel = fuel if last or frame == 1 else fuel * (1.0 + rng.uniform(-fuel_share,
-                                                                             fuel_share))
+    for frame in range(1, frames + 2, key_every):
+        first = frame == 1
+        s.velocity = (0.0, 0.0, 0.0) if first else (rng.uniform(-speed, speed),
+                                                    rng.uniform(-speed, speed), 0.0)
+        s.fuel = fuel if first else fuel * (1.0 + rng.uniform(-fuel_share, fuel_share))
         for name in ("velocity", "fuel"):
-            src.keyframe_insert("plume.source." + name, frame=min(frame, period + 1))
+            src.keyframe_insert("plume.source." + name, frame=frame)
     s.fuel, s.velocity = fuel, (0.0, 0.0, 0.0)
-    for fc in compat().fcurves(src):
-        fc.modifiers.new('CYCLES')
     return src
 
 
@@ -423,18 +422,18 @@ def lit_share(path, level=0.05):
 def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene) builds
     the scene (fuel Sources, camera) and returns the state domains in name order; the look is a
-    400 x 220 Cycles render on a black world. Then the .blend is saved to OUT_DIR/TAG.blend,
+    640 x 360 Cycles render on a black world. Then the .blend is saved to OUT_DIR/TAG.blend,
     every state is baked, Build Flow Graph (kept with state 0; `graph`: the keywords of
     build_flow_graph), the
     target state is keyed at the (fraction of the shot, state) pairs `targets`, FRAMES frames
     are synthesized, the cost-matrix picture is copied to OUT_DIR/TAG_cost.png, the frames at
     fractions `show` are rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the
-    times are printed."""
+    times are printed. Returns (scene, state 0's domain, the fire Volume object, OUT_DIR)."""
     import shutil
     out_dir, frames = parse_args(usage, default_frames)
     scene = new_scene()
     domains = setup(scene)
-    cycles(scene, 400, 220, 64, os.path.join(out_dir, tag + "_"))
+    cycles(scene, 640, 360, 64, os.path.join(out_dir, tag + "_"))
     plain_world(scene, (0.002, 0.002, 0.003))
     # Filmic in every Blender (3.4's default; 4.x/5.x default to AgX, which renders the blackbody
     # fire salmon-pink instead of orange-yellow): the manuals' strips are reproducible in each.
@@ -460,3 +459,4 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     print(f"{tag}: render {seconds:.1f} s/frame ({scene.render.resolution_x}x"
           f"{scene.render.resolution_y}, {scene.cycles.samples} samples; lit pixels {lit}) -> "
           f"{strip(paths, os.path.join(out_dir, tag + '_strip.png'))}", flush=True)
+    return scene, keeper, fire, out_dir
