@@ -353,27 +353,54 @@ def bake_fire_states(domains, tag):
     return seconds
 
 
-def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, epsilon_share=None):
+def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, steady=False):
     """Build Flow Graph (plume.flowgraph_build) over the states `domains` (name order), kept
-    with `keeper`, blocks of B = `block_size`; ε = (2a + b)/3 or, with `epsilon_share`,
-    a + epsilon_share (b - a) (a, b: the cheapest and dearest candidate transition, §4.3, which
-    the panel shows after a build, or the error of a build that joins too little). Prints the
-    graph summary; returns the seconds."""
+    with `keeper`, blocks of B = `block_size`, ε = (2a + b)/3 (§4.3: a, b the cheapest and
+    dearest candidate transition). With `steady`, a and b are taken over the candidates between
+    groups of the states' steady fire, seeded after the first t_max of their bake (L node
+    steps), and ε is given explicitly: every state starts as the same flame in still air, so
+    their first groups are nearly alike and their candidate sets an `a` far below any other
+    (the campfire's 0.57 against 1.13), which puts (2a + b)/3 under nearly every transition of
+    the fire itself. Prints the graph summary (and, with `steady`, what ε over all candidates
+    would keep); returns the seconds."""
     select(domains, keeper)
     g = keeper.plume.domain.flowgraph
     g.block_size, g.min_node_gap, g.epsilon = block_size, min_node_gap, 0.0
-    if epsilon_share is not None:
-        flowgraph, native = addon_module("flowgraph"), addon_module("_native")
-        folder = addon_module("snapshot").cache_folder_of
-        states = flowgraph.open_states(native, [(d.name, folder(d)) for d in domains])
-        cost, counts, params = flowgraph.cost_matrix(
-            native, states, addon_module("operators.flowgraph").graph_settings(g))
-        t = native.select_transitions(cost, counts, params)
-        g.epsilon = t["a"] + epsilon_share * (t["b"] - t["a"])
+    if steady:
+        g.epsilon = steady_epsilon(domains, g, tag)
     seconds = run_op(bpy.ops.plume.flowgraph_build, tag, "Build Flow Graph")
     print(f"{tag}: Build Flow Graph {seconds:.1f} s (B = {block_size}, min node gap "
           f"{min_node_gap}): {g.state_names}; {g.summary}", flush=True)
     return seconds
+
+
+def steady_epsilon(domains, g, tag):
+    """(2a + b)/3 with a, b over the candidates between groups seeded at least L node steps into
+    their states (build_flow_graph's `steady`); prints it and what the default ε would keep."""
+    import numpy as np
+    flowgraph, native = addon_module("flowgraph"), addon_module("_native")
+    folder = addon_module("snapshot").cache_folder_of
+    states = flowgraph.open_states(native, [(d.name, folder(d)) for d in domains])
+    cost, counts, params = flowgraph.cost_matrix(
+        native, states, addon_module("operators.flowgraph").graph_settings(g))
+    t = native.select_transitions(cost, counts, params)
+    warmup = states[0].file.layout.samples
+    start = np.concatenate([[0], np.cumsum(counts)])
+    local = [np.asarray(t[k]) - start[np.searchsorted(start, t[k], side="right") - 1]
+             for k in ("row", "col")]
+    steady = np.asarray(t["cost"])[(local[0] >= warmup) & (local[1] >= warmup)]
+    a, b = float(steady.min()), float(steady.max())
+    try:
+        default = native.FlowGraph.build(cost, counts, params)
+        kept = (f"{int(np.sum(default.transitions()['kept']))} kept, pruned "
+                f"{sum(default.pruned_per_state)}")
+    except ValueError as e:
+        kept = f"no graph ({e})"
+    print(f"{tag}: ε = (2a + b)/3 over all {len(t['cost'])} candidates: a = {t['a']:.4g}, b = "
+          f"{t['b']:.4g}, ε = {t['epsilon']:.4g}: {kept}; over the {len(steady)} between "
+          f"groups of the steady fire (seeded >= {warmup} node steps in): a = {a:.4g}, b = "
+          f"{b:.4g}, ε = {(2 * a + b) / 3:.4g}", flush=True)
+    return (2.0 * a + b) / 3.0
 
 
 def key_target_states(dom, keys):
