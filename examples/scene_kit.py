@@ -301,6 +301,17 @@ def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
     return src
 
 
+def refeed(sources, flicker_args, seed):
+    """Keys the feed of every Source of `sources` anew (flicker(src, **flicker_args) with seeds
+    seed, seed + 1, ...) from an even feed of fuel 1 at rest: one state's own fuel feed, so that
+    no two states share a feed's time line (states fed alike resemble each other at equal times,
+    which would make the flow graph's cheapest transitions mere hops between them)."""
+    for n, src in enumerate(sources):
+        src.animation_data_clear()
+        src.plume.source.fuel, src.plume.source.velocity = 1.0, (0.0, 0.0, 0.0)
+        flicker(src, seed=seed + n, **flicker_args)
+
+
 def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
     """Keys a fuel Source's feed with smooth noise over frames 1 .. frames + 1: a key every
     `key_every` frames with a random horizontal velocity within ±`speed` m/s and fuel within
@@ -326,13 +337,16 @@ def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
     return src
 
 
-def bake_fire_states(domains, tag):
-    """Bakes every state (with its pathlines.bin); prints per state the bake time (per frame) and
-    the pathline file (size, nodes, |Ω|, L, bytes per node), and the RAM Build Flow Graph will
-    hold. Returns the bake seconds per state; exits on failure."""
+def bake_fire_states(domains, tag, feed=None):
+    """Bakes every state (with its pathlines.bin), after feed(n) (when given) for state n, e.g.
+    keying its own fuel feed; prints per state the bake time (per frame) and the pathline file
+    (size, nodes, |Ω|, L, bytes per node), and the RAM Build Flow Graph will hold. Returns the
+    bake seconds per state; exits on failure."""
     native, cache, snapshot = (addon_module(n) for n in ("_native", "cache", "snapshot"))
     seconds, ram = [], 0
-    for dom in domains:
+    for n, dom in enumerate(domains):
+        if feed is not None:
+            feed(n)
         select([dom], dom)
         s, cpu = run_op_cpu(bpy.ops.plume.bake, tag, f"the bake of '{dom.name}'")
         d = dom.plume.domain
@@ -446,9 +460,10 @@ def lit_share(path, level=0.05):
     return float((px.reshape(-1, 4)[:, :3].max(axis=1) > level).mean())
 
 
-def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
+def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph, feed=None):
     """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene) builds
-    the scene (fuel Sources, camera) and returns the state domains in name order; the look is a
+    the scene (fuel Sources, camera) and returns the state domains in name order; feed(n), when
+    given, keys state n's fuel feed before its bake (bake_fire_states); the look is a
     640 x 360 Cycles render on a black world. Then the .blend is saved to OUT_DIR/TAG.blend,
     every state is baked, Build Flow Graph (kept with state 0; `graph`: the keywords of
     build_flow_graph), the
@@ -468,7 +483,7 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     keys = [(max(1, round(f * frames)), state) for f, state in targets]
     scene.frame_start, scene.frame_end = 1, frames
     save_blend(out_dir, tag)
-    bake_fire_states(domains, tag)
+    bake_fire_states(domains, tag, feed)
     keeper = domains[0]
     build_flow_graph(domains, keeper, tag, **graph)
     key_target_states(keeper, keys)
