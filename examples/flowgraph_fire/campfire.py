@@ -8,18 +8,17 @@ states, in name order: "State0 Calm" (no wind), "State1 Breeze" and "State2 Gale
 pulled towards a wind along +x). One fuel Source, a round burner on the floor under four logs,
 feeds all of them; its feed flickers with smooth noise that never repeats (random velocity and
 fuel keyed every 4 frames, half a puff at the puffing rate of a fire that size, ~3 Hz), drawn
-anew for each state. Each
-state is a fire bake of 100 frames with Record Pathlines on: every node step (a third of a
-frame) a group of pathlines is seeded at Δx/2 spacing in the burner and followed for t_max
-(§4.2). Build Flow Graph joins the three states into one graph with the paper's settings
-(transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B = 32, ε =
-(2a+b)/3 over the steady fire's candidates, dead ends and traps pruned; the cost matrix is drawn
-like Figure 4), and Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer
-than any bake), steered by keyed target states: calm, then gale from a quarter of the shot, then
-breeze from 60% on. Every frame the live particles are rasterized into a VDB (density,
-temperature, flame) that a Volume object with Plume's fire material plays. Then one transition
-the walk took is shown: five synthesized frames around it above the same frames of the
-destination state played straight (transition_strip.py).
+anew for each state. Each state is a fire bake of 100 frames with Record Pathlines on: every
+node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the burner and
+followed for t_max (§4.2). Build Flow Graph joins the three states into one graph with the
+paper's settings (transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B
+= 32, ε = (2a+b)/3, dead ends and traps pruned; the cost matrix is drawn like Figure 4), and
+Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake),
+steered by keyed target states: calm, then gale from a quarter of the shot, then breeze from 60%
+on. Every frame the live particles are rasterized into a VDB (density, temperature, flame) that
+a Volume object with Plume's fire material plays. Then one transition the walk took is shown:
+five synthesized frames around it above the same frames of the destination state played straight
+(transition_strip.py).
 
 Writes OUT_DIR/campfire.blend, the caches in OUT_DIR/plume_cache (the graph and the synthesized
 fire/fire_####.vdb and the walk fire/walk.npz with state 0), campfire_cost.png (the cost
@@ -58,13 +57,10 @@ NODES_PER_FRAME = 3            # Δt_n = 1/72 s: the fast gale's particle sheets
 LIFETIME = 0.6                 # t_max, s: L = 43; the flame has cooled or left the box by then
 BAKE_FRAMES = 100              # 4.2 s per state (> 2 t_max), 259 nodes: more than 8 blocks of B
 #: Build Flow Graph (§4.3) with the paper's settings: blocks of B = 32 (the add-on's default),
-#: 777 nodes, 25 blocks per side (the paper's 868 nodes in B = 32 give 28); ε = (2a + b)/3 with
-#: a, b over the candidates of the steady fire (scene_kit.build_flow_graph's `steady`: the
-#: states' first t_max is the same flame lighting in still air, whose near-identical groups set
-#: an a that leaves (2a + b)/3 below nearly every other candidate). Transitions between groups
-#: at least 16 node steps (5 frames) apart, so no loop replays the same few groups at a
-#: visible rhythm.
-GRAPH = dict(block_size=32, min_node_gap=16, steady=True)
+#: 777 nodes, 25 blocks per side (the paper's 868 nodes in B = 32 give 28), ε = (2a + b)/3 (the
+#: default). Transitions between groups at least 16 node steps (5 frames) apart, so no loop
+#: replays the same few groups at a visible rhythm.
+GRAPH = dict(block_size=32, min_node_gap=16)
 DEFAULT_FRAMES = 600
 #: (name, wind m/s along +x, wind strength k_w 1/s); names sort in state order. Neighbouring
 #: states must share some similar pathline groups for the graph to join them (§4.3).

@@ -8,10 +8,10 @@ smooth noise that never repeats, drawn anew for each state) burns in a 2 x 0.5 x
 x 32 x 64. Two fire domains on that box are the two states, in name order: "State0 Low" (weak
 vorticity confinement: the flames rise smoothly) and "State1 High" (strong confinement: they
 break into curling tongues). Each is a bake of 128 frames with Record Pathlines on; Build Flow
-Graph joins them with the paper's settings (B = 32, ε = (2a+b)/3 over the steady fire, dead ends
-and traps pruned, cost matrix like Figure 4) and Synthesize Fire walks the graph for FRAMES
-frames (default 400), keyed to stay in the low state for the first 40% of the shot and then
-steered into the high one (§5.1).
+Graph joins them with the paper's settings (B = 32, ε = (2a+b)/3, dead ends and traps pruned,
+cost matrix like Figure 4) and Synthesize Fire walks the graph for FRAMES frames (default 400),
+keyed to stay in the low state for the first 40% of the shot and then steered into the high one
+(§5.1).
 
 Writes OUT_DIR/firewall.blend, the caches in OUT_DIR/plume_cache, firewall_cost.png,
 firewall_####.png for a few frames and firewall_strip.png (the manual's images); prints the
@@ -46,9 +46,8 @@ NODES_PER_FRAME = 3            # Δt_n = 1/72 s
 LIFETIME = 0.5                 # t_max, s: L = 36
 BAKE_FRAMES = 128              # 5.3 s per state (> 2 t_max), 350 nodes: 11 blocks of B
 COOLING = 20.0                 # c: half the campfire's, for taller flames along the wall
-#: Build Flow Graph as in campfire.py: B = 32, ε = (2a + b)/3 over the steady fire's candidates
-#: (700 nodes: 22 blocks per side).
-GRAPH = dict(block_size=32, min_node_gap=16, steady=True)
+#: Build Flow Graph as in campfire.py: B = 32, ε = (2a + b)/3 (700 nodes: 22 blocks per side).
+GRAPH = dict(block_size=32, min_node_gap=16)
 DEFAULT_FRAMES = 400
 #: (name, vorticity confinement ε); names sort in state order.
 STATES = (("State0 Low", 0.05), ("State1 High", 2.0))
