@@ -369,14 +369,11 @@ def bake_fire_states(domains, tag, feed=None):
 
 def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, steady=False):
     """Build Flow Graph (plume.flowgraph_build) over the states `domains` (name order), kept
-    with `keeper`, blocks of B = `block_size`, ε = (2a + b)/3 (§4.3: a, b the cheapest and
-    dearest candidate transition). With `steady`, a and b are taken over the candidates between
-    groups of the states' steady fire, seeded after the first t_max of their bake (L node
-    steps), and ε is given explicitly: every state starts as the same flame in still air, so
-    their first groups are nearly alike and their candidate sets an `a` far below any other
-    (the campfire's 0.57 against 1.13), which puts (2a + b)/3 under nearly every transition of
-    the fire itself. Prints the graph summary (and, with `steady`, what ε over all candidates
-    would keep); returns the seconds."""
+    with `keeper`, B = `block_size`, ε = (2a + b)/3 (§4.3: a, b the cheapest and dearest
+    candidate). With `steady`, a and b are those of the candidates between groups seeded at
+    least t_max (L node steps) into their bakes: states begun in still air start as the same
+    young flame, whose candidate can set an a below every other. Prints the graph summary;
+    returns the seconds."""
     select(domains, keeper)
     g = keeper.plume.domain.flowgraph
     g.block_size, g.min_node_gap, g.epsilon = block_size, min_node_gap, 0.0
