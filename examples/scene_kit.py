@@ -386,8 +386,7 @@ def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, steady
 
 
 def steady_epsilon(domains, g, tag):
-    """(2a + b)/3 with a, b over the candidates between groups seeded at least L node steps into
-    their states (build_flow_graph's `steady`); prints it and what the default ε would keep."""
+    """build_flow_graph's steady (2a + b)/3; prints it and what the default ε would keep."""
     import numpy as np
     flowgraph, native = addon_module("flowgraph"), addon_module("_native")
     folder = addon_module("snapshot").cache_folder_of
