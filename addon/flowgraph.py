@@ -33,6 +33,7 @@ __all__ = ["PREVIEW_POINTS_RANGE", "TRANSITION_HOLDS", "TRAVERSALS", "FlowGraphS
 GRAPH_NAME = "flowgraph.npz"
 IMAGE_NAME = "flowgraph_cost.png"
 FIRE_FOLDER = "fire"
+WALK_NAME = "walk.npz"
 
 
 def graph_path(folder):
@@ -48,8 +49,53 @@ def fire_path(folder, frame):
 
 
 def walk_path(folder):
-    """The walk of the last synthesis: fire/walk.npz (see SynthesisRunner.run)."""
-    return os.path.join(folder, FIRE_FOLDER, "walk.npz")
+    """The walk of the last synthesis (write_walk): which node each node step emitted."""
+    return os.path.join(folder, FIRE_FOLDER, WALK_NAME)
+
+
+def transition_indices(states, steps):
+    """Indices k >= 1 of a walk's node steps (read_walk: states, steps) that followed a
+    transition (§5.1), not a temporal edge: group steps[k] of state states[k] is not the group
+    after steps[k-1] in state states[k-1]."""
+    states, steps = np.asarray(states, np.int64), np.asarray(steps, np.int64)
+    jump = (steps[1:] != steps[:-1] + 1) | (states[1:] != states[:-1])
+    return np.flatnonzero(jump) + 1
+
+
+def write_walk(path, nodes, node_states, node_steps, frame_start, nodes_per_frame,
+               transition_hold=0, unreachable_target=None):
+    """Writes the walk atomically: nodes (the graph node of each node step, in order), their
+    states and steps (group index in the state's pathline file), frame_start and nodes_per_frame
+    (node step k is emitted in frame frame_start + k // nodes_per_frame), the transition hold H
+    (node steps) and unreachable_target ((frame, state) from which a keyed target state could
+    not be reached, (-1, -1) if none: SynthesisResult)."""
+    nodes = np.asarray(nodes, np.int64)
+    files.save_npz(path, nodes=nodes, states=np.asarray(node_states, np.int64)[nodes],
+                   steps=np.asarray(node_steps, np.int64)[nodes],
+                   frame_start=np.int64(frame_start), nodes_per_frame=np.int64(nodes_per_frame),
+                   transition_hold=np.int64(transition_hold),
+                   unreachable_target=np.asarray(unreachable_target or (-1, -1), np.int64))
+
+
+def read_walk(path):
+    """dict(nodes, states, steps, frame_start, nodes_per_frame, transition_hold,
+    unreachable_target, transitions) of a walk file (transitions: transition_indices()); OSError
+    or ValueError when it cannot be read or its arrays do not match."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            w = {name: np.array(data[name]) for name in (
+                "nodes", "states", "steps", "frame_start", "nodes_per_frame", "transition_hold",
+                "unreachable_target")}
+    except KeyError as e:
+        raise ValueError(f"{path}: no {e} array") from None
+    except zipfile.BadZipFile as e:
+        raise ValueError(f"{path}: {e}") from None
+    n = len(w["nodes"])
+    if (w["states"].shape != (n,) or w["steps"].shape != (n,) or int(w["nodes_per_frame"]) < 1
+            or w["unreachable_target"].shape != (2,)):
+        raise ValueError(f"{path}: arrays of mismatched sizes")
+    w["transitions"] = transition_indices(w["states"], w["steps"])
+    return w
 
 
 def points_path(folder, frame):
@@ -343,7 +389,6 @@ class SynthesisResult:
     last_frame: int
     nodes_visited: List[int] = field(default_factory=list)
     transitions_taken: int = 0
-    transition_steps: List[int] = field(default_factory=list)  # node step of each transition
     transition_hold: int = 0    # H, node steps (the transition state)
     #: (frame, state) where a keyed target state could no longer be reached (the graph does not
     #: lead back to it from where the walk was), or None
@@ -358,14 +403,11 @@ class SynthesisRunner:
     """Walks the graph (§5.1) and integrates the visited nodes' particles (§5.2, eq. 13), one
     node per node step, nodes_per_frame steps per frame; writes fire/fire_<frame>.vdb (density,
     temperature, flame) after each frame, fire/points_<frame>.npz with point_preview, and at the
-    end fire/walk.npz: the node of every step (nodes, states, steps: node n's state and step in
-    it), the steps at which a transition led to a new time line (transitions), the hold H,
-    nodes_per_frame and frame_start (step k belongs to frame frame_start + k // nodes_per_frame)
-    and unreachable_target ((frame, state), or (-1, -1): see SynthesisResult).
-    progress(done, total) and cancel() are optional. After a transition the walk holds for
-    transition_hold_steps() node steps (the transition state of §5). With emitter_transforms
-    each node step's group is placed by its E (Synthesizer.emitter_transform: the fire source).
-    BakeError (naming `owner`) for a hold no state can keep or transforms of the wrong count."""
+    end fire/walk.npz (write_walk). progress(done, total) and cancel() are optional. After a
+    transition the walk holds for transition_hold_steps() node steps (the transition state of
+    §5). With emitter_transforms each node step's group is placed by its E
+    (Synthesizer.emitter_transform: the fire source). BakeError (naming `owner`) for a hold no
+    state can keep or transforms of the wrong count."""
 
     def __init__(self, native, graph, states: List[State], settings: SynthesisSettings,
                  out_folder, progress=None, cancel=None, owner="flow graph"):
@@ -419,7 +461,8 @@ class SynthesisRunner:
         os.makedirs(fire_dir, exist_ok=True)
         for name in os.listdir(fire_dir):  # frames of an older synthesis would mix in
             if ((name.startswith("fire_") and name.endswith(".vdb"))
-                    or (name.startswith("points_") and name.endswith(".npz"))):
+                    or (name.startswith("points_") and name.endswith(".npz"))
+                    or name == WALK_NAME):
                 os.remove(os.path.join(fire_dir, name))
         total = s.frame_end - s.frame_start + 1
         node = self.walk.current
@@ -442,7 +485,6 @@ class SynthesisRunner:
                 nxt = self.walk.next(target)
                 if nxt != node + 1 or self.node_states[nxt] != state:
                     result.transitions_taken += 1
-                    result.transition_steps.append(len(result.nodes_visited))
                 node = nxt
             frame = s.frame_start + i
             t1 = time.perf_counter()
@@ -456,14 +498,7 @@ class SynthesisRunner:
             if self.progress is not None:
                 self.progress(i + 1, total)
         result.group_reads = groups.misses - misses
-        visited = np.asarray(result.nodes_visited, np.int64)
-        files.save_npz(walk_path(self.out_folder), nodes=visited.astype(np.int32),
-                       states=self.node_states[visited].astype(np.int32),
-                       steps=self.node_steps[visited].astype(np.int32),
-                       transitions=np.asarray(result.transition_steps, np.int64),
-                       transition_hold=np.int64(self.hold),
-                       nodes_per_frame=np.int64(self.steps_per_frame),
-                       frame_start=np.int64(s.frame_start),
-                       unreachable_target=np.asarray(result.unreachable_target or (-1, -1),
-                                                     np.int64))
+        write_walk(walk_path(self.out_folder), result.nodes_visited, self.node_states,
+                   self.node_steps, s.frame_start, self.steps_per_frame, self.hold,
+                   result.unreachable_target)
         return result

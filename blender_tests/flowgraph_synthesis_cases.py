@@ -14,8 +14,7 @@ from helpers import assert_reports_error, native, select_only
 class SynthesisCases:
     def walk(self):
         from plume import flowgraph
-        with np.load(flowgraph.walk_path(self.folder(self.windy))) as w:
-            return {k: np.array(w[k]) for k in w.files}
+        return flowgraph.read_walk(flowgraph.walk_path(self.folder(self.windy)))
 
     def test_5_transition_hold(self):
         """The transition state (§5): with Transition Hold = Lifetime (the default) no two

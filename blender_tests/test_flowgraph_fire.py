@@ -11,6 +11,7 @@ Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 
          --python blender_tests/test_flowgraph_fire.py
 """
 
+import importlib
 import os
 import shutil
 import sys
@@ -139,9 +140,23 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         print(f"  fire_synthesize {SYNTH_FRAMES} frames: {time.perf_counter() - t0:.1f} s")
         fire = bpy.data.objects[g.fire_object]
         self.assertEqual(fire.type, 'VOLUME')
-        files = sorted(n for n in os.listdir(os.path.join(folder, "fire"))
-                       if n.startswith("fire_"))
+        files = sorted(n for n in os.listdir(os.path.join(folder, "fire")) if n.endswith(".vdb"))
         self.assertEqual(len(files), SYNTH_FRAMES)
+        # The walk is recorded: one node per node step, each the graph node of its (state, step)
+        # (nodes numbered state by state), some of them after transitions.
+        flowgraph = importlib.import_module("plume.flowgraph")
+        walk = flowgraph.read_walk(flowgraph.walk_path(folder))
+        per_frame = int(walk["nodes_per_frame"])
+        self.assertEqual(len(walk["nodes"]), SYNTH_FRAMES * per_frame)
+        counts = [n.PathlineFile.open(os.path.join(self.folder(d), "pathlines.bin")).node_count
+                  for d in (self.calm, self.windy)]
+        offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        np.testing.assert_array_equal(walk["nodes"], offsets[walk["states"]] + walk["steps"])
+        jumps = flowgraph.transition_indices(walk["states"], walk["steps"])
+        self.assertGreater(len(jumps), 0)
+        self.assertTrue(np.all(walk["steps"] < np.asarray(counts)[walk["states"]]))
+        print(f"  walk: {len(jumps)} transitions, node steps per state "
+              f"{np.bincount(walk['states'], minlength=2).tolist()}")
         scn = bpy.context.scene
         scn.frame_set(150)
         vol = fire.data

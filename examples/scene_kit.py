@@ -301,39 +301,52 @@ def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
     return src
 
 
-def flicker(src, speed, fuel_share, period, seed=0):
-    """Keys a fuel Source's feed to repeat every `period` frames: random horizontal velocity
-    within ±`speed` m/s and fuel within ±`fuel_share` of itself, a key every 2 frames, cycled
-    (a log pile does not burn evenly; a fire puffs at a near-constant rate, ~1.5/√D Hz for a
-    pool fire of diameter D m). The uneven feed breaks the symmetry of the flame, which then
-    flickers as a fire does; its repetition lets groups of pathlines recur, so the flow graph
-    finds transitions (§4.3: the exemplars "can be carefully designed ... to provide enough
-    transitions")."""
+def refeed(sources, flicker_args, seed):
+    """Keys the feed of every Source of `sources` anew (flicker(src, **flicker_args) with seeds
+    seed, seed + 1, ...) from an even feed of fuel 1 at rest: one state's own fuel feed, so that
+    no two states share a feed's time line (states fed alike resemble each other at equal times,
+    which would make the flow graph's cheapest transitions mere hops between them)."""
+    for n, src in enumerate(sources):
+        src.animation_data_clear()
+        src.plume.source.fuel, src.plume.source.velocity = 1.0, (0.0, 0.0, 0.0)
+        flicker(src, seed=seed + n, **flicker_args)
+
+
+def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
+    """Keys a fuel Source's feed with smooth noise over frames 1 .. frames + 1: a key every
+    `key_every` frames with a random horizontal velocity within ±`speed` m/s and fuel within
+    ±`fuel_share` of itself, drawn independently by a generator seeded with `seed`, Bézier in
+    between (the first key is the still, even feed). Nothing repeats: the feed has no period, so
+    no group of pathlines recurs by construction and every transition the flow graph finds is a
+    similarity of the fire itself (§4.3). Keys half a puff apart put the feed's energy near the
+    puffing rate of a fire (~1.5/√D Hz for a pool fire of diameter D m): give `key_every` half
+    the puff period in frames. A log pile does not burn evenly: the uneven feed breaks the
+    symmetry of the flame, which then flickers as a fire does."""
     import random
     rng = random.Random(seed)
     s = src.plume.source
     fuel = s.fuel
-    for frame in range(1, period + 2, 2):
-        last = frame > period
-        s.velocity = (0.0, 0.0, 0.0) if last or frame == 1 else (
-            rng.uniform(-speed, speed), rng.uniform(-speed, speed), 0.0)
-        s.fuel = fuel if last or frame == 1 else fuel * (1.0 + rng.uniform(-fuel_share,
-                                                                             fuel_share))
+    for frame in range(1, frames + 2, key_every):
+        first = frame == 1
+        s.velocity = (0.0, 0.0, 0.0) if first else (rng.uniform(-speed, speed),
+                                                    rng.uniform(-speed, speed), 0.0)
+        s.fuel = fuel if first else fuel * (1.0 + rng.uniform(-fuel_share, fuel_share))
         for name in ("velocity", "fuel"):
-            src.keyframe_insert("plume.source." + name, frame=min(frame, period + 1))
+            src.keyframe_insert("plume.source." + name, frame=frame)
     s.fuel, s.velocity = fuel, (0.0, 0.0, 0.0)
-    for fc in compat().fcurves(src):
-        fc.modifiers.new('CYCLES')
     return src
 
 
-def bake_fire_states(domains, tag):
-    """Bakes every state (with its pathlines.bin); prints per state the bake time (per frame) and
-    the pathline file (size, nodes, |Ω|, L, bytes per node), and the RAM Build Flow Graph will
-    hold. Returns the bake seconds per state; exits on failure."""
+def bake_fire_states(domains, tag, feed=None):
+    """Bakes every state (with its pathlines.bin), after feed(n) (when given) for state n, e.g.
+    keying its own fuel feed; prints per state the bake time (per frame) and the pathline file
+    (size, nodes, |Ω|, L, bytes per node), and the RAM Build Flow Graph will hold. Returns the
+    bake seconds per state; exits on failure."""
     native, cache, snapshot = (addon_module(n) for n in ("_native", "cache", "snapshot"))
     seconds, ram = [], 0
-    for dom in domains:
+    for n, dom in enumerate(domains):
+        if feed is not None:
+            feed(n)
         select([dom], dom)
         s, cpu = run_op_cpu(bpy.ops.plume.bake, tag, f"the bake of '{dom.name}'")
         d = dom.plume.domain
@@ -354,27 +367,50 @@ def bake_fire_states(domains, tag):
     return seconds
 
 
-def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, epsilon_share=None):
+def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, steady=False):
     """Build Flow Graph (plume.flowgraph_build) over the states `domains` (name order), kept
-    with `keeper`, blocks of B = `block_size`; ε = (2a + b)/3 or, with `epsilon_share`,
-    a + epsilon_share (b - a) (a, b: the cheapest and dearest candidate transition, §4.3, which
-    the panel shows after a build, or the error of a build that joins too little). Prints the
-    graph summary; returns the seconds."""
+    with `keeper`, B = `block_size`, ε = (2a + b)/3 (§4.3: a, b the cheapest and dearest
+    candidate). With `steady`, a and b are those of the candidates between groups seeded at
+    least t_max (L node steps) into their bakes: states begun in still air start as the same
+    young flame, whose candidate can set an a below every other. Prints the graph summary;
+    returns the seconds."""
     select(domains, keeper)
     g = keeper.plume.domain.flowgraph
     g.block_size, g.min_node_gap, g.epsilon = block_size, min_node_gap, 0.0
-    if epsilon_share is not None:
-        flowgraph, native = addon_module("flowgraph"), addon_module("_native")
-        folder = addon_module("snapshot").cache_folder_of
-        states = flowgraph.open_states(native, [(d.name, folder(d)) for d in domains])
-        cost, counts, params = flowgraph.cost_matrix(
-            native, states, addon_module("operators.flowgraph").graph_settings(g))
-        t = native.select_transitions(cost, counts, params)
-        g.epsilon = t["a"] + epsilon_share * (t["b"] - t["a"])
+    if steady:
+        g.epsilon = steady_epsilon(domains, g, tag)
     seconds = run_op(bpy.ops.plume.flowgraph_build, tag, "Build Flow Graph")
     print(f"{tag}: Build Flow Graph {seconds:.1f} s (B = {block_size}, min node gap "
           f"{min_node_gap}): {g.state_names}; {g.summary}", flush=True)
     return seconds
+
+
+def steady_epsilon(domains, g, tag):
+    """build_flow_graph's steady (2a + b)/3; prints it and what the default ε would keep."""
+    import numpy as np
+    flowgraph, native = addon_module("flowgraph"), addon_module("_native")
+    folder = addon_module("snapshot").cache_folder_of
+    states = flowgraph.open_states(native, [(d.name, folder(d)) for d in domains])
+    cost, counts, params = flowgraph.cost_matrix(
+        native, states, addon_module("operators.flowgraph").graph_settings(g))
+    t = native.select_transitions(cost, counts, params)
+    warmup = states[0].file.layout.samples
+    start = np.concatenate([[0], np.cumsum(counts)])
+    local = [np.asarray(t[k]) - start[np.searchsorted(start, t[k], side="right") - 1]
+             for k in ("row", "col")]
+    steady = np.asarray(t["cost"])[(local[0] >= warmup) & (local[1] >= warmup)]
+    a, b = float(steady.min()), float(steady.max())
+    try:
+        default = native.FlowGraph.build(cost, counts, params)
+        kept = (f"{int(np.sum(default.transitions()['kept']))} kept, pruned "
+                f"{sum(default.pruned_per_state)}")
+    except ValueError as e:
+        kept = f"no graph ({e})"
+    print(f"{tag}: ε = (2a + b)/3 over all {len(t['cost'])} candidates: a = {t['a']:.4g}, b = "
+          f"{t['b']:.4g}, ε = {t['epsilon']:.4g}: {kept}; over the {len(steady)} between "
+          f"groups of the steady fire (seeded >= {warmup} node steps in): a = {a:.4g}, b = "
+          f"{b:.4g}, ε = {(2 * a + b) / 3:.4g}", flush=True)
+    return (2.0 * a + b) / 3.0
 
 
 def key_target_states(dom, keys):
@@ -420,15 +456,17 @@ def lit_share(path, level=0.05):
     return float((px.reshape(-1, 4)[:, :3].max(axis=1) > level).mean())
 
 
-def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
+def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph, feed=None):
     """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene) builds
-    the scene (fuel Sources, camera) and returns the state domains in name order; the look is a
-    640 x 360 Cycles render on a black world, motion blurred by the fire VDBs' velocity grid.
-    Then the .blend is saved to OUT_DIR/TAG.blend, every state is baked, Build Flow Graph (kept
-    with state 0; `graph`: the keywords of build_flow_graph), the target state is keyed at the
+    the scene (fuel Sources, camera) and returns the state domains in name order; feed(n), when
+    given, keys state n's fuel feed before its bake (bake_fire_states); the look is a 640 x 360
+    Cycles render on a black world, motion blurred by the fire VDBs' velocity grid. Then the
+    .blend is saved to OUT_DIR/TAG.blend, every state is baked, Build Flow Graph (kept with
+    state 0; `graph`: the keywords of build_flow_graph), the target state is keyed at the
     (fraction of the shot, state) pairs `targets`, FRAMES frames are synthesized, the
     cost-matrix picture is copied to OUT_DIR/TAG_cost.png, the frames at fractions `show` are
-    rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are printed."""
+    rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are printed.
+    Returns (scene, state 0's domain, the fire Volume object, OUT_DIR)."""
     import shutil
     out_dir, frames = parse_args(usage, default_frames)
     scene = new_scene()
@@ -444,7 +482,7 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     keys = [(max(1, round(f * frames)), state) for f, state in targets]
     scene.frame_start, scene.frame_end = 1, frames
     save_blend(out_dir, tag)
-    bake_fire_states(domains, tag)
+    bake_fire_states(domains, tag, feed)
     keeper = domains[0]
     build_flow_graph(domains, keeper, tag, **graph)
     key_target_states(keeper, keys)
@@ -462,3 +500,4 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     print(f"{tag}: render {seconds:.1f} s/frame ({scene.render.resolution_x}x"
           f"{scene.render.resolution_y}, {scene.cycles.samples} samples; lit pixels {lit}) -> "
           f"{strip(paths, os.path.join(out_dir, tag + '_strip.png'))}", flush=True)
+    return scene, keeper, fire, out_dir

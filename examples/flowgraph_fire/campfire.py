@@ -6,21 +6,27 @@ graph_fire_synthesis.txt (Table 1, Figure 1).
 Three fire domains on the same 2 x 1 x 1 m box at 128 x 64 x 64 (Table 1's grid) are the three
 states, in name order: "State0 Calm" (no wind), "State1 Breeze" and "State2 Gale" (the air is
 pulled towards a wind along +x). One fuel Source, a round burner on the floor under four logs,
-feeds all of them; its feed flickers (random velocity and fuel keyed to repeat every 8 frames,
-the puffing rate of a fire that size). Each state is a short fire bake with Record Pathlines
-on: every node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the
-burner and followed for t_max (§4.2). Build Flow Graph joins the three states into one graph
-(transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B = 16, ε =
-(a+b)/2, dead ends and traps pruned; the cost matrix is drawn like Figure 4), and Synthesize
-Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake), steered by keyed
-target states: calm, then gale from a quarter of the shot, then breeze from 60% on. Every frame
-the live particles are rasterized into a VDB (density, temperature, flame) that a Volume object
-with Plume's fire material plays.
+feeds all of them; its feed flickers with smooth noise that never repeats (random velocity and
+fuel keyed every 4 frames, half a puff at the puffing rate of a fire that size, ~3 Hz), drawn
+anew for each state. Each state is a fire bake of 100 frames with Record Pathlines on: every
+node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the burner and
+followed for t_max (§4.2). Build Flow Graph joins the three states into one graph with the
+paper's settings (transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B
+= 32, ε = (2a+b)/3, dead ends and traps pruned; the cost matrix is drawn like Figure 4), and
+Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake),
+steered by keyed target states: calm, then gale from a quarter of the shot, then breeze from 60%
+on. Every frame the live particles are rasterized into a VDB (density, temperature, flame) that
+a Volume object with Plume's fire material plays. Then one transition the walk took is shown:
+five synthesized frames around it above the same frames of the destination state played straight
+(transition_strip.py).
 
 Writes OUT_DIR/campfire.blend, the caches in OUT_DIR/plume_cache (the graph and the synthesized
-fire/fire_####.vdb with state 0), campfire_cost.png (the cost matrix), campfire_####.png for a
-few frames and campfire_strip.png (the manual's images). Prints the bake time per state and per
-frame, the pathline files (size, bytes per node, RAM of the graph build), the graph build time,
+fire/fire_####.vdb and the walk fire/walk.npz with state 0), campfire_cost.png (the cost
+matrix), campfire_####.png for a few frames, campfire_strip.png, campfire_transition.png (the
+manual's images; its frames are campfire_transition_####.png and campfire_straight_####.png,
+the straight run's VDBs in OUT_DIR/campfire_straight). Prints the bake time per state and per
+frame, the pathline files (size, bytes per node, RAM of the graph build), the graph (nodes,
+candidates, transitions kept, pruned nodes) and its build time, the transitions the walk took,
 the synthesis and render times. Needs the Plume add-on installed (README). The synthesis cost
 split and its ratio to the simulation: examples/flowgraph_fire/flowgraph_speed.py OUT_DIR after
 this.
@@ -35,6 +41,7 @@ import bpy
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
+import transition_strip  # noqa: E402
 
 TAG = "campfire"
 USAGE = (f"usage: blender -b --factory-startup --python examples/flowgraph_fire/{TAG}.py -- "
@@ -45,16 +52,15 @@ CENTRE = (0.0, 0.0, 0.5)
 BURNER = (-0.45, 0.0, 0.0465)  # upwind of the centre, so the gale's flame stays in the box
 BURNER_SIZE = (0.24, 0.24, 0.027)  # two cell layers, 420 fuel cells: |Ω| = 3,360 seeds
 # Memory of the graph build: |Ω| L 20 B per node and BAKE_FRAMES NODES_PER_FRAME - L + 2 nodes
-# per state: 3,360 x 43 x 20 B = 2.9 MB per node, 151 nodes per state, 1.3 GB for three.
+# per state: 3,360 x 43 x 20 B = 2.9 MB per node, 259 nodes per state, 2.2 GB for three.
 NODES_PER_FRAME = 3            # Δt_n = 1/72 s: the fast gale's particle sheets stay ~1 cell apart
 LIFETIME = 0.6                 # t_max, s: L = 43; the flame has cooled or left the box by then
-BAKE_FRAMES = 64               # 2.7 s per state (>= 2 t_max)
-#: Build Flow Graph (§4.3): 453 nodes in blocks of B = 16, 28 per side as the paper's 868 nodes
-#: in B = 32; transitions between groups at least 16 node steps (5 frames) apart, so no loop
-#: replays the same few groups at a visible rhythm; ε = a + (b - a)/2 instead of (2a + b)/3:
-#: every state starts from the same still air, so their first groups are nearly alike and set
-#: a low a, and (2a + b)/3 then keeps so few transitions that the states hardly join.
-GRAPH = dict(block_size=16, min_node_gap=16, epsilon_share=0.5)
+BAKE_FRAMES = 100              # 4.2 s per state (> 2 t_max), 259 nodes: more than 8 blocks of B
+#: Build Flow Graph (§4.3) with the paper's settings: blocks of B = 32 (the add-on's default),
+#: 777 nodes, 25 blocks per side (the paper's 868 nodes in B = 32 give 28), ε = (2a + b)/3 (the
+#: default). Transitions between groups at least 16 node steps (5 frames) apart, so no loop
+#: replays the same few groups at a visible rhythm.
+GRAPH = dict(block_size=32, min_node_gap=16)
 DEFAULT_FRAMES = 600
 #: (name, wind m/s along +x, wind strength k_w 1/s); names sort in state order. Neighbouring
 #: states must share some similar pathline groups for the graph to join them (§4.3).
@@ -63,13 +69,15 @@ STATES = (("State0 Calm", 0.0, 0.0), ("State1 Breeze", 0.5, 2.0), ("State2 Gale"
 TARGETS = ((0.0, 0), (0.25, 2), (0.6, 1))
 SHOW = (0.2, 0.45, 0.55, 0.9)  # rendered frames: calm, gale, gale, breeze
 LOG_COLOR = (0.012, 0.006, 0.003)
-PUFF_PERIOD = 8                # frames: the feed repeats at ~3 Hz, 1.5/√D for D = 0.24 m
+SOURCES = []                   # the fuel Sources, for feed()
+PUFF_KEYS = 4                  # frames between the feed's keys: half a puff at ~3 Hz, 1.5/√D for
+                               # D = 0.24 m (the noise has no period)
 
 
 def make_states(frames_baked):
     burner = scene_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
                                    BURNER_SIZE)
-    scene_kit.flicker(burner, speed=1.0, fuel_share=0.4, period=PUFF_PERIOD)
+    SOURCES[:] = [burner]
     domains = []
     for name, speed, strength in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, frames_baked,
@@ -77,6 +85,12 @@ def make_states(frames_baked):
         dom.plume.domain.wind, dom.plume.domain.wind_strength = (speed, 0.0, 0.0), strength
         domains.append(dom)
     return domains
+
+
+def feed(state):
+    """State `state`'s own noise feed of the burner (scene_kit.refeed)."""
+    scene_kit.refeed(SOURCES, dict(speed=1.0, fuel_share=0.4, frames=BAKE_FRAMES,
+                                   key_every=PUFF_KEYS), seed=100 * state)
 
 
 def logs():
@@ -99,7 +113,10 @@ def setup(scene):
 
 
 def main():
-    scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup, TARGETS, SHOW, GRAPH)
+    scene, keeper, fire, out_dir = scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
+                                                               TARGETS, SHOW, GRAPH, feed)
+    print(f"{TAG}: transition strip -> "
+          f"{transition_strip.transition_strip(scene, keeper, fire, out_dir, TAG)}", flush=True)
 
 
 if __name__ == "__main__":

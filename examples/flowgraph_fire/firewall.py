@@ -3,18 +3,20 @@
 
     blender -b --factory-startup --python examples/flowgraph_fire/firewall.py -- OUT_DIR [FRAMES]
 
-A long, thin line of fuel (1.6 m x 2.5 cm on the floor: eight Sources, each with its own feed
-repeating every 8 frames) burns in a 2 x 0.5 x 1 m box at 128 x 32 x 64. Two fire domains on
-that box are the two states, in name order: "State0 Low" (weak vorticity confinement: the
-flames rise smoothly) and "State1 High" (strong confinement: they break into curling tongues).
-Each is a short bake with Record Pathlines on; Build Flow Graph joins them (B = 16, ε =
-(a+b)/2, dead ends and traps pruned, cost matrix like Figure 4) and Synthesize Fire walks the
-graph for FRAMES frames (default 400), keyed to stay in the low state for the first 40% of the
-shot and then steered into the high one (§5.1).
+A long, thin line of fuel (1.6 m x 2.5 cm on the floor: eight Sources, each with its own feed of
+smooth noise that never repeats, drawn anew for each state) burns in a 2 x 0.5 x 1 m box at 128
+x 32 x 64. Two fire domains on that box are the two states, in name order: "State0 Low" (weak
+vorticity confinement: the flames rise smoothly) and "State1 High" (strong confinement: they
+break into curling tongues). Each is a bake of 128 frames with Record Pathlines on; Build Flow
+Graph joins them with the paper's settings (B = 32, ε = (2a+b)/3, dead ends and traps pruned,
+cost matrix like Figure 4) and Synthesize Fire walks the graph for FRAMES frames (default 400),
+keyed to stay in the low state for the first 40% of the shot and then steered into the high one
+(§5.1).
 
 Writes OUT_DIR/firewall.blend, the caches in OUT_DIR/plume_cache, firewall_cost.png,
 firewall_####.png for a few frames and firewall_strip.png (the manual's images); prints the
-bake, graph, synthesis and render times. Needs the Plume add-on installed (README).
+bake, the graph (nodes, candidates, transitions kept, pruned nodes), the transitions the walk
+took (fire/walk.npz), synthesis and render times. Needs the Plume add-on installed (README).
 """
 
 import os
@@ -25,6 +27,7 @@ import bpy
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
+import transition_strip  # noqa: E402
 
 TAG = "firewall"
 USAGE = (f"usage: blender -b --factory-startup --python examples/flowgraph_fire/{TAG}.py -- "
@@ -35,20 +38,27 @@ CENTRE = (0.0, 0.0, 0.5)
 WALL = (0.0, 0.0, 0.0465)
 WALL_SIZE = (1.6, 0.025, 0.027)  # two cell layers: about 3,300 seeds
 SEGMENTS = 8
-PUFF_PERIOD = 8                # frames: each piece's feed repeats at 3 Hz
+SOURCES = []                   # the fuel Sources, for feed()
+PUFF_KEYS = 4                  # frames between a piece's feed keys: half a puff at ~3 Hz
 # Memory of the graph build: 3,328 seeds x L = 36 samples x 20 B = 2.4 MB per node,
-# 3 BAKE_FRAMES - L + 2 = 266 nodes per state, 1.3 GB.
+# 3 BAKE_FRAMES - L + 2 = 350 nodes per state, 1.7 GB.
 NODES_PER_FRAME = 3            # Δt_n = 1/72 s
 LIFETIME = 0.5                 # t_max, s: L = 36
-BAKE_FRAMES = 100              # 4.2 s per state (>= 2 t_max)
+BAKE_FRAMES = 128              # 5.3 s per state (> 2 t_max), 350 nodes: 11 blocks of B
 COOLING = 20.0                 # c: half the campfire's, for taller flames along the wall
-#: Build Flow Graph as in campfire.py (532 nodes: 33 blocks per side).
-GRAPH = dict(block_size=16, min_node_gap=16, epsilon_share=0.5)
+#: Build Flow Graph as in campfire.py: B = 32, ε = (2a + b)/3 (700 nodes: 22 blocks per side).
+GRAPH = dict(block_size=32, min_node_gap=16)
 DEFAULT_FRAMES = 400
 #: (name, vorticity confinement ε); names sort in state order.
 STATES = (("State0 Low", 0.05), ("State1 High", 2.0))
 TARGETS = ((0.0, 0), (0.4, 1))  # keyed target states: (fraction of the shot, state)
 SHOW = (0.2, 0.35, 0.6, 0.9)    # rendered frames: low, low, high, high
+
+
+def feed(state):
+    """State `state`'s own noise feeds of the pieces (scene_kit.refeed)."""
+    scene_kit.refeed(SOURCES, dict(speed=0.8, fuel_share=0.5, frames=BAKE_FRAMES,
+                                   key_every=PUFF_KEYS), seed=100 * state)
 
 
 def setup(scene):
@@ -59,7 +69,7 @@ def setup(scene):
         x = WALL[0] - 0.5 * WALL_SIZE[0] + (n + 0.5) * length
         piece = scene_kit.fuel_source(f"Fuel{n}", bpy.ops.mesh.primitive_cube_add,
                                       (x, WALL[1], WALL[2]), (length, *WALL_SIZE[1:]))
-        scene_kit.flicker(piece, speed=0.8, fuel_share=0.5, period=PUFF_PERIOD, seed=n)
+        SOURCES.append(piece)
     domains = []
     for name, vorticity in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, BAKE_FRAMES, NODES_PER_FRAME,
@@ -71,7 +81,11 @@ def setup(scene):
 
 
 def main():
-    scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup, TARGETS, SHOW, GRAPH)
+    _scene, keeper, _fire, _out = scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
+                                                              TARGETS, SHOW, GRAPH, feed)
+    flowgraph = scene_kit.addon_module("flowgraph")
+    folder = scene_kit.addon_module("snapshot").cache_folder_of(keeper)
+    transition_strip.walk_summary(flowgraph.read_walk(flowgraph.walk_path(folder)), TAG)
 
 
 if __name__ == "__main__":
