@@ -340,7 +340,7 @@ def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
 def bake_fire_states(domains, tag, feed=None):
     """Bakes every state (with its pathlines.bin), after feed(n) (when given) for state n, e.g.
     keying its own fuel feed; prints per state the bake time (per frame) and the pathline file
-    (size, nodes, |Ω|, L, bytes per node), and the RAM Build Flow Graph will hold. Returns the
+    (size, nodes, |Ω|, L, bytes per node), and the size of all their groups. Returns the
     bake seconds per state; exits on failure."""
     native, cache, snapshot = (addon_module(n) for n in ("_native", "cache", "snapshot"))
     seconds, ram = [], 0
@@ -363,54 +363,22 @@ def bake_fire_states(domains, tag, feed=None):
               f"({lay.sample_dt * 1e3:.1f} ms apart), {f.bytes_per_node / 1e6:.2f} MB/node on "
               f"disk, {node_ram / 1e6:.2f} MB/node in RAM", flush=True)
         seconds.append(s)
-    print(f"{tag}: Build Flow Graph holds {ram / 1e9:.2f} GB of pathline groups", flush=True)
+    print(f"{tag}: the states hold {ram / 1e9:.2f} GB of pathline groups (Build Flow Graph "
+          "streams them: at most a block of 192 nodes and 32 more in memory)", flush=True)
     return seconds
 
 
-def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8, steady=False):
+def build_flow_graph(domains, keeper, tag, block_size=32, min_node_gap=8):
     """Build Flow Graph (plume.flowgraph_build) over the states `domains` (name order), kept
     with `keeper`, B = `block_size`, ε = (2a + b)/3 (§4.3: a, b the cheapest and dearest
-    candidate). With `steady`, a and b are those of the candidates between groups seeded at
-    least t_max (L node steps) into their bakes: states begun in still air start as the same
-    young flame, whose candidate can set an a below every other. Prints the graph summary;
-    returns the seconds."""
+    candidate). Prints the graph summary; returns the seconds."""
     select(domains, keeper)
     g = keeper.plume.domain.flowgraph
     g.block_size, g.min_node_gap, g.epsilon = block_size, min_node_gap, 0.0
-    if steady:
-        g.epsilon = steady_epsilon(domains, g, tag)
     seconds = run_op(bpy.ops.plume.flowgraph_build, tag, "Build Flow Graph")
     print(f"{tag}: Build Flow Graph {seconds:.1f} s (B = {block_size}, min node gap "
           f"{min_node_gap}): {g.state_names}; {g.summary}", flush=True)
     return seconds
-
-
-def steady_epsilon(domains, g, tag):
-    """build_flow_graph's steady (2a + b)/3; prints it and what the default ε would keep."""
-    import numpy as np
-    flowgraph, native = addon_module("flowgraph"), addon_module("_native")
-    folder = addon_module("snapshot").cache_folder_of
-    states = flowgraph.open_states(native, [(d.name, folder(d)) for d in domains])
-    cost, counts, params = flowgraph.cost_matrix(
-        native, states, addon_module("operators.flowgraph").graph_settings(g))
-    t = native.select_transitions(cost, counts, params)
-    warmup = states[0].file.layout.samples
-    start = np.concatenate([[0], np.cumsum(counts)])
-    local = [np.asarray(t[k]) - start[np.searchsorted(start, t[k], side="right") - 1]
-             for k in ("row", "col")]
-    steady = np.asarray(t["cost"])[(local[0] >= warmup) & (local[1] >= warmup)]
-    a, b = float(steady.min()), float(steady.max())
-    try:
-        default = native.FlowGraph.build(cost, counts, params)
-        kept = (f"{int(np.sum(default.transitions()['kept']))} kept, pruned "
-                f"{sum(default.pruned_per_state)}")
-    except ValueError as e:
-        kept = f"no graph ({e})"
-    print(f"{tag}: ε = (2a + b)/3 over all {len(t['cost'])} candidates: a = {t['a']:.4g}, b = "
-          f"{t['b']:.4g}, ε = {t['epsilon']:.4g}: {kept}; over the {len(steady)} between "
-          f"groups of the steady fire (seeded >= {warmup} node steps in): a = {a:.4g}, b = "
-          f"{b:.4g}, ε = {(2 * a + b) / 3:.4g}", flush=True)
-    return (2.0 * a + b) / 3.0
 
 
 def key_target_states(dom, keys):

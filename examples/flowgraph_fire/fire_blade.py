@@ -3,8 +3,8 @@ graph_fire_synthesis.txt (Table 1: "the fire source is attached on a dynamic mes
 
     blender -b --factory-startup --python examples/flowgraph_fire/fire_blade.py -- OUT_DIR [FRAMES]
 
-Two short fire bakes of a blade-shaped fuel Source lying still in a 1.4 x 0.5 x 1 m box (96 x
-34 x 68 cells) are the states: "State0 Low" (weak vorticity confinement: smooth flames) and
+Two short fire bakes (each with its own noise fuel feed) of a blade-shaped fuel Source lying
+still in a 1.4 x 0.5 x 1 m box (96 x 34 x 68 cells) are the states: "State0 Low" (weak vorticity confinement: smooth flames) and
 "State1 High" (strong: curling tongues). Build Flow Graph joins them (the paper's ε = (2a+b)/3).
 The visible blade, parented to a hilt that is keyed to swing it up through 75 degrees and down
 again, is the flow graph's **Fire Source**: Synthesize Fire emits every node step's group of
@@ -42,15 +42,16 @@ HILT = (-0.4, 0.0, 0.12)       # the pivot of the swing, at the blade's inner en
 NODES_PER_FRAME = 3
 LIFETIME = 0.5                 # t_max, s: L = 36 node steps
 BAKE_FRAMES = 96               # 4 s per state: 254 nodes each
-COOLING = 25.0
+COOLING = 15.0                 # c: slow cooling, flames tall enough to trail behind the swing
 GRAPH = dict(block_size=32, min_node_gap=16)  # ε = (2a + b)/3, the paper's
+SOURCES = []                   # the fuel Source, for feed()
 DEFAULT_FRAMES = 144
 #: (name, vorticity confinement ε); names sort in state order.
 STATES = (("State0 Low", 0.1), ("State1 High", 1.5))
 TARGETS = ((0.0, 0), (0.5, 1))
 SHOW = (0.2, 0.4, 0.55, 0.75)
 #: The swing: (frame as a fraction of the shot, hilt angle about -y in degrees).
-SWING = ((0.0, 0.0), (0.15, 0.0), (0.45, 75.0), (0.75, -10.0), (1.0, 20.0))
+SWING = ((0.0, 0.0), (0.15, 0.0), (0.35, 75.0), (0.6, -10.0), (0.8, 40.0), (1.0, 0.0))
 STEEL = (0.55, 0.56, 0.6)
 
 
@@ -78,10 +79,15 @@ def blade(frames):
     return steel
 
 
+def feed(state):
+    """State `state`'s own noise feed of the blade's fuel (scene_kit.refeed)."""
+    scene_kit.refeed(SOURCES, dict(speed=0.6, fuel_share=0.4, frames=BAKE_FRAMES, key_every=4),
+                     seed=10 * state)
+
+
 def setup(scene, frames):
-    fuel = scene_kit.fuel_source("BladeFuel", bpy.ops.mesh.primitive_cube_add, BLADE_AT,
-                                 FUEL_SIZE)
-    scene_kit.flicker(fuel, speed=0.6, fuel_share=0.4, period=8)
+    SOURCES.append(scene_kit.fuel_source("BladeFuel", bpy.ops.mesh.primitive_cube_add,
+                                         BLADE_AT, FUEL_SIZE))
     domains = []
     for name, vorticity in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, BAKE_FRAMES, NODES_PER_FRAME,
@@ -98,7 +104,7 @@ def setup(scene, frames):
 def main():
     _, frames = scene_kit.parse_args(USAGE, DEFAULT_FRAMES)
     scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, lambda scene: setup(scene, frames),
-                                TARGETS, SHOW, GRAPH)
+                                TARGETS, SHOW, GRAPH, feed)
 
 
 if __name__ == "__main__":
