@@ -472,7 +472,7 @@ class SynthesisRunner:
                 break
             target = s.targets[i] if i < len(s.targets) else -1
             if (target >= 0 and result.unreachable_target is None
-                    and self.walk.target_distance(node, target) < 0):
+                    and self.walk.target_distance(node, target, self.walk.hold_remaining) < 0):
                 result.unreachable_target = (s.frame_start + i, target)
             wind = self.external_velocity(i)
             t0 = time.perf_counter()

@@ -354,15 +354,18 @@ void bindWalk(py::module_& m) {
                           "Transitions taken inside a hold (the node had no temporal edge nor long transition).");
   w.def(
       "target_distance",
-      [](const RandomWalk& walk, int node, int state) {
+      [](const RandomWalk& walk, int node, int state, int hold) {
         if (node < 0 || node >= walk.graph().nodeCount())
           throw py::value_error("node must be in [0, " + std::to_string(walk.graph().nodeCount() - 1) + "]");
         if (state < 0 || state >= walk.graph().stateCount())
           throw py::value_error("state must be in [0, " + std::to_string(walk.graph().stateCount() - 1) + "]");
-        return walk.targetDistance(node, state);
+        if (hold < 0 || hold > walk.transitionHold())
+          throw py::value_error("hold must be in [0, " + std::to_string(walk.transitionHold()) + "]");
+        return walk.targetDistance(node, state, hold);
       },
-      py::arg("node"), py::arg("state"),
-      "Fewest edges from node to the nodes of `state` a walk can stay in (-1: unreachable).");
+      py::arg("node"), py::arg("state"), py::arg("hold") = 0,
+      "Fewest node steps from node, with `hold` steps of the transition state left, to the nodes "
+      "of `state` a walk can stay in (-1: unreachable).");
   w.def(
       "temporal_run",
       [](const RandomWalk& walk, int node) {

@@ -5,8 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <queue>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -14,36 +12,7 @@
 namespace plume {
 namespace {
 
-constexpr int kFar = std::numeric_limits<int>::max();
-
-/// δ(n): fewest edges from every node to the goal W' of `state` (see edgeProbabilities()), by a
-/// breadth-first search backwards from W'.
-std::vector<int> distancesTo(const FlowGraph& graph, int state, const std::vector<std::vector<int>>& into) {
-  std::vector<int> goal;
-  for (bool mustStay : {true, false}) {
-    for (int step = 0; step < graph.stateNodeCount(state); ++step) {
-      const int n = graph.node(state, step);
-      if (!graph.pruned(n) && (!mustStay || graph.staysInState(n))) goal.push_back(n);
-    }
-    if (!goal.empty()) break;
-  }
-  std::vector<int> dist(std::size_t(graph.nodeCount()), kFar);
-  std::queue<int> open;
-  for (int n : goal) {
-    dist[std::size_t(n)] = 0;
-    open.push(n);
-  }
-  while (!open.empty()) {
-    const int n = open.front();
-    open.pop();
-    for (int from : into[std::size_t(n)])
-      if (dist[std::size_t(from)] == kFar) {
-        dist[std::size_t(from)] = dist[std::size_t(n)] + 1;
-        open.push(from);
-      }
-  }
-  return dist;
-}
+constexpr int kFar = TargetDistances::kFar;
 
 void requireTarget(const FlowGraph& graph, int targetState) {
   if (targetState < -1 || targetState >= graph.stateCount())
@@ -79,10 +48,7 @@ RandomWalk::RandomWalk(const FlowGraph& graph, std::uint64_t seed, WalkBias bias
   for (int n = graph.nodeCount() - 1; n >= 0; --n)
     for (const FlowEdge& e : graph.outEdges(n))
       if (e.temporal) mRun[std::size_t(n)] = mRun[std::size_t(e.to)] + 1;
-  std::vector<std::vector<int>> into(std::size_t(graph.nodeCount()));
-  for (int n = 0; n < graph.nodeCount(); ++n)
-    for (const FlowEdge& e : graph.outEdges(n)) into[std::size_t(e.to)].push_back(n);
-  for (int s = 0; s < graph.stateCount(); ++s) mDistance.push_back(distancesTo(graph, s, into));
+  mTargets = TargetDistances(graph, transitionHold);
   mCurrent = graph.node(startState, 0);
   if (graph.pruned(mCurrent))
     throw std::invalid_argument("start_state " + std::to_string(startState) + ": its first node was pruned");
@@ -98,15 +64,18 @@ void RandomWalk::probabilities(int node, int targetState, std::vector<double>& p
   const bool filter = mHold > 0 && longEdges > 0;
   auto allowed = [&](const FlowEdge& e) { return !filter || longEnough(e); };
   if (targetState >= 0) {
-    // §5.1 target state W: along a shortest path to W', then staying in it (see the header);
-    // edges the hold allows first (reaching W matters more than one shortened hold).
-    const std::vector<int>& dist = mDistance[std::size_t(targetState)];
-    const int here = dist[std::size_t(node)];
+    // §5.1 target state W: along a shortest path to W' (its distance counting the holds), then
+    // staying in W' (see the header), inside it the edges the hold allows first.
+    // The strict distance (no hold broken on the way) where it is finite, else the loose one.
+    const bool strict = mTargets(targetState, node, 0, true) != kFar;
+    const int here = mTargets(targetState, node, 0, strict);
     if (here != kFar) {
-      const int want = here == 0 ? 0 : here - 1;
       for (bool mustAllow : {true, false}) {
         auto take = [&](const FlowEdge& e) {
-          return (!mustAllow || allowed(e)) && dist[std::size_t(e.to)] == want;
+          if (here == 0)  // stay in W', the hold that follows a transition kept inside it
+            return mTargets.inGoal(targetState, e.to) &&
+                   (!mustAllow || e.temporal || mTargets.goalRun(targetState, e.to) >= mHold);
+          return mTargets(targetState, e.to, e.temporal ? 0 : mHold, strict) == here - 1;
         };
         int k = 0;
         for (const FlowEdge& e : edges) k += take(e);
@@ -142,12 +111,11 @@ void RandomWalk::biased(const FlowGraph::EdgeRange& edges, const Take& take, std
   }
 }
 
-bool RandomWalk::keepsTarget(int from, int to, int targetState) const {
+bool RandomWalk::keepsTarget(int from, int to, int holdAfter, int targetState) const {
   if (targetState < 0) return true;
-  const std::vector<int>& dist = mDistance[std::size_t(targetState)];
-  const int here = dist[std::size_t(from)], there = dist[std::size_t(to)];
-  if (here == 0) return there == 0;          // inside W': stay in it
-  return here == kFar || there != kFar;      // on the way: never where W' is out of reach
+  if (mTargets.inGoal(targetState, from)) return mTargets.inGoal(targetState, to);  // stay in W'
+  return mTargets(targetState, from, holdAfter + 1, false) == kFar ||  // on the way: never
+         mTargets(targetState, to, holdAfter, false) != kFar;          // where W' is out of reach
 }
 
 std::vector<double> RandomWalk::edgeProbabilities(int node, int targetState) const {
@@ -166,7 +134,7 @@ int RandomWalk::next(int targetState) {
   if (mHoldLeft > 0) {  // the transition state: the temporal edge, no draw
     --mHoldLeft;
     for (const FlowEdge& e : edges)
-      if (e.temporal && keepsTarget(mCurrent, e.to, targetState)) return mCurrent = e.to;
+      if (e.temporal && keepsTarget(mCurrent, e.to, mHoldLeft, targetState)) return mCurrent = e.to;
     ++mForced;  // the time line ends here, or leaves the target: a transition after all (below)
   }
   probabilities(mCurrent, targetState, mScratch);

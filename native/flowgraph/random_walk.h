@@ -6,9 +6,9 @@
 
 #include "core/rng.h"
 #include "flowgraph/flow_graph.h"
+#include "flowgraph/target_distance.h"
 
 #include <cstdint>
-#include <limits>
 #include <vector>
 
 namespace plume {
@@ -49,11 +49,13 @@ class RandomWalk {
   int holdRemaining() const { return mHoldLeft; }
   /// Transitions taken while holding, because the node had no temporal edge nor long transition.
   long long forcedTransitions() const { return mForced; }
-  /// δ(node) for target state `state`: the fewest edges to W' (see edgeProbabilities()), −1
-  /// where W' cannot be reached.
-  int targetDistance(int node, int state) const {
-    const int d = mDistance[std::size_t(state)][std::size_t(node)];
-    return d == std::numeric_limits<int>::max() ? -1 : d;
+  /// D(node, h) for target state `state` (target_distance.h): the fewest node steps from
+  /// `node` with `hold` hold steps left (0: a free step) to W' (see edgeProbabilities()), the
+  /// strict distance where finite, else the loose one; −1 where W' cannot be reached.
+  int targetDistance(int node, int state, int hold = 0) const {
+    int d = mTargets(state, node, hold, true);
+    if (d == TargetDistances::kFar) d = mTargets(state, node, hold, false);
+    return d == TargetDistances::kFar ? -1 : d;
   }
   /// Temporal edges that follow `node` before its state's time line ends (or is pruned).
   int temporalRun(int node) const { return mRun[std::size_t(node)]; }
@@ -69,8 +71,10 @@ class RandomWalk {
   /// current visited node is from the target state"). The goal is W' = the nodes of W from which
   /// a walk can stay in W forever (FlowGraph::staysInState; all of W if none can), so that "once
   /// a target state is reached, the traversal will remain there" holds on any graph. With
-  /// δ(n) the fewest edges from n to W': outside W' the walk takes, uniformly, one of the edges
-  /// on a shortest path (δ(to) = δ(node) − 1), so it reaches W' in δ steps wherever it starts
+  /// δ(n) = D(n, 0) the fewest node steps from n to W', the holds of the transition state
+  /// counted (target_distance.h): outside W' a free step takes, uniformly, one of the edges on a
+  /// shortest path (D of the walk state it leads to = δ(node) − 1), so it reaches W' in δ steps
+  /// wherever it starts
   /// (taking only edges straight into W, a walk can wander for ever in a part of the graph
   /// whose exits to W are several edges away); inside W' it takes the edges that stay in W'
   /// (δ = 0) with the bias below (eq. 12 or uniform) among them. Where W cannot be reached
@@ -93,7 +97,7 @@ class RandomWalk {
   void biased(const FlowGraph::EdgeRange& edges, const Take& take, std::vector<double>& p) const;
   /// False when a held step from → to would leave the target's goal W' or put it out of reach:
   /// the hold then ends early (a forced transition), since the artist's key comes first.
-  bool keepsTarget(int from, int to, int targetState) const;
+  bool keepsTarget(int from, int to, int holdAfter, int targetState) const;
   /// False for an edge a free step drops under the hold (a transition with a short run).
   bool longEnough(const FlowEdge& e) const { return e.temporal || mRun[std::size_t(e.to)] >= mHold; }
 
@@ -106,8 +110,8 @@ class RandomWalk {
   int mHoldLeft = 0;
   long long mForced = 0;
   std::vector<int> mRun;  ///< temporalRun() of every node
-  /// δ of every node to the goal W' of each target state (kFar where W' cannot be reached).
-  std::vector<std::vector<int>> mDistance;
+  TargetDistances mTargets;  ///< D of every walk state to each target state's goal W'
+
   std::vector<double> mScratch;
 };
 

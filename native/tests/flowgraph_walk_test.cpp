@@ -172,6 +172,27 @@ TEST(FlowGraphWalk, TargetIsReachedAlongAShortestPath) {
   EXPECT_GE(far, 2);  // some starts were more than one edge away
 }
 
+TEST(FlowGraphWalk, TargetIsReachedAcrossHolds) {
+  // With the transition state, the distance counts the holds (target_distance.h): a steered
+  // walk still reaches W' in exactly D(start, h) node steps, its transitions spaced by the hold.
+  const FlowGraph g = walkGraph();
+  const int hold = 12;
+  RandomWalk walk(g, 5, WalkBias::Temporal, 0.875, 0, hold);
+  long long forcedBefore = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    for (int k = 0; k < 41; ++k) walk.next();
+    const int target = trial % 3;
+    const int delta = walk.targetDistance(walk.current(), target, walk.holdRemaining());
+    ASSERT_GE(delta, 0);
+    for (int k = 0; k < delta; ++k) {
+      walk.next(target);
+      EXPECT_EQ(walk.targetDistance(walk.current(), target, walk.holdRemaining()), delta - k - 1);
+    }
+    EXPECT_EQ(g.state(walk.current()), target);
+  }
+  EXPECT_EQ(walk.forcedTransitions(), forcedBefore);
+}
+
 TEST(FlowGraphWalk, TemporalRuns) {
   const FlowGraph g = walkGraph();
   RandomWalk walk(g, 1);
