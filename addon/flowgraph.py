@@ -12,7 +12,6 @@ n of the graph is group node_steps[n] of state node_states[n]'s pathline file.
 import math
 import os
 import time
-import zipfile
 import zlib
 from dataclasses import dataclass, field
 from typing import Callable, List, Optional, Sequence, Tuple
@@ -81,15 +80,8 @@ def read_walk(path):
     """dict(nodes, states, steps, frame_start, nodes_per_frame, transition_hold,
     unreachable_target, transitions) of a walk file (transitions: transition_indices()); OSError
     or ValueError when it cannot be read or its arrays do not match."""
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            w = {name: np.array(data[name]) for name in (
-                "nodes", "states", "steps", "frame_start", "nodes_per_frame", "transition_hold",
-                "unreachable_target")}
-    except KeyError as e:
-        raise ValueError(f"{path}: no {e} array") from None
-    except zipfile.BadZipFile as e:
-        raise ValueError(f"{path}: {e}") from None
+    w = files.load_npz(path, ("nodes", "states", "steps", "frame_start", "nodes_per_frame",
+                              "transition_hold", "unreachable_target"))
     n = len(w["nodes"])
     if (w["states"].shape != (n,) or w["steps"].shape != (n,) or int(w["nodes_per_frame"]) < 1
             or w["unreachable_target"].shape != (2,)):
@@ -126,14 +118,7 @@ def write_points(path, particles, cap):
 def read_points(path):
     """dict(positions, temperature, density, live) of a points file; OSError or ValueError when
     it cannot be read or its arrays do not match (sizes checked, never trusted)."""
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            p = {name: np.array(data[name]) for name in ("positions", "temperature", "density",
-                                                         "live")}
-    except KeyError as e:
-        raise ValueError(f"{path}: no {e} array") from None
-    except zipfile.BadZipFile as e:
-        raise ValueError(f"{path}: {e}") from None
+    p = files.load_npz(path, ("positions", "temperature", "density", "live"))
     n = len(p["temperature"])
     if (p["positions"].shape != (n, 3) or p["density"].shape != (n,) or p["live"].shape != ()
             or int(p["live"]) < n or any(p[k].dtype != np.float32

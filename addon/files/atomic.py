@@ -61,3 +61,18 @@ def npz_bytes(compressed=False, **arrays):
 def save_npz(path, compressed=False, **arrays):
     """np.savez (or savez_compressed) to `path`, atomically."""
     return write_bytes(path, npz_bytes(compressed, **arrays))
+
+
+def load_npz(path, names):
+    """dict name -> array of the arrays `names` of an .npz file (no pickles); OSError when it
+    cannot be read, ValueError naming the file when it is no .npz or an array is missing. The
+    caller checks the sizes."""
+    import zipfile
+    import numpy as np
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return {name: np.array(data[name]) for name in names}
+    except KeyError as e:
+        raise ValueError(f"{path}: no {e} array") from None
+    except zipfile.BadZipFile as e:
+        raise ValueError(f"{path}: {e}") from None
