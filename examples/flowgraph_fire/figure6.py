@@ -110,7 +110,7 @@ def plot(rows, lifetime, path):
     blocks = sorted({k[0] for k in rows})
     strategies = ("random", "biased", "target")
     labels = {"random": "random (1/d)", "biased": "temporal bias γ = 0.875", "target": "target states"}
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4.2))
     titles = ("share of temporal edges", "frames between transitions", "mean cost of transitions")
     width = 0.8 / (2 * len(strategies))
     colors = {"random": "#d0703c", "biased": "#3c78d0", "target": "#5aa05a"}
@@ -126,10 +126,11 @@ def plot(rows, lifetime, path):
         ax.set_title(titles[a], fontsize=10)
         if a == 1:
             ax.set_yscale("log")
-    axes[0].legend(fontsize=7, loc="lower right")
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, fontsize=8, loc="lower center", ncol=3, frameon=False)
     fig.suptitle("Figure 6: traversal strategies on the campfire's flow graph (50,000 node steps "
                  "each)", fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.12, 1, 1))
     fig.savefig(path, dpi=90)
     print(f"-> {path}")
 
