@@ -11,6 +11,7 @@
 #include "core/parallel.h"
 #include "io/byte_buffer.h"
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -176,6 +177,15 @@ void readState(const std::string& path, SmokeSolver& solver) {
     }
     values[g].resize(std::size_t(count));
     r.floats(values[g].data(), std::size_t(count));
+    // A checksum only proves the bytes are the ones written: a NaN or infinity (a diverged
+    // bake, a hand-made file) would become an index of INT_MIN in the next step's sampling.
+    for (std::size_t i = 0; i < values[g].size(); ++i)
+      if (!std::isfinite(values[g][i])) {
+        std::ostringstream s;
+        s << "is corrupt: grid '" << expectName << "' holds a non-finite value (" << values[g][i]
+          << ") at index " << i;
+        fail(path, s.str());
+      }
   }
   if (r.position() + 8 != expectedSize) fail(path, "is corrupt (unexpected trailing bytes)");
 

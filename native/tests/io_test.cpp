@@ -7,10 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -245,6 +247,26 @@ TEST(StateFile, BadFilesThrowAndLeaveTheSolverUnchanged) {
 
   EXPECT_THROW(readState((dir / "nope.bin").string(), b), std::runtime_error);
   expectSameState(b, reference);
+
+  // Checksum-valid files holding NaN or infinity (written as they are: the checksum is right)
+  // are refused by grid name, before they reach the sampling (where NaN became an index).
+  for (float bad_value : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+    SmokeSolver poisoned(smallParams());
+    fillPattern(poisoned, 3.f);
+    poisoned.temperature().values()[17] = bad_value;
+    const std::string nan = (dir / "nan.bin").string();
+    writeState(nan, poisoned);
+    try {
+      readState(nan, b);
+      ADD_FAILURE() << "accepted a state holding " << bad_value;
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("non-finite"), std::string::npos) << what;
+      EXPECT_NE(what.find("'temperature'"), std::string::npos) << what;
+      EXPECT_NE(what.find("index 17"), std::string::npos) << what;
+    }
+    expectSameState(b, reference);
+  }
 
   // A state of another resolution is refused by name.
   SmokeParams other = smallParams();
