@@ -23,7 +23,10 @@ namespace plume {
 /// last cell taken for x = n-1. Every trilinear and cubic sample of Plume splits this way.
 inline void splitCoordinate(float x, int n, int& i, float& t) {
   const float hi = float(n - 1);
-  x = x < 0.f ? 0.f : (x > hi ? hi : x);
+  // max(x, 0) then min(x, hi) as SSE's maxps/minps select (a > b ? a : b, a < b ? a : b): a NaN
+  // coordinate lands on 0 instead of becoming the index INT_MIN.
+  x = x > 0.f ? x : 0.f;
+  x = x < hi ? x : hi;
   i = int(x);
   if (i >= n - 1) i = n > 1 ? n - 2 : 0;
   t = x - float(i);
@@ -34,8 +37,7 @@ inline void splitCoordinate(float x, int n, int& i, float& t) {
 /// form; lanes differ at most in the sign of a zero fraction, which no sample depends on).
 inline void splitCoordinate4(__m128 x, int n, __m128i& i, __m128& t) {
   const __m128 zero = _mm_setzero_ps(), hi = _mm_set1_ps(float(n - 1));
-  x = _mm_blendv_ps(x, zero, _mm_cmplt_ps(x, zero));
-  x = _mm_blendv_ps(x, hi, _mm_cmpgt_ps(x, hi));
+  x = _mm_min_ps(_mm_max_ps(x, zero), hi);  // NaN -> 0, as the scalar form
   i = _mm_cvttps_epi32(x);
   const __m128i last = _mm_cmpgt_epi32(i, _mm_set1_epi32(n - 2));  // i >= n - 1
   i = _mm_blendv_epi8(i, _mm_set1_epi32(n > 1 ? n - 2 : 0), last);
@@ -48,8 +50,7 @@ inline void splitCoordinate4(__m128 x, int n, __m128i& i, __m128& t) {
 __attribute__((target("avx2"))) inline void splitCoordinate8(__m256 x, int n, __m256i& i,
                                                              __m256& t) {
   const __m256 zero = _mm256_setzero_ps(), hi = _mm256_set1_ps(float(n - 1));
-  x = _mm256_blendv_ps(x, zero, _mm256_cmp_ps(x, zero, _CMP_LT_OQ));
-  x = _mm256_blendv_ps(x, hi, _mm256_cmp_ps(x, hi, _CMP_GT_OQ));
+  x = _mm256_min_ps(_mm256_max_ps(x, zero), hi);  // NaN -> 0, as the scalar form
   i = _mm256_cvttps_epi32(x);
   const __m256i last = _mm256_cmpgt_epi32(i, _mm256_set1_epi32(n - 2));  // i >= n - 1
   i = _mm256_blendv_epi8(i, _mm256_set1_epi32(n > 1 ? n - 2 : 0), last);

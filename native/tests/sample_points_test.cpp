@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <vector>
 
 namespace plume {
@@ -36,6 +38,27 @@ TEST(SamplePoints, PositionIsTheClampedPosition) {
   for (std::size_t m = 0; m < f.positions.size(); ++m) {
     const glm::vec3 p = glm::clamp(f.positions[m], glm::vec3(0.f), glm::vec3(f.grid.size() - 1));
     ASSERT_EQ(f.points.position(m), p) << m;
+  }
+}
+
+TEST(SamplePoints, NonFiniteCoordinatesStayInsideTheGrid) {
+  // A NaN coordinate (a diverged velocity, a corrupt state) lands on cell 0 instead of the
+  // index INT_MIN; infinities clamp onto the sides. The four- and eight-lane forms agree.
+  const float nan = std::nanf(""), inf = std::numeric_limits<float>::infinity();
+  for (float x : {nan, inf, -inf}) {
+    int i = -1;
+    float t = -1.f;
+    splitCoordinate(x, 9, i, t);
+    EXPECT_GE(i, 0) << x;
+    EXPECT_LE(i, 7) << x;
+    EXPECT_TRUE(t >= 0.f && t <= 1.f) << x;
+#if defined(__SSE4_1__)
+    __m128i i4;
+    __m128 t4;
+    splitCoordinate4(_mm_set1_ps(x), 9, i4, t4);
+    EXPECT_EQ(_mm_cvtsi128_si32(i4), i) << x;
+    EXPECT_EQ(_mm_cvtss_f32(t4), t) << x;
+#endif
   }
 }
 
