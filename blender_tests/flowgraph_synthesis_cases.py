@@ -12,6 +12,17 @@ from helpers import assert_reports_error, native, select_only
 
 
 class SynthesisCases:
+    def synthesis_settings(self, frames):
+        """The graph's settings of test_1's graph (skips without it), the windy state selected,
+        frames 1..frames, no force fields and no point preview."""
+        g = self.windy.plume.domain.flowgraph
+        if not g.summary:
+            self.skipTest("needs the graph of test_1")
+        select_only(self.windy)
+        g.frame_start, g.frame_end = 1, frames
+        g.use_force_fields, g.point_preview = False, False
+        return g
+
     def walk(self):
         from plume import flowgraph
         return flowgraph.read_walk(flowgraph.walk_path(self.folder(self.windy)))
@@ -21,12 +32,7 @@ class SynthesisCases:
         transitions of a 200-frame random walk are closer than the pathlines' lifetime L (24 node
         steps here), and the keyed target is still reached; Off lets them follow each other. A
         hold longer than the bake is refused, naming the setting, and nothing changes."""
-        g = self.windy.plume.domain.flowgraph
-        if not g.summary:
-            self.skipTest("needs the graph of test_1")
-        select_only(self.windy)
-        g.frame_start, g.frame_end = 1, 200
-        g.use_force_fields, g.point_preview = False, False
+        g = self.synthesis_settings(200)
         g.traversal = 'UNIFORM'  # transitions wherever they exist: the hold is what spaces them
         from plume import blender_compat
         fcurves = blender_compat.fcurves(self.windy)
@@ -89,12 +95,7 @@ class SynthesisCases:
         windy state's lean along x, which would hide a trail along x). A non-mesh Fire
         Source is refused and changes nothing."""
         n = native()
-        g = self.windy.plume.domain.flowgraph
-        if not g.summary:
-            self.skipTest("needs the graph of test_1")
-        select_only(self.windy)
-        g.frame_start, g.frame_end = 1, 40
-        g.use_force_fields, g.point_preview = False, False
+        g = self.synthesis_settings(40)
         folder = self.folder(self.windy)
 
         def base_and_width():
