@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 from ..settings import BakeError
-from . import registry
+from . import folder_lock, registry
 from .staging import Staging
 
 
@@ -111,6 +111,8 @@ class JobRunner(abc.ABC):
         self.forecast_said = None
         #: time.perf_counter() of the first cancel() (None while not cancelled).
         self.cancelled_at = None
+        #: The FolderLocks of the cache folders the job writes (lock_folder()).
+        self.folder_locks = []
 
     # ------------------------------------------------------------------ the four parts
     def forecast(self, context):
@@ -172,6 +174,19 @@ class JobRunner(abc.ABC):
         """Holds registry keys for the job's life (BakeError with the holder's busy_text when
         another job holds one); call it in prepare() as soon as the keys are known."""
         registry.claim(self, keys)
+
+    def lock_folder(self, folder, setting=None):
+        """Makes the job the one writer of cache folder `folder` (folder_lock.py) until it ends
+        in any way (registry.release()); LockHeld naming the holder when another Blender or job
+        writes it, BakeError naming `setting` when the folder cannot be written. Call it in
+        prepare() before anything is written."""
+        self.folder_locks.append(folder_lock.acquire(folder, self.title, setting=setting,
+                                                     on_lost=self.cancel))
+
+    def release_folders(self):
+        """Drops the job's cache folder locks (registry.release() calls it); safe twice."""
+        for lock in self.folder_locks:
+            lock.release()
 
     def cancel(self):
         """Thread-safe: run() stops within one unit of work; watched native objects too."""
