@@ -177,6 +177,8 @@ class FolderLock:
     def __init__(self, folder, fd, record, made_dirs, on_lost):
         self.folder, self.path = folder, lock_path(folder)
         self.record, self.lost = record, False
+        #: The setting naming the folder in reports ("cache_directory '//x/'"), if any.
+        self.setting = None
         self._fd, self._made, self._on_lost = fd, made_dirs, on_lost
         self._stop = threading.Event()
         self._beat = threading.Thread(target=self._refresh_loop, daemon=True,
@@ -328,7 +330,9 @@ def acquire(folder, job, setting=None, on_lost=None):
         for _ in range(ATTEMPTS):
             fd, refusal = _try_once(folder, record)
             if fd is not None:
-                return FolderLock(folder, fd, record, made, on_lost)
+                lock = FolderLock(folder, fd, record, made, on_lost)
+                lock.setting = setting
+                return lock
             if refusal is not None:
                 raise LockHeld(refusal)
         raise LockHeld(f"Plume: cache folder '{folder}': its lock file '{lock_path(folder)}' "

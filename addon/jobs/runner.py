@@ -27,6 +27,7 @@ import time
 from dataclasses import dataclass
 from typing import Optional
 
+from ..files import no_room
 from ..settings import BakeError
 from . import folder_lock, registry
 from .staging import Staging
@@ -161,6 +162,21 @@ class JobRunner(abc.ABC):
         if isinstance(exc, BakeError):
             return str(exc)
         return f"Plume: {self.title} failed: {exc}"
+
+    def no_room_text(self, exc):
+        """The report of a write that failed for want of room (a full disk, the file size
+        limit), naming the cache folder and its setting; None for any other error."""
+        reason = no_room(exc)
+        if reason is None:
+            return None
+        lock = self.folder_locks[0] if self.folder_locks else None
+        where = "the cache folder" if lock is None else f"cache folder '{lock.folder}'"
+        if lock is not None and lock.setting:
+            where += f" ({lock.setting})"
+        kept = ("the frames finished before are kept" if self.keeps_partial
+                else "nothing was changed")
+        return (f"Plume: {self.title} stopped: {reason} writing into {where}: {exc}. Free space "
+                f"there or choose another cache folder, then run {self.title} again; {kept}")
 
     def cancelled_text(self):
         return f"Plume: {self.title} cancelled: nothing was changed"
