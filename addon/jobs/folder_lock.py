@@ -40,6 +40,7 @@ try:
 except ImportError:  # Windows: the record alone decides
     fcntl = None
 
+from ..files import no_room
 from ..settings import BakeError
 
 LOCK_NAME = ".plume.lock"
@@ -338,7 +339,9 @@ def acquire(folder, job, setting=None, on_lost=None):
         raise LockHeld(f"Plume: cache folder '{folder}': its lock file '{lock_path(folder)}' "
                        f"keeps changing (other Blenders are starting to write it); try again")
     except OSError as e:
-        error = BakeError(f"Plume: {what} is not writable ({folder}: {e.strerror or e})")
+        full = no_room(e)  # "the disk is full"
+        reason = f"cannot be written: {full}" if full else "is not writable"
+        error = BakeError(f"Plume: {what} {reason} ({folder}: {e.strerror or e})")
     except BaseException:
         _remove_made(made)
         raise
