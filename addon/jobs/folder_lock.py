@@ -203,7 +203,7 @@ class FolderLock:
                     self._on_lost()
             return False
         try:
-            os.utime(fd)
+            os.utime(fd if os.utime in os.supports_fd else self.path)
         except OSError:
             pass
         return True
