@@ -172,6 +172,25 @@ class CacheLockTest(unittest.TestCase):
             lock.release()
         print("  refusal:", msg)
 
+    def test_every_job_writing_the_folder_is_refused(self):
+        # The lock is part of the job machinery: each job on the domain's folder asks for it.
+        # Build Toon Smoke needs a bake and a camera before it gets that far: bake first.
+        self.assert_baked()
+        cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+        bpy.context.scene.collection.objects.link(cam)
+        bpy.context.scene.camera = cam
+        select_only(self.domain)
+        other = self.child("hold", self.folder)
+        pid = int(other.wait_for("HELD "))
+        files = tree_listing(self.tmp)
+        for op in (bpy.ops.plume.bake, bpy.ops.plume.cache_free, bpy.ops.plume.surfaces_build,
+                   bpy.ops.plume.toon_build, bpy.ops.plume.fire_synthesize):
+            with self.assertRaises(RuntimeError, msg=op.idname()) as cm:
+                op()
+            self.assertIn(f"pid {pid}", str(cm.exception), op.idname())
+        self.assertEqual(tree_listing(self.tmp), files, "files changed")
+        self.assertEqual(other.finish(), 0, "".join(other.log))
+
     # ------------------------------------------------------------------ stale locks
     def test_lock_of_a_killed_blender_is_taken_over(self):
         other = self.child("hold", self.folder)
