@@ -289,6 +289,34 @@ class CacheLockTest(unittest.TestCase):
         self.domain.plume.domain.vorticity = 0.0
         self.assert_baked()
 
+    def test_lock_released_when_a_file_load_aborts_the_bake(self):
+        # The bake on its worker thread (as from a button), held after frame 1 until it is
+        # cancelled; loading a file aborts it (quit takes the same path: registry.abort_all).
+        from plume.jobs import Worker, registry
+        from plume.operators.bake import BakeJob
+        job, at_frame, gate = BakeJob(), threading.Event(), threading.Event()
+
+        def progress(p):
+            if p.done >= 1:
+                at_frame.set()
+                gate.wait()
+        cancel = job.cancel
+
+        def cancel_and_go_on():
+            cancel()
+            gate.set()
+        job.on_progress, job.cancel = progress, cancel_and_go_on
+        job.prepare(bpy.context)
+        Worker(job).start()
+        self.assertTrue(at_frame.wait(CHILD_TIMEOUT_S))
+        self.assertTrue(os.path.exists(self.lock_file()))
+        path = os.path.join(self.tmp, "other.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+        bpy.ops.wm.open_mainfile(filepath=path)
+        self.assertTrue(job.aborted and job.worker.finished)
+        self.assertEqual(registry.running(), [])
+        self.assertFalse(os.path.exists(self.lock_file()), "the aborted bake kept its lock")
+
     def test_refresh_notices_a_lock_taken_away(self):
         fl = folder_lock()
         lost = []
