@@ -59,10 +59,10 @@ class FlowGraphJob(JobRunner):
         self.states = flowgraph.open_states(
             _native, [(d.name, cache_folder_of(d)) for d in domains])
         self.folder = cache_folder_of(domain)
+        self.lock_folder(self.folder)
         error = cache.check_writable(self.folder)
         if error is not None:
             raise BakeError(f"Plume: cache folder {self.folder} is not writable ({error})")
-        self.lock_folder(self.folder)
         self._job = self._job_started = None
 
     def _attach(self, job):
