@@ -12,14 +12,14 @@ blocking (``blender -b``, scripts) or on a worker thread with progress and Esc (
     runner.finish(context)    main thread: commits the staged files, builds the Blender data,
                               returns the report (kind, text)
 
-A job that writes a cache folder takes its lock in prepare() (lock_folder(), folder_lock.py)
-before writing anything: one writer per folder across Blenders and hosts, released however the
-job ends. A write that fails for want of room is reported by no_room_text().
-
-And when the job is cancelled or fails, ``runner.discard()`` removes whatever it wrote, so the
+and, when the job is cancelled or fails, ``runner.discard()`` removes whatever it wrote, so the
 scene and the cache folder are left as they were. Bakes (keeps_partial) are the exception: their
 per-frame files are complete and resumable, so a cancelled bake keeps them and finish() builds
 what is there.
+
+A job that writes a cache folder takes its lock in prepare() (lock_folder(), folder_lock.py)
+before writing anything: one writer per folder across Blenders and hosts, released however the
+job ends. A write that fails for want of room is reported by no_room_text().
 
 cancel() is thread-safe and may come from the main thread (Esc, file load, a deleted object) at
 any time; native objects that run long register with watch() and are cancelled with it.
