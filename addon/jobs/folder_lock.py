@@ -182,6 +182,7 @@ class FolderLock:
         self.setting = None
         self._fd, self._made, self._on_lost = fd, made_dirs, on_lost
         self._stop = threading.Event()
+        self._fd_lock = threading.Lock()  # refresh() never uses a closed (reused) fd number
         self._beat = threading.Thread(target=self._refresh_loop, daemon=True,
                                       name="plume folder lock")
         self._beat.start()
@@ -193,20 +194,21 @@ class FolderLock:
     def refresh(self):
         """Sign of life: the lock file's time set to now. False (and on_lost called) when the
         path no longer names our file (deleted by hand and taken by another writer)."""
-        fd = self._fd
-        if fd is None:
-            return False
-        if not _same_file(fd, self.path):
-            if not self.lost:
-                self.lost = True
-                if self._on_lost is not None:
-                    self._on_lost()
-            return False
-        try:
-            os.utime(fd if os.utime in os.supports_fd else self.path)
-        except OSError:
-            pass
-        return True
+        with self._fd_lock:
+            fd = self._fd
+            if fd is None:
+                return False
+            ours = _same_file(fd, self.path)
+            if ours:
+                try:
+                    os.utime(fd if os.utime in os.supports_fd else self.path)
+                except OSError:
+                    pass
+        if not ours and not self.lost:
+            self.lost = True
+            if self._on_lost is not None:
+                self._on_lost()
+        return ours
 
     def _refresh_loop(self):
         while not self._stop.wait(REFRESH_S):
@@ -214,7 +216,8 @@ class FolderLock:
 
     def release(self):
         """Deletes the lock file (when still ours) and drops the flock; safe to call twice."""
-        fd, self._fd = self._fd, None
+        with self._fd_lock:
+            fd, self._fd = self._fd, None
         if fd is None:
             return
         self._stop.set()
@@ -254,7 +257,7 @@ def _create(folder, record):
     try:
         os.link(tmp, path)
         return fd
-    except FileExistsError:
+    except (FileExistsError, FileNotFoundError):  # another was first (or swept our .tmp)
         os.close(fd)
         return None
     except OSError as e:
@@ -263,7 +266,10 @@ def _create(folder, record):
             os.close(fd)
             raise
     finally:
-        os.remove(tmp)
+        try:
+            os.remove(tmp)
+        except FileNotFoundError:
+            pass
     os.close(fd)  # no hard links here: exclusive create, then the record
     try:
         fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
