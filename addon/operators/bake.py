@@ -4,6 +4,8 @@ plume.bake is a job (jobs/): blocking in execute() (``blender -b``, scripts), on
 with status-bar progress and Esc from a button. A cancelled bake keeps its complete frames (a
 later bake with the same settings resumes from them) and builds the Volume over them."""
 
+import os
+
 import bpy
 
 from .. import bake_runner, cache, cache_state
@@ -105,9 +107,11 @@ class PLUME_OT_cache_free(bpy.types.Operator):
                                    "it first")
             return {'CANCELLED'}
         folder = cache_folder_of(domain)
+        count = 0
         try:
-            with folder_lock.holding(folder, "Free Bake"):  # not while another Blender bakes
-                count = cache.delete_plume_files(folder)
+            if os.path.isdir(folder):
+                with folder_lock.holding(folder, "Free Bake"):  # not while another Blender bakes
+                    count = cache.delete_plume_files(folder)
         except BakeError as e:
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
