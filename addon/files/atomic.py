@@ -1,8 +1,11 @@
 """The one way the add-on writes a cache file, so a cancelled or killed job never leaves a half
 file (DESIGN.md "Cache folder"): the bytes go to a temporary name in the same folder
 (``<name>.<pid>_<random>.tmp``, which the cache cleaners recognise), are flushed and fsynced,
-renamed over the final name, and the folder is fsynced so the rename itself survives a crash."""
+renamed over the final name, and the folder is fsynced so the rename itself survives a crash.
+A write that fails (a full disk) removes its temporary file and leaves the final name as it was;
+no_room() tells such a failure from others, for the reports."""
 
+import errno
 import io
 import os
 import uuid
@@ -11,6 +14,24 @@ import numpy as np
 
 #: Ending of every temporary file; cache cleaners and job staging skip or delete these.
 TMP_SUFFIX = ".tmp"
+
+
+#: errno of a write that failed for want of room -> what the report says.
+NO_ROOM = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is used up",
+           errno.EFBIG: "the file size limit is reached"}
+
+
+def no_room(exc):
+    """What a failed write means when it failed for want of room ("the disk is full", "the file
+    size limit is reached"), else None: from an OSError's errno, or from the reason the native
+    writers put in their RuntimeError (the errno's text, e.g. "No space left on device")."""
+    if isinstance(exc, OSError) and exc.errno in NO_ROOM:
+        return NO_ROOM[exc.errno]
+    text = str(exc)
+    for code, meaning in NO_ROOM.items():
+        if os.strerror(code) in text:
+            return meaning
+    return None
 
 
 def temporary_path(path):

@@ -7,6 +7,7 @@ fire synthesis, mesh export) as one runner protocol and one operator mixin.
               + Esc; cancel() when Blender drops the handler
 - worker.py   the thread run() executes on
 - registry.py which jobs run, by the keys they hold (one job per domain at a time)
+- folder_lock.py one writer per cache folder (.plume.lock: host, pid, job; flock; stale takeover)
 - staging.py  new files kept in a hidden folder until the job succeeds (atomic renames)
 - handlers.py file load, quit and add-on disable abort the running jobs
 """

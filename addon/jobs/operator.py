@@ -238,7 +238,7 @@ class JobOperator:
         try:
             if error is not None:
                 runner.discard()
-                self.report({'ERROR'}, runner.error_text(error))
+                self.report({'ERROR'}, runner.no_room_text(error) or runner.error_text(error))
                 return {'CANCELLED'}
             if gone is not None:
                 runner.discard()
@@ -255,7 +255,7 @@ class JobOperator:
                 if not isinstance(e, BakeError):
                     traceback.print_exc()
                 runner.discard()
-                self.report({'ERROR'}, runner.error_text(e))
+                self.report({'ERROR'}, runner.no_room_text(e) or runner.error_text(e))
                 return {'CANCELLED'}
             if runner.forecast_said is not None:
                 text += f" (forecast: {runner.forecast_said.about()})"

@@ -32,7 +32,8 @@ def claim(runner, keys):
 
 
 def release(runner):
-    """Frees every key of `runner` (no-op when it holds none)."""
+    """Frees every key of `runner` (no-op when it holds none) and its cache folder locks."""
+    runner.release_folders()
     for key in list(runner.keys):
         if _held.get(key) is runner:
             del _held[key]

@@ -17,6 +17,10 @@ scene and the cache folder are left as they were. Bakes (keeps_partial) are the 
 per-frame files are complete and resumable, so a cancelled bake keeps them and finish() builds
 what is there.
 
+A job that writes a cache folder takes its lock in prepare() (lock_folder(), folder_lock.py)
+before writing anything: one writer per folder across Blenders and hosts, released however the
+job ends. A write that fails for want of room is reported by no_room_text().
+
 cancel() is thread-safe and may come from the main thread (Esc, file load, a deleted object) at
 any time; native objects that run long register with watch() and are cancelled with it.
 """
@@ -27,8 +31,9 @@ import time
 from dataclasses import dataclass
 from typing import Optional
 
+from ..files import no_room
 from ..settings import BakeError
-from . import registry
+from . import folder_lock, registry
 from .staging import Staging
 
 
@@ -111,6 +116,8 @@ class JobRunner(abc.ABC):
         self.forecast_said = None
         #: time.perf_counter() of the first cancel() (None while not cancelled).
         self.cancelled_at = None
+        #: The FolderLocks of the cache folders the job writes (lock_folder()).
+        self.folder_locks = []
 
     # ------------------------------------------------------------------ the four parts
     def forecast(self, context):
@@ -160,6 +167,21 @@ class JobRunner(abc.ABC):
             return str(exc)
         return f"Plume: {self.title} failed: {exc}"
 
+    def no_room_text(self, exc):
+        """The report of a write that failed for want of room (a full disk, the file size
+        limit), naming the cache folder and its setting; None for any other error."""
+        reason = no_room(exc)
+        if reason is None:
+            return None
+        lock = self.folder_locks[0] if self.folder_locks else None
+        where = "the cache folder" if lock is None else f"cache folder '{lock.folder}'"
+        if lock is not None and lock.setting:
+            where += f" ({lock.setting})"
+        kept = ("the frames finished before are kept" if self.keeps_partial
+                else "nothing was changed")
+        return (f"Plume: {self.title} stopped: {reason} writing into {where}: {exc}. Free space "
+                f"there or choose another cache folder, then run {self.title} again; {kept}")
+
     def cancelled_text(self):
         return f"Plume: {self.title} cancelled: nothing was changed"
 
@@ -172,6 +194,19 @@ class JobRunner(abc.ABC):
         """Holds registry keys for the job's life (BakeError with the holder's busy_text when
         another job holds one); call it in prepare() as soon as the keys are known."""
         registry.claim(self, keys)
+
+    def lock_folder(self, folder, setting=None):
+        """Makes the job the one writer of cache folder `folder` (folder_lock.py) until it ends
+        in any way (registry.release()); LockHeld naming the holder when another Blender or job
+        writes it, BakeError naming `setting` when the folder cannot be written. Call it in
+        prepare() before anything is written."""
+        self.folder_locks.append(folder_lock.acquire(folder, self.title, setting=setting,
+                                                     on_lost=self.cancel))
+
+    def release_folders(self):
+        """Drops the job's cache folder locks (registry.release() calls it); safe twice."""
+        for lock in self.folder_locks:
+            lock.release()
 
     def cancel(self):
         """Thread-safe: run() stops within one unit of work; watched native objects too."""

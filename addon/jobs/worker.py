@@ -4,6 +4,7 @@ import threading
 import time
 import traceback
 
+from ..files import no_room
 from ..settings import BakeError
 from .runner import JobCancelled
 
@@ -31,8 +32,8 @@ class Worker:
             pass
         except Exception as e:  # reported by the operator on the main thread
             if not self.runner.cancelled:
-                if not isinstance(e, BakeError):  # bad input is reported, not a bug
-                    traceback.print_exc()
+                if not isinstance(e, BakeError) and no_room(e) is None:  # a bug: its trace
+                    traceback.print_exc()  # (bad input and a full disk are reported, not bugs)
                 self.error = e
         finally:
             self.ended_at = time.perf_counter()

@@ -4,12 +4,14 @@ plume.bake is a job (jobs/): blocking in execute() (``blender -b``, scripts), on
 with status-bar progress and Esc from a button. A cancelled bake keeps its complete frames (a
 later bake with the same settings resumes from them) and builds the Volume over them."""
 
+import os
+
 import bpy
 
 from .. import bake_runner, cache, cache_state
 from ..native import _native
 from ..build import volume
-from ..jobs import JobOperator, JobRunner, registry
+from ..jobs import JobOperator, JobRunner, folder_lock, registry
 from ..mantaflow_trace import MantaflowTraceRunner
 from ..settings import BakeError
 from ..version import VERSION
@@ -34,6 +36,7 @@ class BakeJob(JobRunner):
         self.domain_name = snap.domain_name
         self.objects = (snap.domain_name,)
         self.claim(domain_key(snap.domain_name))
+        self.lock_folder(snap.cache_folder, f"cache_directory '{snap.cache_directory}'")
         # motion_source 'MANTAFLOW': trace the Mantaflow cache's velocity instead of simulating.
         runner_class = bake_runner.BakeRunner if snap.mantaflow is None else MantaflowTraceRunner
         self.bake = runner_class(snap, _native, progress=self._frame_done)
@@ -104,7 +107,14 @@ class PLUME_OT_cache_free(bpy.types.Operator):
                                    "it first")
             return {'CANCELLED'}
         folder = cache_folder_of(domain)
-        count = cache.delete_plume_files(folder)
+        count = 0
+        try:
+            if os.path.isdir(folder):
+                with folder_lock.holding(folder, "Free Bake"):  # not while another Blender bakes
+                    count = cache.delete_plume_files(folder)
+        except BakeError as e:
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
         cache_state.refresh(domain)
         volume.remove_volume(domain)
         self.report({'INFO'}, f"Plume: freed '{domain.name}' ({count} files deleted)")

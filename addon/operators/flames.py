@@ -16,7 +16,8 @@ from ..native import _native
 from ..build import flame_spine_keys, flame_spines, flames_volume
 from ..snapshot import flames_cache_folder
 from ..snapshot.flames import flames_snapshot
-from ..jobs import JobOperator, JobRunner, registry
+from ..jobs import JobOperator, JobRunner, folder_lock, registry
+from ..settings import BakeError
 
 #: The registry key of the scene's flames bake (one at a time).
 FLAMES_KEY = ("flames",)
@@ -32,6 +33,8 @@ class FlamesJob(JobRunner):
         self.t0 = time.perf_counter()
         self.claim(FLAMES_KEY)
         snap = flames_snapshot(context)
+        self.lock_folder(snap.folder, "the flames' cache_directory "
+                                      f"'{context.scene.plume_flames.cache_directory}'")
         self.objects = tuple(dict.fromkeys(src.name for src in snap.sources))
         self.bake = flames.FlameBakeRunner(_native, snap, progress=self._frame_done,
                                            cancel=lambda: self.cancelled)
@@ -103,9 +106,14 @@ class PLUME_OT_flames_free(bpy.types.Operator):
         folder = flames_cache_folder(scene)
         count = 0
         if os.path.isdir(folder):
-            before = len(os.listdir(folder))
-            flames.clear_folder(folder)
-            count = before - len(os.listdir(folder))
+            try:
+                with folder_lock.holding(folder, "Free Flames"):  # not while another Blender bakes
+                    before = len(os.listdir(folder))
+                    flames.clear_folder(folder)
+                    count = before - len(os.listdir(folder))
+            except BakeError as e:
+                self.report({'ERROR'}, str(e))
+                return {'CANCELLED'}
         flames_volume.remove()
         flame_spines.remove(scene)
         f = scene.plume_flames

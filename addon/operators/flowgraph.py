@@ -59,6 +59,7 @@ class FlowGraphJob(JobRunner):
         self.states = flowgraph.open_states(
             _native, [(d.name, cache_folder_of(d)) for d in domains])
         self.folder = cache_folder_of(domain)
+        self.lock_folder(self.folder)
         error = cache.check_writable(self.folder)
         if error is not None:
             raise BakeError(f"Plume: cache folder {self.folder} is not writable ({error})")
@@ -130,6 +131,7 @@ class SynthesisJob(JobRunner):
         self.folder = folder = cache_folder_of(domain)
         self.objects = (domain.name,)
         self.claim(domain_key(domain.name), SYNTHESIS_KEY)
+        self.lock_folder(folder)
         graph, states = flowgraph.load_graph(_native, folder, owner)
         settings = synthesis_settings(domain)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)

@@ -107,6 +107,7 @@ class SurfacesJob(JobRunner):
         self.folder = cache_folder_of(domain)
         self.objects = (domain.name,)
         self.claim(domain_key(domain.name))
+        self.lock_folder(self.folder)
         self.manifest = ss.streak_manifest(self.folder, domain.name)
         size = surfaces_forecast.shot_size(_native, self.folder, self.manifest)
         if size is not None:

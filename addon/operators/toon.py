@@ -44,6 +44,7 @@ class ToonJob(JobRunner):
                             "scene.camera")
         self.objects = (domain.name, scene.camera.name)  # the billboards face the camera
         self.claim(domain_key(domain.name))
+        self.lock_folder(folder)
         # The Sources over the bake's frames: their matrices per frame when they move, their
         # keyed Density / Emit Particles per frame (§2.1 emission follows both).
         frame_start, last = int(manifest["frame_start"]), int(manifest["last_complete_frame"])

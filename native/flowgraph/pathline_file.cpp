@@ -7,6 +7,7 @@
 
 #include <openvdb/Types.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -165,11 +166,12 @@ PathlineFileWriter::PathlineFileWriter(const std::string& path, const PathlineFi
   // The bake that writes this file replaces the older one: removing it first means a kill
   // leaves no complete-looking file of another bake behind.
   std::remove(mPath.c_str());
+  errno = 0;
   mOut.open(partialPath(), std::ios::binary | std::ios::trunc);
-  if (!mOut) fail("cannot be written (missing directory, no permission or disk full?)");
+  if (!mOut) fail("cannot be written: " + writeFailure(errno));
   const std::vector<unsigned char> header = headerBytes(mInfo, kIncomplete, 0);
   mOut.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size()));
-  if (!mOut) fail("cannot be written");
+  if (!mOut) fail("cannot be written: " + writeFailure(errno));
   mOffset = header.size();
   mBlock.resize(mInfo.blockBytes());
 }
@@ -206,8 +208,9 @@ void PathlineFileWriter::append(const PathlineGroup& g) {
   out = encode(&g.velocity[0].x, 3 * v, half, out);
   out = encode(g.density.data(), v, half, out);
   out = encode(g.temperature.data(), v, half, out);
+  errno = 0;
   mOut.write(reinterpret_cast<const char*>(mBlock.data()), std::streamsize(mBlock.size()));
-  if (!mOut) fail("cannot be written (disk full?)");
+  if (!mOut) fail("cannot be written: " + writeFailure(errno));
   mTable.push_back({mOffset, pathlineChecksum(mBlock.data(), mBlock.size())});
   mOffset += mBlock.size();
 }
@@ -221,6 +224,7 @@ void PathlineFileWriter::finish() {
     t.integer<std::uint64_t>(e.checksum);
   }
   t.integer<std::uint64_t>(pathlineChecksum(t.buffer().data(), t.buffer().size()));
+  errno = 0;
   mOut.write(reinterpret_cast<const char*>(t.buffer().data()), std::streamsize(t.buffer().size()));
   // Only now does the header say "complete": a kill before this point leaves it "incomplete".
   const std::vector<unsigned char> header = headerBytes(mInfo, std::uint32_t(mTable.size()), mOffset);
@@ -228,11 +232,13 @@ void PathlineFileWriter::finish() {
   mOut.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size()));
   mOut.flush();
   const bool ok = bool(mOut);
+  int err = errno;
   mOut.close();
+  if (ok && mOut.fail()) err = errno;
   mClosed = true;
   if (!ok || mOut.fail()) {
     std::remove(partialPath().c_str());
-    throw std::runtime_error(named(mPath) + " cannot be written (disk full?)");
+    throw std::runtime_error(named(mPath) + " cannot be written: " + writeFailure(err));
   }
   if (std::rename(partialPath().c_str(), mPath.c_str()) != 0) {
     std::remove(partialPath().c_str());

@@ -1,5 +1,6 @@
 #include "io/byte_buffer.h"
 
+#include <cerrno>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -81,6 +82,14 @@ bool ByteReader::checksumMatches() const {
   return fnv1a64(mData, mSize - 8) == stored;
 }
 
+std::string writeFailure(int err) {
+  if (err == 0) return "a short write";
+  const std::string text = std::strerror(err);
+  if (err == ENOSPC || err == EDQUOT) return "the disk is full (" + text + ")";
+  if (err == EFBIG) return "the file size limit is reached (" + text + ")";
+  return text;
+}
+
 void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,
                      const std::string& kind) {
   writeFileAtomic(path, kind, [&](std::ostream& out) {
@@ -92,20 +101,25 @@ void writeFileAtomic(const std::string& path, const std::string& kind,
                      const std::function<void(std::ostream&)>& write) {
   const std::string tmp = path + ".tmp";
   bool ok = false;
+  errno = 0;
+  int err = 0;
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (out) {
       write(out);
       out.flush();
       ok = bool(out);
+      if (!ok) err = errno;  // the failed write(2)'s
       out.close();
+      if (ok && out.fail()) err = errno;
       ok = ok && !out.fail();
+    } else {
+      err = errno;
     }
   }
   if (!ok) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(kind + " '" + path +
-                             "' cannot be written (missing directory, no permission or disk full?)");
+    std::remove(tmp.c_str());  // no half file: the previous one, if any, stays
+    throw std::runtime_error(kind + " '" + path + "' cannot be written: " + writeFailure(err));
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());

@@ -89,6 +89,11 @@ class ByteReader {
   std::size_t mPos = 0;
 };
 
+/// Why a write failed, from its errno: "the disk is full (No space left on device)" for
+/// ENOSPC and EDQUOT, "the file size limit is reached (File too large)" for EFBIG (RLIMIT_FSIZE,
+/// the file system's largest file), else strerror; "a short write" when errno is 0.
+std::string writeFailure(int err);
+
 /// Writes `bytes` to `path` atomically: to "<path>.tmp", then rename. Throws std::runtime_error
 /// "<kind> '<path>' cannot be written ..." on failure, leaving no temporary file behind.
 void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,

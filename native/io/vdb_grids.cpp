@@ -6,6 +6,9 @@
 #include <openvdb/io/File.h>
 #include <openvdb/tools/Dense.h>
 
+#include "io/byte_buffer.h"
+
+#include <cerrno>
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
@@ -67,16 +70,23 @@ void writeGridsAtomic(const std::string& path, const openvdb::GridPtrVec& grids,
                       const openvdb::MetaMap& meta) {
   initializeOpenVdb();
   const std::string tmp = path + ".tmp";
+  int err = 0;  // errno after OpenVDB's own stream wrote the file
   try {
     {
       openvdb::io::File file(tmp);
       if (openvdb::io::File::hasBloscCompression())
         file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+      errno = 0;
       file.write(grids, meta);
       file.close();
+      err = errno;
     }
-    // io::File::write does not report a failed stream (a full disk): read the grid descriptors
-    // back, which fails on a short file.
+    // io::File::write does not report a failed stream: a write(2) that failed for want of room
+    // left its errno (then the short file is not read back: its garbage sizes could ask for
+    // gigabytes); anything else is caught by reading the grid descriptors back.
+    if (err == ENOSPC || err == EDQUOT || err == EFBIG || err == EIO)
+      throw std::runtime_error(writeFailure(err));
+    err = 0;
     openvdb::io::File check(tmp);
     check.open(/*delayLoad=*/true);
     std::size_t written = 0;
@@ -84,7 +94,7 @@ void writeGridsAtomic(const std::string& path, const openvdb::GridPtrVec& grids,
     check.close();
     if (written != grids.size()) throw std::runtime_error("grids missing after writing");
   } catch (const std::exception& e) {
-    std::remove(tmp.c_str());
+    std::remove(tmp.c_str());  // no half file: the previous one, if any, stays
     fail(path, std::string("cannot be written: ") + e.what());
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
