@@ -111,6 +111,11 @@ class JobRunner(abc.ABC):
         self.forecast_said = None
         #: time.perf_counter() of the first cancel() (None while not cancelled).
         self.cancelled_at = None
+        #: How the job ended (operator.py, registry.py): 'finished', 'cancelled' (Esc; a bake
+        #: keeps its frames), 'gone' (an object it works on was deleted or renamed), 'failed',
+        #: 'aborted' (file load, quit); None while it runs. `report_text`: what was reported.
+        self.outcome = None
+        self.report_text = ""
 
     # ------------------------------------------------------------------ the four parts
     def forecast(self, context):
