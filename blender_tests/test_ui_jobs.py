@@ -31,6 +31,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -105,19 +106,24 @@ class UiJobsTest(unittest.TestCase):
             raise RuntimeError("xvfb-run is missing: install the 'xvfb' package "
                                "(.ci/common.sh does)")
         cls.tmp = tempfile.mkdtemp(prefix="plume_ui_")
+        t0 = time.perf_counter()
         rc, out, res = windowed(cls.tmp, os.path.join(cls.tmp, "matrix.json"), CASES)
         cls.returncode, cls.output, cls.result = rc, out, res
         cls.cases = {(c["operator"], c["action"]): c for c in res["cases"]}
-        cls.quits = {}
-        for case in QUITS:
-            rc, out, res = windowed(cls.tmp, os.path.join(cls.tmp, f"{case}.json"), [case])
-            cls.quits[case] = (rc, out, res)
-        for c in cls.result["cases"] + [q[2]["cases"][-1] for q in cls.quits.values()
-                                        if q[2]["cases"]]:
+        for c in res["cases"]:
             print(f"  {c['operator']}:{c['action']}: at unit {c.get('done_at_action')}, "
-                  f"{c.get('outcome') or 'process ended'}, stopped "
+                  f"{c.get('outcome') or 'nothing ran'}, ended "
                   f"{c.get('seconds_to_stop', float('nan')):.2f} s after; "
                   f"{c.get('report', '')[:90]}")
+        print(f"  {len(CASES)} cases in one windowed Blender: {time.perf_counter() - t0:.0f} s")
+        cls.quits = {}
+        for case in QUITS:
+            t0 = time.perf_counter()
+            rc, out, res = windowed(cls.tmp, os.path.join(cls.tmp, f"{case}.json"), [case])
+            cls.quits[case] = (rc, out, res)
+            c = res["cases"][-1] if res["cases"] else {}
+            print(f"  {case}: quit at unit {c.get('done_at_quit', c.get('done_at_action'))}, "
+                  f"exit code {rc}, the process {time.perf_counter() - t0:.1f} s")
 
     @classmethod
     def tearDownClass(cls):
