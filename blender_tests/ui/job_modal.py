@@ -203,7 +203,8 @@ def end_case(rec):
                    done_at_cancel=run.get("frames_done_at_cancel"), cancelled=run.get("cancelled"),
                    total=m["frame_end"] - m["frame_start"] + 1,
                    volume_frames=vol.data.frame_duration if vol else None,
-                   resolution=m["resolution"], vdb_files=sorted(n for n in os.listdir(folder) if n.endswith(".vdb")))
+                   resolution=m["resolution"],
+                   vdb_files=sorted(n for n in os.listdir(folder) if n.endswith(".vdb")))
     if rec["operator"] == "flames":
         with open(os.path.join(rec["cache"], "flames_manifest.json")) as f:
             m = json.load(f)
