@@ -91,9 +91,10 @@ def add_sphere_source(radius=0.25, location=(0.0, 0.0, 0.35), name="Source"):
     return ob
 
 
-def incense_streak_scene(cache_dir, resolution, frames):
-    """Two source cells of 10 point sources low in a 2 m domain of `resolution` cells, streaks
-    on, and a camera: a small streak scene (about 190 streaklines at 24³ over 60 frames)."""
+def incense_streak_scene(cache_dir, resolution, frames, point_sources=10):
+    """Two source cells of `point_sources` point sources low in a 2 m domain of `resolution`
+    cells, streaks on, and a camera: a small streak scene (about 190 streaklines at 24³ over 60
+    frames with 10)."""
     cell = 2.0 / resolution
     bpy.ops.mesh.primitive_cube_add(size=cell * 1.8, location=(0.5 * cell, 0.5 * cell,
                                                                  0.2 + 0.5 * cell))
@@ -102,7 +103,8 @@ def incense_streak_scene(cache_dir, resolution, frames):
     bpy.ops.plume.role_set(role='SOURCE')
     s = src.plume.source
     s.point_placement = 'CELLS'  # the paper's set-up: random points in the source cells
-    s.point_sources, s.velocity, s.density, s.temperature = 10, (0.0, 0.0, 1.0), 1.0, 2.0
+    s.point_sources, s.velocity = point_sources, (0.0, 0.0, 1.0)
+    s.density, s.temperature = 1.0, 2.0
     dom = add_domain(resolution=resolution, frame_end=frames, cache_directory=cache_dir + "/")
     dom.plume.domain.streaks = True
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))

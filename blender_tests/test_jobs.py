@@ -1,5 +1,6 @@
 """The job mechanism headless (addon/jobs/): a cancelled job leaves nothing behind, one job per
-domain at a time, loading a file aborts a running job, and the staging folder commits atomically.
+domain at a time, loading a file aborts a running job, the staging folder commits atomically,
+and the process exits cleanly with a worker still running (jobs_exit.py).
 
 A 24³ streak bake of 20 frames with a camera is built once; Build Surfaces, Build Toon Smoke and
 Export Mesh then run through their operators (blocking, as scripts call them) with a runner
@@ -167,6 +168,34 @@ class JobsTest(unittest.TestCase):
             self.assertEqual(tree_listing(self.tmp), before)
         finally:
             type(self).dom = bpy.data.objects["Domain"]
+
+    def test_11_exit_with_a_running_worker(self):
+        """The process ends while a bake's worker runs, nobody cancelling it (jobs_exit.py):
+        Python's shutdown cancels and joins it. Exit code 0, no abort ("terminate called
+        without an active exception" came from a worker still in native code when Python
+        finalized), and the bake stopped with whole frames, not run to its end (in the bpy
+        module nothing else stops it: without worker.py's shutdown hook its non-daemon thread
+        ran all 200 frames; Blender itself disables the add-ons as it quits)."""
+        import json
+        cache = temp_dir("plume_exit_")
+        script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "jobs_exit.py")
+        if os.path.basename(bpy.app.binary_path or "").startswith("blender"):
+            cmd = [bpy.app.binary_path, "-b", "--factory-startup", "--python", script]
+        else:  # the bpy module: its own Python
+            cmd = [sys.executable, script]
+        proc = subprocess.run(cmd + ["--", cache], capture_output=True, text=True, timeout=300)
+        out = proc.stdout + proc.stderr
+        print("  " + next((line for line in out.splitlines() if "exiting" in line), "?"))
+        self.assertEqual(proc.returncode, 0, out[-3000:])
+        self.assertIn("exiting with the worker at frame", out)
+        self.assertNotRegex(out, r"terminate called|Traceback")
+        folder = os.path.join(cache, "Domain")
+        with open(os.path.join(folder, "manifest.json")) as f:
+            last = json.load(f)["last_complete_frame"]
+        self.assertLess(last, 200)
+        self.assertEqual(len([n for n in os.listdir(folder) if n.endswith(".vdb")]), last)
+        self.assertEqual([n for n in os.listdir(folder) if n.startswith(".plume_job_")], [])
+        rmtree(cache)
 
     # ------------------------------------------------------------------ staging
     def test_8_staging_commit_discard_sweep(self):

@@ -5,7 +5,8 @@ fire synthesis, mesh export) as one runner protocol and one operator mixin.
               bpy), main_steps() and finish() (main thread, Blender data); cancel(), progress()
 - operator.py JobOperator: execute() blocking, invoke() worker thread + modal timer + status bar
               + Esc; cancel() when Blender drops the handler
-- worker.py   the thread run() executes on
+- worker.py   the thread run() executes on (not a daemon: every live worker is cancelled and
+              joined before Python finalizes, see its docstring)
 - registry.py which jobs run, by the keys they hold (one job per domain at a time)
 - folder_lock.py one writer per cache folder (.plume.lock: host, pid, job; flock; stale takeover)
 - staging.py  new files kept in a hidden folder until the job succeeds (atomic renames)

@@ -1,12 +1,15 @@
 """What stops running jobs from outside their operators: loading another file (a persistent
 load_pre handler), quitting (Blender drops the modal handlers first, which calls the operators'
-cancel(); atexit covers the rest, e.g. the bpy module), and disabling the add-on."""
+cancel(); then Python's shutdown runs worker.stop_all() before it joins the worker threads, and
+atexit covers the rest, e.g. the bpy module), and disabling the add-on."""
 
 import atexit
+import sys
+import threading
 
 import bpy
 
-from . import registry
+from . import registry, worker
 
 
 @bpy.app.handlers.persistent
@@ -17,6 +20,28 @@ def load_pre(*_args):
 
 def _at_exit():
     registry.abort_all()
+    worker.stop_all()
+
+
+def _register_shutdown_hook():
+    """worker.stop_all() before Python joins the non-daemon worker threads at shutdown (that
+    join comes before atexit, and would wait for an uncancelled job to finish). Once per
+    process: threading keeps the hooks until it shuts down; the hook finds the worker module
+    by name, so a reloaded add-on's workers are the ones stopped."""
+    if getattr(threading, "_plume_stop_all", False):
+        return
+    hook = getattr(threading, "_register_atexit", None)  # CPython 3.9+
+    if hook is None:
+        return
+    name = worker.__name__
+
+    def stop_all():
+        module = sys.modules.get(name)
+        if module is not None:
+            module.stop_all()
+
+    hook(stop_all)
+    threading._plume_stop_all = True
 
 
 def register():
@@ -24,6 +49,7 @@ def register():
         bpy.app.handlers.load_pre.append(load_pre)
     atexit.unregister(_at_exit)
     atexit.register(_at_exit)
+    _register_shutdown_hook()
 
 
 def unregister():

@@ -234,32 +234,38 @@ class JobOperator:
 
     def _conclude(self, context, runner, error, gone):
         """Reports how the job ended; finish() when it succeeded (or a bake was cancelled),
-        discard() otherwise. Frees the job's keys."""
+        discard() otherwise. Frees the job's keys. The runner keeps how it ended (`outcome`:
+        finished, failed, gone, cancelled) and the report's text (`report_text`)."""
         try:
             if error is not None:
                 runner.discard()
-                self.report({'ERROR'}, runner.no_room_text(error) or runner.error_text(error))
-                return {'CANCELLED'}
+                return self._end_report(runner, 'failed', 'ERROR',
+                                        runner.no_room_text(error) or runner.error_text(error))
             if gone is not None:
                 runner.discard()
-                self.report({'WARNING'}, f"Plume: {runner.title} cancelled: object '{gone}' "
-                                         "was deleted or renamed; nothing was built")
-                return {'CANCELLED'}
+                return self._end_report(runner, 'gone', 'WARNING',
+                                        f"Plume: {runner.title} cancelled: object '{gone}' was "
+                                        "deleted or renamed; nothing was built")
             if runner.cancelled and not runner.keeps_partial:
                 runner.discard()
-                self.report({'WARNING'}, runner.cancelled_text())
-                return {'CANCELLED'}
+                return self._end_report(runner, 'cancelled', 'WARNING', runner.cancelled_text())
             try:
                 kind, text = runner.finish(context)
             except Exception as e:
                 if not isinstance(e, BakeError):
                     traceback.print_exc()
                 runner.discard()
-                self.report({'ERROR'}, runner.no_room_text(e) or runner.error_text(e))
-                return {'CANCELLED'}
+                return self._end_report(runner, 'failed', 'ERROR',
+                                        runner.no_room_text(e) or runner.error_text(e))
             if runner.forecast_said is not None:
                 text += f" (forecast: {runner.forecast_said.about()})"
-            self.report({kind}, text)
+            self._end_report(runner, 'cancelled' if runner.cancelled else 'finished', kind, text)
             return {'FINISHED'}
         finally:
             registry.release(runner)
+
+    def _end_report(self, runner, outcome, kind, text):
+        """Reports `text`; {'CANCELLED'} (the callers that built nothing return it)."""
+        runner.outcome, runner.report_text = outcome, text
+        self.report({kind}, text)
+        return {'CANCELLED'}

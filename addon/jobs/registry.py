@@ -62,19 +62,21 @@ def running():
     return out
 
 
-def abort(runner, wait_s=ABORT_WAIT_S):
-    """Stops a job from outside its operator: cancel, wait for its worker thread, remove its
-    temporaries, free its keys. Its operator then ends without touching the scene."""
+def abort(runner, wait_s=None):
+    """Stops a job from outside its operator: cancel, wait up to `wait_s` (ABORT_WAIT_S) for its
+    worker thread, remove its temporaries, free its keys. Its operator then ends without touching
+    the scene. A worker still running after the wait removes the temporaries itself when it ends
+    (worker.py; at quit, worker.stop_all() waits for it)."""
     runner.aborted = True
+    runner.outcome = 'aborted'
     runner.cancel()
     worker = getattr(runner, "worker", None)
-    if worker is not None:
-        worker.join(wait_s)
-    runner.discard()
+    if worker is None or worker.join(ABORT_WAIT_S if wait_s is None else wait_s):
+        runner.discard()
     release(runner)
 
 
-def abort_all(wait_s=ABORT_WAIT_S):
+def abort_all(wait_s=None):
     """abort() for every running job (file load, quit, add-on disabled); how many."""
     jobs = running()
     for runner in jobs:

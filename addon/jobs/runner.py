@@ -118,6 +118,11 @@ class JobRunner(abc.ABC):
         self.cancelled_at = None
         #: The FolderLocks of the cache folders the job writes (lock_folder()).
         self.folder_locks = []
+        #: How the job ended (operator.py, registry.py): 'finished', 'cancelled' (Esc; a bake
+        #: keeps its frames), 'gone' (an object it works on was deleted or renamed), 'failed',
+        #: 'aborted' (file load, quit); None while it runs. `report_text`: what was reported.
+        self.outcome = None
+        self.report_text = ""
 
     # ------------------------------------------------------------------ the four parts
     def forecast(self, context):

@@ -1,5 +1,14 @@
-"""The thread a job's run() executes on (or the caller's own thread, blocking), no ``bpy``."""
+"""The thread a job's run() executes on (or the caller's own thread, blocking), no ``bpy``.
 
+No worker may still run when Python finalizes: a thread that comes back from native code (a
+pybind11 call that released the GIL) after finalization has begun is ended by CPython with
+pthread_exit, whose forced unwind through the binding's noexcept GIL guard calls std::terminate
+("terminate called without an active exception", Blender exits 134). So workers are not daemon
+threads, and a hook that threading runs before it joins them at shutdown (stop_all()) cancels
+every live worker and waits for it: quitting never leaves one behind, however Blender quits and
+whatever the registry still holds."""
+
+import sys
 import threading
 import time
 import traceback
@@ -7,6 +16,36 @@ import traceback
 from ..files import no_room
 from ..settings import BakeError
 from .runner import JobCancelled
+
+#: Workers whose thread runs now (started, not ended).
+_live = set()
+_live_lock = threading.Lock()
+#: Seconds between two "still waiting" lines while stop_all() waits at quit.
+WAIT_NOTE_S = 5.0
+
+
+def live():
+    """The workers whose thread was started and has not ended."""
+    with _live_lock:
+        return list(_live)
+
+
+def stop_all():
+    """Cancels every live worker and waits until each has ended (Python's shutdown, before it
+    finalizes; also atexit). A worker stops within one unit of work of its job; it is waited for
+    however long that takes, saying so every WAIT_NOTE_S seconds, because ending the process with
+    the worker inside native code is what crashes."""
+    workers = live()
+    for w in workers:
+        w.runner.aborted = True
+        w.runner.cancel()
+    for w in workers:
+        waited = 0.0
+        while not w.join(WAIT_NOTE_S):
+            waited += WAIT_NOTE_S
+            print(f"Plume: waiting for {w.runner.title} to stop ({waited:.0f} s)",
+                  file=sys.stderr, flush=True)
+        w.runner.discard()
 
 
 class Worker:
@@ -38,6 +77,10 @@ class Worker:
         finally:
             self.ended_at = time.perf_counter()
             self.finished = True
+            with _live_lock:
+                _live.discard(self)
+            if self.runner.aborted:  # abort() stopped waiting for it: its temporaries go now
+                self.runner.discard()
 
     def run_here(self):
         """Blocking: run() on the calling thread (execute(), ``blender -b``)."""
@@ -45,11 +88,18 @@ class Worker:
         return self
 
     def start(self):
-        """run() on a new daemon thread (a hung native call never keeps Blender from quitting;
-        quit and file load cancel and join it first)."""
+        """run() on a new thread; not a daemon: Python's shutdown waits for it, after stop_all()
+        has cancelled it (see the module docstring)."""
         self.thread = threading.Thread(target=self._run, name=f"plume {self.runner.title}",
-                                       daemon=True)
-        self.thread.start()
+                                       daemon=False)
+        with _live_lock:
+            _live.add(self)
+        try:
+            self.thread.start()
+        except BaseException:
+            with _live_lock:
+                _live.discard(self)
+            raise
         return self
 
     @property
@@ -58,6 +108,6 @@ class Worker:
 
     def join(self, timeout=None):
         """True when run() has ended (within `timeout` seconds)."""
-        if self.thread is not None:
+        if self.thread is not None and self.thread is not threading.current_thread():
             self.thread.join(timeout)
         return self.finished

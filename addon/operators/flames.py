@@ -59,8 +59,11 @@ class FlamesJob(JobRunner):
         else:
             vol = flames_volume.build(scene, snap.folder, snap.frame_start, frames,
                                       float(scene.plume_flames.emission))
+            # The light unit the frames were baked with (the emission grids hold E x it), not
+            # the panel's: a change during the bake applies to the next bake. Flame Brightness
+            # and Flame Lights only shape the built objects: read now, as the panel shows them.
             spines = flame_spines.build(scene, snap.folder, snap.frame_start, result.last_frame,
-                                        float(f.light_unit), bool(f.lights))
+                                        float(snap.settings[0].light_unit), bool(f.lights))
             f.volume_object, f.spines_object, f.frames_baked = vol.name, spines.name, frames
         seconds = time.perf_counter() - self.t0
         per_frame = seconds / max(frames, 1)

@@ -64,6 +64,7 @@ class FlowGraphJob(JobRunner):
         if error is not None:
             raise BakeError(f"Plume: cache folder {self.folder} is not writable ({error})")
         self._job = self._job_started = None
+        self.set_progress(0, 0, "reading the pathlines")  # until the cost matrix reports
 
     def _attach(self, job):
         self._job_started = time.perf_counter()

@@ -1,57 +1,67 @@
 """Runs inside a windowed Blender (under Xvfb, started by test_ui_jobs.py with
---enable-event-simulate): Plume's jobs as an artist runs them, from a button.
+--enable-event-simulate): Plume's jobs as an artist runs them, from a button, and what the artist
+may do while they run.
 
-    blender --factory-startup --enable-event-simulate --python job_modal.py -- RESULT CASE...
+    blender --factory-startup --enable-event-simulate --python job_modal.py -- RESULT TMP CASE...
 
-Each CASE is <operator>:<action>, run in order:
+TMP is the run's temporary folder (its "shared" folder keeps the prerequisite bakes between
+cases and processes). Each CASE is <operator>:<action>, run in order (job_cases.py has the
+operators and their scenes):
 
-    operator  bake (a 200-frame 40³ bake), surfaces (Build Surfaces), toon (Build Toon Smoke);
-              surfaces and toon first bake a small streak scene (blocking), once, then reuse it
-    action    esc     press Esc once the job has made progress
-              delete  delete the domain while the job runs
-              load    open another .blend file while the job runs
-              quit    quit Blender while the job runs (the last case)
-              ask     the job is made "long" (LONG_JOB_S = 0): the button opens a dialog
-                      saying how long; Return starts the job, which then runs to its end
-              decline the same dialog answered with Esc: nothing starts
+    operator  bake, flames, surfaces, toon, graph (Build Flow Graph), synth (Synthesize Fire)
+    action    esc      press Esc once the job has made progress
+              load     open another .blend file
+              undo     move an unrelated object, push an undo step, undo it (memfile undo
+                       replaces every datablock the job's scene had)
+              redo     the same, then redo
+              delete   delete the object the job works on
+              rename   rename it
+              settings change its main settings (job_cases.change_settings)
+              free     the pipeline's Free (plume.cache_free, plume.flames_free)
+              save     save the .blend file under a new name
+              quit     quit Blender (the last case: it ends the process)
+              quit0    the same with the operator's wait for its worker cut to 0 s
+                       (registry.ABORT_WAIT_S): the worker is still in native code when
+                       Blender tears down, and Python's shutdown must stop it
+              A+quit   action A, then quit Blender at the next poll while the job still runs
+              ask      the job is made "long" (LONG_JOB_S = 0): the button opens a dialog saying
+                       how long; Return starts the job, which then runs to its end
+              decline  the same dialog answered with Esc: nothing starts
 
 A case sets its scene up, invokes the operator from the Properties editor's context
-('INVOKE_DEFAULT': worker thread + modal timer), polls the job (its progress and status-bar line)
-until it has done a few units and the status bar shows them with the time left, acts, waits for the
-job to end, and records what it saw: the job's progress over time, the thread it ran on, the
-seconds from the action to its end, and the scene's objects and the cache folder's files before and
+('INVOKE_DEFAULT': worker thread + modal timer), polls the job until it has done a few units and
+the status bar shows them with the time left, acts, waits for the job to end, and records what it
+saw: the job's progress over time, the thread it ran on, how the job ended and its report, the
+seconds from the action to its end, the scene's objects and the cache folder's files before and
 after. RESULT (JSON) is rewritten after every case (and before quitting), so a crash still leaves
 the cases before it."""
 
 import json
 import os
 import sys
-import tempfile
 import threading
 import time
 import traceback
 
 import bpy
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from helpers import (add_domain, add_sphere_source, enable_addon, incense_streak_scene,  # noqa: E402
-                     select_only, tree_listing)
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]
+from helpers import enable_addon, tree_listing  # noqa: E402
+import job_cases  # noqa: E402
 
 ARGS = sys.argv[sys.argv.index("--") + 1:]
-RESULT, CASES = ARGS[0], [tuple(c.split(":")) for c in ARGS[1:]]
-OPERATORS = {"bake": "bake", "surfaces": "surfaces_build", "toon": "toon_build"}
-#: Units of progress (frames, density maps) the job must report before the action.
-TRIGGER = {"bake": 3, "surfaces": 2, "toon": 2}
+RESULT, TMP, CASES = ARGS[0], ARGS[1], [tuple(c.split(":")) for c in ARGS[2:]]
+SHARED = os.path.join(TMP, "shared")
 CASE_LIMIT_S = 120.0
 POLL_S = 0.05
 
-state = {"case": -1, "phase": "next", "results": [], "t0": time.perf_counter(),
-         "tmp": tempfile.mkdtemp(prefix="plume_ui_")}
+state = {"case": -1, "phase": "next", "results": [], "t0": time.perf_counter()}
 
 
 def save(**extra):
     with open(RESULT, "w") as f:
-        json.dump({"cases": state["results"], "tmp": state["tmp"], **extra}, f)
+        json.dump({"cases": state["results"], "tmp": TMP, **extra}, f)
 
 
 def window_and_area():
@@ -61,59 +71,44 @@ def window_and_area():
     return win, area
 
 
+def override():
+    win, area = window_and_area()
+    return bpy.context.temp_override(window=win, area=area, screen=win.screen)
+
+
 def job():
     from plume.jobs import registry
     jobs = registry.running()
     return jobs[0] if jobs else None
 
 
-def clear_objects():
-    for ob in list(bpy.data.objects):
-        bpy.data.objects.remove(ob, do_unlink=True)
-
-
-def bake_scene(cache):
-    """The old Esc test's scene: a 40³ domain over 200 frames, baked until Esc."""
-    dom = add_domain(resolution=40, frame_end=200, cache_directory=cache + "/")
-    add_sphere_source()
-    return dom
-
-
-def streak_scene(cache):
-    """The shared small streak scene (24³, 60 frames, ~190 streaklines), baked blocking; the
-    cache is complete after the first case, so later cases' bakes return at once."""
-    dom = incense_streak_scene(cache, 24, 60)
-    assert bpy.ops.plume.bake() == {'FINISHED'}
-    return dom
-
-
 def start_case():
     operator, action = CASES[state["case"]]
     enable_addon()
-    clear_objects()
-    if operator == "bake":
-        cache = tempfile.mkdtemp(prefix="bake_", dir=state["tmp"])
-        dom = bake_scene(cache)
-    else:
-        cache = os.path.join(state["tmp"], "streaks")
-        dom = streak_scene(cache)
-    select_only(dom)
+    os.makedirs(SHARED, exist_ok=True)
+    t0 = time.perf_counter()
+    ob, cache = job_cases.set_up(operator, TMP, SHARED)
+    marker = bpy.data.objects.new("Marker", None)  # what undo / redo move
+    bpy.context.scene.collection.objects.link(marker)
     rec = {"operator": operator, "action": action, "cache": cache, "seen": [],
+           "object": ob.name, "set_up_s": round(time.perf_counter() - t0, 2),
            "objects_before": sorted(o.name for o in bpy.data.objects),
            "files_before": tree_listing(cache)}
     state["results"].append(rec)
     if action == "load":
-        path = os.path.join(state["tmp"], "other.blend")
+        path = os.path.join(TMP, "other.blend")
         bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
         rec["other_file"] = path
-    win, area = window_and_area()
+    with override():
+        bpy.ops.ed.undo_push(message="Plume test scene")
     from plume.jobs import operator as job_operator
     long_job_s = job_operator.LONG_JOB_S
     if action in ("ask", "decline"):
         job_operator.LONG_JOB_S = 0.0  # every forecast is "long": the dialog opens
     try:
-        with bpy.context.temp_override(window=win, area=area, screen=win.screen):
-            rec["invoke"] = sorted(getattr(bpy.ops.plume, OPERATORS[operator])('INVOKE_DEFAULT'))
+        with override():
+            op = getattr(bpy.ops.plume, job_cases.OPERATORS[operator][0])
+            rec["invoke"] = sorted(op('INVOKE_DEFAULT'))
     finally:
         job_operator.LONG_JOB_S = long_job_s
     j = job()
@@ -122,21 +117,55 @@ def start_case():
     state.update(phase="running", case_t0=time.perf_counter(), acted_at=None)
 
 
+def call(rec, operator, **kw):
+    """Calls an operator as a button would (window context); its result, or the error it
+    reported (bpy.ops raises RuntimeError for an ERROR report)."""
+    try:
+        with override():
+            return sorted(operator(**kw))
+    except RuntimeError as e:
+        return str(e).strip()
+
+
 def act(rec, j):
-    """The artist's action on the running job."""
-    action = rec["action"]
+    """The artist's action on the running job (A+quit: A now, quit at the next poll)."""
+    action, operator = rec["action"].split("+")[0], rec["operator"]
+    if "+" in rec["action"]:
+        state["then"] = rec["action"].split("+")[1]
     rec["done_at_action"] = j.progress().done
     rec["worker_is_main_thread"] = j.worker.thread_id == threading.main_thread().ident
     state["acted_at"] = time.perf_counter()
+    ob = bpy.data.objects[rec["object"]]
     if action == "esc":
         win = bpy.context.window_manager.windows[0]
         win.event_simulate(type='ESC', value='PRESS')
         win.event_simulate(type='ESC', value='RELEASE')
-    elif action == "delete":
-        bpy.data.objects.remove(bpy.data.objects["Domain"], do_unlink=True)
     elif action == "load":
         bpy.ops.wm.open_mainfile(filepath=rec["other_file"], load_ui=False)
-    elif action == "quit":
+    elif action in ("undo", "redo"):
+        bpy.data.objects["Marker"].location.x += 1.0
+        with override():
+            bpy.ops.ed.undo_push(message="Move Marker")
+        rec["undo"] = call(rec, bpy.ops.ed.undo)
+        if action == "redo":
+            rec["redo"] = call(rec, bpy.ops.ed.redo)
+        rec["marker_x"] = bpy.data.objects["Marker"].location.x
+    elif action == "delete":
+        bpy.data.objects.remove(ob, do_unlink=True)
+    elif action == "rename":
+        ob.name = rec["object"] + " renamed"
+    elif action == "settings":
+        job_cases.change_settings(operator, ob)
+    elif action == "free":
+        rec["free"] = call(rec, getattr(bpy.ops.plume, job_cases.OPERATORS[operator][1]))
+    elif action == "save":
+        rec["saved_file"] = os.path.join(TMP, f"saved_{operator}.blend")
+        rec["objects_at_save"] = sorted(o.name for o in bpy.data.objects)
+        rec["save"] = call(rec, bpy.ops.wm.save_as_mainfile, filepath=rec["saved_file"])
+    elif action in ("quit", "quit0"):
+        if action == "quit0":
+            from plume.jobs import registry
+            registry.ABORT_WAIT_S = 0.0
         save(quitting=True)
         bpy.ops.wm.quit_blender()
 
@@ -152,15 +181,18 @@ def answer_dialog(rec):
 
 
 def end_case(rec):
-    """The job has ended: what it left behind."""
+    """The job has ended: how, and what it left behind."""
     j = state["job"]
     rec["seconds_to_stop"] = time.perf_counter() - state["acted_at"]
     if j is not None:
         rec["seconds_to_cancel"] = (j.cancelled_at - state["acted_at"]) if j.cancelled_at else None
         rec["seconds_worker_ran_on"] = (j.worker.ended_at - state["acted_at"]
                                         if j.worker.ended_at else None)
+        rec["outcome"], rec["report"] = j.outcome, j.report_text
+        rec["worker_alive"] = j.worker.alive
     rec["objects_after"] = sorted(o.name for o in bpy.data.objects)
     rec["files_after"] = tree_listing(rec["cache"])
+    rec["leftovers"] = job_cases.leftovers(rec["cache"])
     if rec["operator"] == "bake":
         folder = os.path.join(rec["cache"], "Domain")
         with open(os.path.join(folder, "manifest.json")) as f:
@@ -171,7 +203,14 @@ def end_case(rec):
                    done_at_cancel=run.get("frames_done_at_cancel"), cancelled=run.get("cancelled"),
                    total=m["frame_end"] - m["frame_start"] + 1,
                    volume_frames=vol.data.frame_duration if vol else None,
+                   resolution=m["resolution"],
                    vdb_files=sorted(n for n in os.listdir(folder) if n.endswith(".vdb")))
+    if rec["operator"] == "flames":
+        with open(os.path.join(rec["cache"], "flames_manifest.json")) as f:
+            m = json.load(f)
+        spines = bpy.data.objects.get(bpy.context.scene.plume_flames.spines_object)
+        rec.update(baked_light_unit=m["settings"]["light_unit"],
+                   lights_light_unit=spines.get("plume_flames_light_unit") if spines else None)
     state["phase"] = "next"
     save()
 
@@ -211,12 +250,18 @@ def step():
         elif state["job"] is None and rec["action"] == "ask" and \
                 time.perf_counter() - state["acted_at"] < 5.0:
             return POLL_S  # Return not handled yet
+    if j is not None and state.get("then") == "quit":
+        rec["done_at_quit"] = j.progress().done
+        save(quitting=True)
+        bpy.ops.wm.quit_blender()
+        return None
     if j is not None:
         p = j.progress()
         rec["seen"].append([round(time.perf_counter() - state["case_t0"], 3), p.done, p.total,
                             p.label, j.status_text])
         # Act once the job has done a few units and the status bar has shown them.
-        if (state["acted_at"] is None and p.total > 0 and p.done >= TRIGGER[rec["operator"]]
+        if (state["acted_at"] is None and p.total > 0
+                and p.done >= job_cases.TRIGGER[rec["operator"]]
                 and " s left" in j.status_text):
             act(rec, j)
         return POLL_S
