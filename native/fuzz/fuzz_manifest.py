@@ -261,7 +261,8 @@ def main(argv=None):
             driver.run(raw, kind if rng.random() < 0.9 else rng.choice(KINDS))
             fuzzed += 1
         print(f"manifest: {driver.cases} cases run ({replayed} replayed, {fuzzed} fuzzed, "
-              f"seed {args.seed}), findings: {driver.findings} (stalls > {STALL_SECONDS:g} s: {driver.stalls}), "
+              f"seed {args.seed}), findings: {driver.findings} "
+              f"(stalls > {STALL_SECONDS:g} s: {driver.stalls}), "
               f"slowest read {driver.slowest * 1e3:.1f} ms", flush=True)
     finally:
         driver.close()
