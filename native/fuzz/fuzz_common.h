@@ -3,8 +3,9 @@
 /// What every fuzz target of Plume's readers shares (README.md "Reliability"): the input
 /// written to a per-process temporary file (the readers take paths), and the property a reader
 /// must keep on any bytes: it returns, or it throws its documented exception type with a clean
-/// UTF-8 message that names the file. Anything else (another exception type, a message without the path or
-/// with broken UTF-8) aborts, so libFuzzer and the replay ctest report it like a crash.
+/// UTF-8 message that names the file. Anything else (another exception type, a message without
+/// the path or with broken UTF-8) aborts, so libFuzzer and the replay ctest report it like a
+/// crash.
 
 #include <cstddef>
 #include <cstdint>
