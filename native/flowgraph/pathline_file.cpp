@@ -368,6 +368,20 @@ void PathlineFile::readGroup(int k, PathlineGroup& out, int state) const {
   in = decode(in, 3 * v, half, &out.velocity[0].x);
   in = decode(in, v, half, out.density.data());
   decode(in, v, half, out.temperature.data());
+  // A checksum only proves the bytes are the ones written: a NaN or infinity (a hand-made or
+  // damaged file; half NaN/inf bits) would move synthesized particles to non-finite positions
+  // that become cell indices. x * 0 is 0 for finite x and NaN otherwise: one vectorized pass.
+  float bad = 0.f;
+  const auto sweep = [&bad](const float* a, std::size_t n) {
+    for (std::size_t m = 0; m < n; ++m) bad += a[m] * 0.f;
+  };
+  sweep(&out.start[0].x, 3 * p);
+  sweep(&out.velocity[0].x, 3 * v);
+  sweep(out.density.data(), v);
+  sweep(out.temperature.data(), v);
+  if (bad != 0.f)
+    throw std::runtime_error(named(mPath) + " is corrupt (node " + std::to_string(k) +
+                             " holds a non-finite value)");
 }
 
 PathlineGroup PathlineFile::readGroup(int k, int state) const {

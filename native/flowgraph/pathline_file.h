@@ -114,7 +114,7 @@ class PathlineFile {
   /// Node k (0 <= k < nodeCount()): its block is read, its checksum verified and its samples
   /// decoded into `out` (buffers reused). `state` is copied into out.state. Throws
   /// std::out_of_range for a bad k, std::runtime_error naming the file when the block is
-  /// unreadable or corrupt.
+  /// unreadable or corrupt (checksum, step, or a non-finite value).
   void readGroup(int k, PathlineGroup& out, int state = 0) const;
   PathlineGroup readGroup(int k, int state = 0) const;
 

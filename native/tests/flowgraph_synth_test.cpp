@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -188,6 +189,48 @@ TEST(PathlineFile, TruncatedOrCorruptFilesNameTheFile) {
   expectThrowsNaming([&] { f.readGroup(1); }, path, "corrupt");
   std::ofstream(path, std::ios::binary | std::ios::trunc) << std::string(200, 'x');
   expectThrowsNaming([&] { PathlineFile::open(path); }, path, "bad magic");
+}
+
+TEST(PathlineFile, NonFiniteSamplesAreRefusedByName) {
+  // Checksum-valid files holding NaN or infinity: synthesized particles would move to
+  // non-finite positions that become cell indices.
+  const PathlineLayout layout{10, 4, 0.05f};
+  const std::string path = tempPath("nonfinite.bin");
+  {  // float32: the writer stores the values as given
+    PathlineFileWriter w(path, fileInfo(layout, false));
+    w.append(randomGroup(layout, 0, 1));
+    PathlineGroup g = randomGroup(layout, 1, 2);
+    g.velocity[7].y = std::numeric_limits<float>::quiet_NaN();
+    w.append(g);
+    g = randomGroup(layout, 2, 3);
+    g.temperature[39] = std::numeric_limits<float>::infinity();
+    w.append(g);
+    w.finish();
+  }
+  const PathlineFile f = PathlineFile::open(path);
+  EXPECT_NO_THROW(f.readGroup(0));
+  expectThrowsNaming([&] { f.readGroup(1); }, path, "node 1 holds a non-finite value");
+  expectThrowsNaming([&] { f.readGroup(2); }, path, "node 2 holds a non-finite value");
+
+  // float16: the writer never stores NaN or infinity (it clamps), so set the bits of a density
+  // sample of node 0 to +inf (0x7c00) and re-sign the block and the table.
+  const PathlineFileInfo info = fileInfo(layout, true);
+  writeGroups(path, info, 1);
+  std::vector<unsigned char> bytes(fs::file_size(path));
+  std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(bytes.data()),
+                                              std::streamsize(bytes.size()));
+  const std::size_t block = info.blockBytes(), density = 80 + 8 + 12 * 10 + 2 * 3 * 40;
+  bytes[density + 2 * 5] = 0x00;
+  bytes[density + 2 * 5 + 1] = 0x7c;
+  const std::size_t table = 80 + block;
+  const std::uint64_t blockSum = pathlineChecksum(bytes.data() + 80, block);
+  for (int b = 0; b < 8; ++b) bytes[table + 8 + std::size_t(b)] = (blockSum >> (8 * b)) & 0xff;
+  const std::uint64_t tableSum = pathlineChecksum(bytes.data() + table, 16);
+  for (int b = 0; b < 8; ++b) bytes[table + 16 + std::size_t(b)] = (tableSum >> (8 * b)) & 0xff;
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  const PathlineFile h = PathlineFile::open(path);
+  expectThrowsNaming([&] { h.readGroup(0); }, path, "node 0 holds a non-finite value");
 }
 
 TEST(PathlineFile, UnfinishedWriteNeverReadsAsComplete) {

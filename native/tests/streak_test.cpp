@@ -425,6 +425,25 @@ TEST(StreakFile, CorruptAndTruncatedFilesAreRejected) {
   EXPECT_NE(readError(bad).find("truncated or corrupt"), std::string::npos);
 }
 
+TEST(StreakFile, NonFiniteValuesAreRefusedByName) {
+  // A checksum-valid file (its own writer's) holding NaN or infinity: those would become grid
+  // cell indices when the streaklines are paired (streak/candidate_pairs.cpp).
+  const fs::path dir = scratchDir("nonfinite");
+  const fs::path bad = dir / "streaks_0003.bin";
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int which = 0; which < 3; ++which) {
+    StreakFrame f = randomFrames(4, {6}, 2)[0];
+    if (which == 0) f.positions[5].y = nan;
+    if (which == 1) f.positions[2].z = -inf;
+    if (which == 2) f.density[3] = inf;
+    writeStreakFile(bad.string(), f);
+    const std::string e = readError(bad);
+    EXPECT_NE(e.find(bad.string()), std::string::npos) << e;
+    EXPECT_NE(e.find("non-finite"), std::string::npos) << e;
+  }
+}
+
 TEST(StreakFile, UnwritablePathThrowsNamingIt) {
   const std::string path = "/nonexistent_plume_dir/streaks_0001.bin";
   try {

@@ -4,12 +4,14 @@
 ///   | f32 positions[3 M] (x, y, z per particle, sources concatenated, birth order)
 ///   | f32 density[M] | i32 groups[S] | u8 outside[M] | u64 FNV-1a 64 of every byte before it,
 /// with M = Σ counts. Reading checks the header, then that the counts fit in the file, then the
-/// exact size, then the checksum, and only then allocates and parses the arrays.
+/// exact size, then the checksum, and only then allocates and parses the arrays, whose values
+/// must be finite.
 
 #include "tracers/streak_file.h"
 
 #include "io/byte_buffer.h"
 
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -100,6 +102,15 @@ StreakFrame readStreakFile(const std::string& path) {
   if (r.remaining() != kChecksumSize) fail(path, "is corrupt (unexpected trailing bytes)");
   for (std::uint8_t o : f.outside)
     if (o > 1) fail(path, "is corrupt (bad outside flag)");
+  // A checksum only proves the bytes are the ones written: a NaN or infinity (a hand-made or
+  // damaged file) would become a grid cell index in streak/candidate_pairs.cpp.
+  for (std::size_t i = 0; i < m; ++i) {
+    const glm::vec3& x = f.positions[i];
+    if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z) ||
+        !std::isfinite(f.density[i]))
+      fail(path, "is corrupt: particle " + std::to_string(i) +
+                     " has a non-finite position or density");
+  }
   return f;
 }
 

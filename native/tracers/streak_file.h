@@ -19,7 +19,7 @@ std::string streakFileName(int frame);
 void writeStreakFile(const std::string& path, const StreakFrame& frame);
 
 /// Reads a frame. Throws std::runtime_error naming the path on a missing, truncated, corrupt
-/// (bad magic, checksum, sizes) or newer-version file.
+/// (bad magic, checksum, sizes, non-finite values) or newer-version file.
 StreakFrame readStreakFile(const std::string& path);
 
 }  // namespace plume
