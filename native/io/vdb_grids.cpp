@@ -3,6 +3,8 @@
 
 #include "io/vdb_grids.h"
 
+#include "io/vdb_guard.h"
+
 #include <openvdb/io/File.h>
 #include <openvdb/tools/Dense.h>
 
@@ -75,14 +77,10 @@ void writeGridsAtomic(const std::string& path, const openvdb::GridPtrVec& grids,
       file.write(grids, meta);
       file.close();
     }
-    // io::File::write does not report a failed stream (a full disk): read the grid descriptors
-    // back, which fails on a short file.
-    openvdb::io::File check(tmp);
-    check.open(/*delayLoad=*/true);
-    std::size_t written = 0;
-    for (auto it = check.beginName(); it != check.endName(); ++it) ++written;
-    check.close();
-    if (written != grids.size()) throw std::runtime_error("grids missing after writing");
+    // io::File::write does not report a failed stream (a full disk): read the file back and
+    // check its header and grid descriptors (a short file fails).
+    if (CheckedVdbFile(tmp).gridNames().size() != grids.size())
+      throw std::runtime_error("grids missing after writing");
   } catch (const std::exception& e) {
     std::remove(tmp.c_str());
     fail(path, std::string("cannot be written: ") + e.what());
