@@ -1,6 +1,6 @@
 /// \file vdb_hostile_test.cpp
 /// Hostile VDB files (issue 18): files made by OpenVDB's own writer (fuzz/vdb_seeds.h), then
-/// truncated at every length, changed at every byte, given Blosc chunks that claim more than
+/// truncated and changed at every byte of their headers and throughout, given Blosc chunks that claim more than
 /// the leaf holds, voxels near 2^30, a NaN voxel size and a grid type that is not UTF-8. Every
 /// VDB reader of Plume either reads the file or throws std::runtime_error naming the file in
 /// clean UTF-8; nothing crashes (run under AddressSanitizer: no write or read out of bounds).
@@ -69,6 +69,16 @@ struct Seed {
   Bytes bytes;
 };
 
+/// Positions to damage in a seed of `size` bytes (about 30 kB, mostly node masks): every one of
+/// the first 640 (header, descriptors, metadata, transform, root of the first grid), every
+/// `stride`-th after, and the last 16 (the end of the last leaf buffer).
+std::vector<std::size_t> positions(std::size_t size, std::size_t stride) {
+  std::vector<std::size_t> p;
+  for (std::size_t k = 0; k < size; k += k < 640 ? 1 : stride) p.push_back(k);
+  for (std::size_t k = size > 16 ? size - 16 : 0; k < size; ++k) p.push_back(k);
+  return p;
+}
+
 std::vector<Seed> makeSeeds() {
   std::vector<Seed> seeds;
   const std::string path = tempPath("seed.vdb");
@@ -102,10 +112,10 @@ TEST(VdbHostile, SeedsReadAndHalfFloatsMatch) {
   std::remove(path.c_str());
 }
 
-TEST(VdbHostile, TruncatedAtEveryLengthIsRefusedByEveryReader) {
+TEST(VdbHostile, TruncatedFilesAreRefusedByEveryReader) {
   const std::string path = tempPath("short.vdb");
   for (const Seed& s : makeSeeds())
-    for (std::size_t size = 0; size < s.bytes.size(); ++size) {
+    for (const std::size_t size : positions(s.bytes.size(), 61)) {
       save(path, s.bytes, size);
       // The last grid ends at the end of the file: every reader sees the file is short.
       ASSERT_EQ(readAll(path), 5) << s.name << " cut to " << size << " bytes";
@@ -113,20 +123,19 @@ TEST(VdbHostile, TruncatedAtEveryLengthIsRefusedByEveryReader) {
   std::remove(path.c_str());
 }
 
-TEST(VdbHostile, EveryChangedByteIsReadOrRefusedCleanly) {
+TEST(VdbHostile, ChangedBytesAreReadOrRefusedCleanly) {
   const std::string path = tempPath("changed.vdb");
   for (Seed& s : makeSeeds()) {
     int refusals = 0;
-    for (std::size_t p = 0; p < s.bytes.size(); ++p) {
+    const std::vector<std::size_t> changed = positions(s.bytes.size(), 151);
+    for (const std::size_t p : changed) {
       const unsigned char original = s.bytes[p];
-      for (const unsigned char value : {std::uint8_t(original ^ 0xff), std::uint8_t(original ^ 0x80)}) {
-        s.bytes[p] = value;
-        save(path, s.bytes, s.bytes.size());
-        refusals += readAll(path);
-      }
+      s.bytes[p] = std::uint8_t(original ^ (p % 2 ? 0xff : 0x80));
+      save(path, s.bytes, s.bytes.size());
+      refusals += readAll(path) > 0 ? 1 : 0;
       s.bytes[p] = original;
     }
-    EXPECT_GT(refusals, int(s.bytes.size())) << s.name;  // most bytes matter
+    EXPECT_GT(refusals, int(changed.size()) / 2) << s.name;  // most bytes matter
   }
   std::remove(path.c_str());
 }
