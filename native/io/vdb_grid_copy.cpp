@@ -3,6 +3,8 @@
 
 #include "io/vdb_grid_copy.h"
 
+#include <openvdb/openvdb.h>
+
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -32,8 +34,11 @@ const std::map<std::string, std::size_t>& plainMetadata() {
   return sizes;
 }
 
-/// MetaMap::readMeta: count, then name, type name, byte count and value per entry.
-void copyMetadata(VdbCursor& c, ByteWriter& w) {
+/// MetaMap::readMeta: count, then name, type name, byte count and value per entry. OpenVDB
+/// takes the half-float flag of the tree from the metadata `is_saved_as_half_float` (any type,
+/// read after the descriptor's flag), so the file's entry is replaced by `half`, the descriptor's
+/// flag the tree is checked with.
+void copyMetadata(VdbCursor& c, ByteWriter& w, bool half) {
   const std::uint32_t count = c.pod<std::uint32_t>("metadata count");
   c.need(std::uint64_t(count) * 12, "metadata entries");
   ByteWriter kept;
@@ -45,6 +50,7 @@ void copyMetadata(VdbCursor& c, ByteWriter& w) {
     const unsigned char* value = c.at(c.skip(size, "metadata value"));
     const auto plain = plainMetadata().find(type);
     if (type != "string" && plain == plainMetadata().end()) continue;  // not read by Plume
+    if (name == openvdb::GridBase::META_SAVE_HALF_FLOAT) continue;
     if (plain != plainMetadata().end() && plain->second != size)
       bad("metadata '" + name + "' of type " + type + " holds " + std::to_string(size) +
           " bytes; the type has " + std::to_string(plain->second));
@@ -55,7 +61,11 @@ void copyMetadata(VdbCursor& c, ByteWriter& w) {
     kept.bytes(value, size);
     ++keptCount;
   }
-  w.integer<std::uint32_t>(keptCount);
+  putString(kept, openvdb::GridBase::META_SAVE_HALF_FLOAT);
+  putString(kept, "bool");
+  kept.integer<std::uint32_t>(1);
+  kept.integer<std::uint8_t>(half ? 1 : 0);
+  w.integer<std::uint32_t>(keptCount + 1);
   w.bytes(kept.buffer().data(), kept.buffer().size());
 }
 
@@ -102,7 +112,7 @@ std::string checkedGridStream(const VdbGridSource& s) {
   putString(w, "");  // not an instance
   for (int k = 0; k < 3; ++k) w.integer<std::int64_t>(0);  // offsets, unused by io::Stream
   w.integer<std::uint32_t>(compression);
-  copyMetadata(c, w);
+  copyMetadata(c, w, s.half);
   copyTransform(c, w);
   VdbTreeFormat f;
   f.valueBytes = s.type == "Tree_float_5_4_3" ? 4 : 12;

@@ -188,6 +188,30 @@ TEST(VdbHostile, ChunksClaimingMoreThanTheLeafHoldsAreRefused) {
   std::remove(path.c_str());
 }
 
+/// OpenVDB takes the tree's half-float flag from the grid metadata is_saved_as_half_float, read
+/// after the descriptor: a file whose metadata says "half" for a full-precision tree would be
+/// read with the wrong value size (found by fuzz_mantaflow: a 25 GB Blosc allocation). The flag
+/// of the descriptor, the one the tree is checked with, is the one OpenVDB gets.
+TEST(VdbHostile, HalfFloatMetadataCannotChangeHowTheTreeIsRead) {
+  const std::string path = tempPath("halfmeta.vdb");
+  for (const bool half : {false, true}) {
+    seeds::writeMantaflowSeed(path, half);
+    Bytes b = load(path);
+    const std::string name = "is_saved_as_half_float";
+    int changed = 0;
+    for (auto at = b.begin(); (at = std::search(at, b.end(), name.begin(), name.end())) != b.end();
+         ++at) {
+      // name, then the type "bool" (u32 length + 4 bytes), the size (u32), the value byte.
+      b[std::size_t(at - b.begin()) + name.size() + 4 + 4 + 4] = half ? 0 : 1;
+      ++changed;
+    }
+    ASSERT_EQ(changed, 3);
+    save(path, b, b.size());
+    EXPECT_EQ(readAll(path), 0) << half;
+  }
+  std::remove(path.c_str());
+}
+
 TEST(VdbHostile, VoxelsNearTwoToTheThirtyAreRefused) {
   openvdb::initialize();
   const std::string path = tempPath("far.vdb");
