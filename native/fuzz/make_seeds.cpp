@@ -4,6 +4,7 @@
 /// OUTDIR/<target>/seed_<n>.bin, a few small files per format, the empty cases included.
 
 #include "fuzz_fixtures.h"
+#include "fuzz/vdb_seeds.h"
 #include "solver/state_file.h"
 #include "toon/toon_file.h"
 #include "tracers/streak_file.h"
@@ -115,6 +116,16 @@ void pathlineSeeds(const fs::path& out) {
     }
 }
 
+/// VDB frames (OpenVDB's own writer, vdb_seeds.h): a Plume volume frame and Mantaflow frames in
+/// full and half precision for both VDB targets (either reader meets both kinds).
+void vdbSeeds(const fs::path& out) {
+  for (const char* target : {"vdb_frame", "mantaflow"}) {
+    seeds::writePlumeFrameSeed(seed(out, target, 0));
+    seeds::writeMantaflowSeed(seed(out, target, 1), /*half=*/false);
+    seeds::writeMantaflowSeed(seed(out, target, 2), /*half=*/true);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -128,6 +139,7 @@ int main(int argc, char** argv) {
     tracerSeeds(out);
     toonSeeds(out);
     pathlineSeeds(out);
+    vdbSeeds(out);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "plume_fuzz_seeds: %s\n", e.what());
     return 1;

@@ -4,7 +4,6 @@
 
 #include "io/mantaflow_cache.h"
 
-#include <openvdb/io/File.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +12,9 @@
 
 #include "core/parallel.h"
 #include "io/mac_faces.h"
+#include "io/utf8_text.h"
 #include "io/vdb_grids.h"
+#include "io/vdb_guard.h"
 
 namespace plume {
 namespace {
@@ -24,8 +25,13 @@ std::string text(glm::ivec3 v) {
   return s.str();
 }
 
+/// An error already naming the file (not wrapped again).
+struct MantaflowFileError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw std::runtime_error("Mantaflow cache file '" + path + "': " + what);
+  throw MantaflowFileError(cleanUtf8("Mantaflow cache file '" + path + "': " + what));
 }
 
 /// Relative tolerance of the voxel size check: Blender stores it as a float computed from
@@ -88,10 +94,10 @@ void checkResolution(const openvdb::GridBase& grid, const MantaflowGrid& g,
 }
 
 template <typename GridT>
-typename GridT::Ptr readGrid(openvdb::io::File& file, const std::string& name,
+typename GridT::Ptr readGrid(const CheckedVdbFile& file, const std::string& name,
                              const MantaflowGrid& g, const std::string& path) {
-  if (!file.hasGrid(name)) fail(path, "has no grid named '" + name + "'");
   openvdb::GridBase::Ptr base = file.readGrid(name);
+  if (!base) fail(path, "has no grid named '" + name + "'");
   auto grid = openvdb::gridPtrCast<GridT>(base);
   if (!grid)
     fail(path,
@@ -188,7 +194,10 @@ float MantaflowFrame::maxCellsPerSecond(const MantaflowGrid& grid) const {
   return float(m);
 }
 
-MantaflowFrame readMantaflowFrame(const std::string& path, const MantaflowGrid& grid) {
+namespace {
+
+/// readMantaflowFrame() without the translation of foreign exceptions.
+MantaflowFrame readFrame(const std::string& path, const MantaflowGrid& grid) {
   try {
     grid.validate();
   } catch (const std::invalid_argument& e) {
@@ -197,14 +206,11 @@ MantaflowFrame readMantaflowFrame(const std::string& path, const MantaflowGrid& 
   initializeOpenVdb();
   openvdb::FloatGrid::Ptr density;
   openvdb::Vec3SGrid::Ptr velocity;
-  try {
-    openvdb::io::File file(path);
-    file.open(/*delayLoad=*/false);
+  {
+    // Read whole and checked before OpenVDB parses it (vdb_guard.h), never delay-loaded.
+    const CheckedVdbFile file(path);
     density = readGrid<openvdb::FloatGrid>(file, "density", grid, path);
     velocity = readGrid<openvdb::Vec3SGrid>(file, "velocity", grid, path);
-    file.close();
-  } catch (const openvdb::Exception& e) {
-    fail(path, std::string("cannot be read: ") + e.what());
   }
 
   const glm::ivec3 n = grid.resolution;
@@ -239,6 +245,21 @@ MantaflowFrame readMantaflowFrame(const std::string& path, const MantaflowGrid& 
     for (float& u : frame.velocity.component(a).values()) u *= scale;
   }
   return frame;
+}
+
+}  // namespace
+
+MantaflowFrame readMantaflowFrame(const std::string& path, const MantaflowGrid& grid) {
+  // Every failure names the file: OpenVDB's exceptions, a std::bad_alloc, anything.
+  try {
+    return readFrame(path, grid);
+  } catch (const MantaflowFileError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    fail(path, "does not fit in memory");
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot be read: ") + e.what());
+  }
 }
 
 void writeMantaflowVolume(const std::string& path, const MantaflowFrame& frame,

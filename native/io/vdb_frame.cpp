@@ -5,12 +5,15 @@
 
 #include "core/huge_pages.h"
 #include "core/parallel.h"
+#include "io/utf8_text.h"
 #include "io/vdb_grids.h"
+#include "io/vdb_guard.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
+#include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -18,8 +21,13 @@
 namespace plume {
 namespace {
 
+/// An error already naming the file (not wrapped again).
+struct VdbFrameError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw std::runtime_error("VDB file '" + path + "': " + what);
+  throw VdbFrameError(cleanUtf8("VDB file '" + path + "': " + what));
 }
 
 }  // namespace
@@ -85,17 +93,11 @@ void writeVdbFrame(const std::string& path, const SmokeSolver& solver, bool velo
 }
 
 std::vector<std::string> vdbGridNames(const std::string& path) {
-  initializeOpenVdb();
-  std::vector<std::string> names;
   try {
-    openvdb::io::File file(path);
-    file.open(/*delayLoad=*/true);
-    for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(it.gridName());
-    file.close();
+    return CheckedVdbFile(path).gridNames();
   } catch (const std::exception& e) {
     fail(path, std::string("cannot be read: ") + e.what());
   }
-  return names;
 }
 
 namespace {
@@ -109,6 +111,13 @@ void readDense(const GridT& grid, DenseGrid& out, const std::string& path) {
     out.size = glm::ivec3(0);
     return;
   }
+  // Where the box lies, before any size is computed from it: copyToDense works in int
+  // coordinates, and a box near 2^31 overflows them (the tree check keeps nodes within 2^24).
+  constexpr int kLimit = 1 << 24;
+  for (int a = 0; a < 3; ++a)
+    if (box.min()[a] < -kLimit || box.max()[a] >= kLimit)
+      fail(path, "grid '" + out.name + "' has voxels outside [-2^24, 2^24) on axis " +
+                     std::to_string(a));
   const openvdb::Coord dim = box.dim();
   const double count = double(dim.x()) * dim.y() * dim.z() * out.components;
   // A file is never trusted: refuse boxes no solver could have written.
@@ -128,41 +137,48 @@ void readDense(const GridT& grid, DenseGrid& out, const std::string& path) {
   }
 }
 
+/// The dense box of a grid read from `path`, with its placement (finite, positive voxel size).
+DenseGrid denseOf(const openvdb::GridBase& base, const std::string& name, const std::string& path) {
+  DenseGrid out;
+  out.name = name;
+  const openvdb::Vec3d voxel = base.voxelSize();
+  const openvdb::Vec3d w0 = base.indexToWorld(openvdb::Vec3d(0.0));
+  for (int a = 0; a < 3; ++a)
+    if (!(voxel[a] > 0.0) || !std::isfinite(float(voxel[a])) || !std::isfinite(float(w0[a])))
+      fail(path, "grid '" + name + "' has a voxel size or origin that is not a finite "
+                 "positive number");
+  out.voxelSize = float(voxel[0]);
+  out.voxelSizes = glm::vec3(float(voxel[0]), float(voxel[1]), float(voxel[2]));
+  out.axisAligned = base.transform().isLinear() &&
+                    base.transform().baseMap()->getAffineMap()->isScaleTranslate();
+  out.worldOfVoxelZero = glm::vec3(float(w0[0]), float(w0[1]), float(w0[2]));
+  if (auto g = dynamic_cast<const openvdb::FloatGrid*>(&base)) {
+    out.components = 1;
+    readDense(*g, out, path);
+  } else if (auto v = dynamic_cast<const openvdb::Vec3SGrid*>(&base)) {
+    out.components = 3;
+    readDense(*v, out, path);
+  } else {
+    fail(path, "grid '" + name + "' is of type " + base.type() + "; expected float or vec3s");
+  }
+  return out;
+}
+
 }  // namespace
 
 DenseGrid readVdbGrid(const std::string& path, const std::string& name) {
   initializeOpenVdb();
-  openvdb::GridBase::Ptr base;
-  bool found = false;
   try {
-    openvdb::io::File file(path);
-    file.open(/*delayLoad=*/true);
-    found = file.hasGrid(name);
-    if (found) base = file.readGrid(name);
-    file.close();
+    const openvdb::GridBase::Ptr base = CheckedVdbFile(path).readGrid(name);
+    if (!base) fail(path, "has no grid named '" + name + "'");
+    return denseOf(*base, name, path);
+  } catch (const VdbFrameError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    fail(path, "grid '" + name + "' does not fit in memory");
   } catch (const std::exception& e) {
     fail(path, std::string("cannot be read: ") + e.what());
   }
-  if (!found || !base) fail(path, "has no grid named '" + name + "'");
-  DenseGrid out;
-  out.name = name;
-  const openvdb::Vec3d voxel = base->voxelSize();
-  out.voxelSize = float(voxel[0]);
-  out.voxelSizes = glm::vec3(float(voxel[0]), float(voxel[1]), float(voxel[2]));
-  out.axisAligned = base->transform().isLinear() &&
-                    base->transform().baseMap()->getAffineMap()->isScaleTranslate();
-  const openvdb::Vec3d w0 = base->indexToWorld(openvdb::Vec3d(0.0));
-  out.worldOfVoxelZero = glm::vec3(float(w0[0]), float(w0[1]), float(w0[2]));
-  if (auto g = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) {
-    out.components = 1;
-    readDense(*g, out, path);
-  } else if (auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base)) {
-    out.components = 3;
-    readDense(*v, out, path);
-  } else {
-    fail(path, "grid '" + name + "' is of type " + base->type() + "; expected float or vec3s");
-  }
-  return out;
 }
 
 }  // namespace plume

@@ -3,6 +3,8 @@
 
 #include "io/vdb_grids.h"
 
+#include "io/vdb_guard.h"
+
 #include <openvdb/io/File.h>
 #include <openvdb/tools/Dense.h>
 
@@ -82,17 +84,13 @@ void writeGridsAtomic(const std::string& path, const openvdb::GridPtrVec& grids,
       err = errno;
     }
     // io::File::write does not report a failed stream: a write(2) that failed for want of room
-    // left its errno (then the short file is not read back: its garbage sizes could ask for
-    // gigabytes); anything else is caught by reading the grid descriptors back.
+    // left its errno; anything else (a short file) is caught by reading the header and grid
+    // descriptors back through the same checks as every read (vdb_guard).
     if (err == ENOSPC || err == EDQUOT || err == EFBIG || err == EIO)
       throw std::runtime_error(writeFailure(err));
     err = 0;
-    openvdb::io::File check(tmp);
-    check.open(/*delayLoad=*/true);
-    std::size_t written = 0;
-    for (auto it = check.beginName(); it != check.endName(); ++it) ++written;
-    check.close();
-    if (written != grids.size()) throw std::runtime_error("grids missing after writing");
+    if (CheckedVdbFile(tmp).gridNames().size() != grids.size())
+      throw std::runtime_error("grids missing after writing");
   } catch (const std::exception& e) {
     std::remove(tmp.c_str());  // no half file: the previous one, if any, stays
     fail(path, std::string("cannot be written: ") + e.what());

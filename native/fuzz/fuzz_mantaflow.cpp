@@ -1,0 +1,34 @@
+/// \file fuzz_mantaflow.cpp
+/// libFuzzer target: the bytes as a Blender Mantaflow fluid_data frame read onto the seeds'
+/// domain (readMantaflowFrame). The contract (issue 18): a std::runtime_error naming the file,
+/// or a frame; anything else (another exception, a crash, a stall, unbounded memory) is a
+/// finding. Seeds: make_seeds.cpp (vdb_seeds.h).
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <unistd.h>
+
+#include "fuzz/vdb_seeds.h"
+#include "io/mantaflow_cache.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static const std::string path =
+      "/tmp/plume_fuzz_mantaflow_" + std::to_string(::getpid()) + ".vdb";
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+  }
+  try {
+    plume::readMantaflowFrame(path, plume::seeds::mantaflowGrid());
+  } catch (const std::runtime_error& e) {
+    if (std::string(e.what()).find(path) == std::string::npos) {
+      std::fprintf(stderr, "error without the file name: %s\n", e.what());
+      std::abort();
+    }
+  }
+  return 0;
+}
