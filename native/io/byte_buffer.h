@@ -76,7 +76,7 @@ class ByteReader {
   bool checksumMatches() const;
   void bytes(void* out, std::size_t n) {
     need(n);
-    std::memcpy(out, mData + mPos, n);
+    if (n) std::memcpy(out, mData + mPos, n);  // out may be null for n == 0 (an empty vector)
     mPos += n;
   }
   std::size_t position() const { return mPos; }
