@@ -7,6 +7,8 @@
 
 #include "core/sample_points.h"
 
+#include <cstring>
+
 namespace plume {
 
 /// Offsets of the +1 neighbour along x, y, z: 0 on an axis of one sample (sampleLinear()).
@@ -79,8 +81,9 @@ __attribute__((target("avx2"))) inline Corners8 cornersOf8(const float* data,
     return c;
   }
   auto pairs = [](const float* lo, const float* hi) {  // (lo[0] lo[1] hi[0] hi[1])
-    return _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(lo))),
-                        reinterpret_cast<const __m64*>(hi));
+    double pair;  // two floats at any 4-byte address: read through memcpy, not a double*
+    std::memcpy(&pair, lo, sizeof pair);
+    return _mm_loadh_pi(_mm_castpd_ps(_mm_set_sd(pair)), reinterpret_cast<const __m64*>(hi));
   };
   __m128 r[2][8];  // r[0][p] = corners 0-3 of point p, r[1][p] = corners 4-7
   for (int p = 0; p < 8; ++p) {
