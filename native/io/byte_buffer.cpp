@@ -4,6 +4,9 @@
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 
 namespace plume {
 namespace {
@@ -90,6 +93,22 @@ std::string writeFailure(int err) {
   return text;
 }
 
+int writeFailureCause(const std::string& path, int err) {
+  if (err != 0) return err;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return 0;
+  struct rlimit limit {};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+      static_cast<rlim_t>(st.st_size) >= limit.rlim_cur)
+    return EFBIG;
+  struct statvfs fs {};
+  // "No block left": less free than one 64 KiB stream buffer for an unprivileged writer.
+  if (::statvfs(path.c_str(), &fs) == 0 &&
+      static_cast<unsigned long long>(fs.f_bavail) * fs.f_frsize < (64ull << 10))
+    return ENOSPC;
+  return 0;
+}
+
 void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,
                      const std::string& kind) {
   writeFileAtomic(path, kind, [&](std::ostream& out) {
@@ -118,6 +137,7 @@ void writeFileAtomic(const std::string& path, const std::string& kind,
     }
   }
   if (!ok) {
+    err = writeFailureCause(tmp, err);  // writes on a worker thread leave errno there
     std::remove(tmp.c_str());  // no half file: the previous one, if any, stays
     throw std::runtime_error(kind + " '" + path + "' cannot be written: " + writeFailure(err));
   }

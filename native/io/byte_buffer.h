@@ -94,6 +94,12 @@ class ByteReader {
 /// the file system's largest file), else strerror; "a short write" when errno is 0.
 std::string writeFailure(int err);
 
+/// The errno a failed write of `path` most likely met when the one at hand is lost (0: the
+/// stream's writes may have run on another thread, whose errno is its own): EFBIG when the file
+/// reached the process's file size limit (RLIMIT_FSIZE), ENOSPC when the file system has no
+/// block left for it, else 0. Call before removing the partial file.
+int writeFailureCause(const std::string& path, int err);
+
 /// Writes `bytes` to `path` atomically: to "<path>.tmp", then rename. Throws std::runtime_error
 /// "<kind> '<path>' cannot be written ..." on failure, leaving no temporary file behind.
 void writeFileAtomic(const std::string& path, const std::vector<unsigned char>& bytes,
