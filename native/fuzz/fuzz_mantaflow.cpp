@@ -1,6 +1,6 @@
 /// \file fuzz_mantaflow.cpp
 /// libFuzzer target: the bytes as a Blender Mantaflow fluid_data frame read onto the seeds'
-/// domain (readMantaflowFrame). The contract (issue 18): a std::runtime_error naming the file,
+/// domain (readMantaflowFrame). The contract: a std::runtime_error naming the file,
 /// or a frame; anything else (another exception, a crash, a stall, unbounded memory) is a
 /// finding. Seeds: make_seeds.cpp (vdb_seeds.h).
 

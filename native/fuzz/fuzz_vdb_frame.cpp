@@ -1,6 +1,6 @@
 /// \file fuzz_vdb_frame.cpp
 /// libFuzzer target: the bytes as a VDB volume frame read back by Plume (vdbGridNames, then
-/// readVdbGrid of each grid listed and of the frame's grid names). The contract (issue 18): a
+/// readVdbGrid of each grid listed and of the frame's grid names). The contract: a
 /// std::runtime_error naming the file, or a result; anything else (another exception, a crash,
 /// a stall, unbounded memory) is a finding. Seeds: make_seeds.cpp (vdb_seeds.h).
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file vdb_guard.h
-/// VDB files are checked byte by byte before OpenVDB parses any of them (issue 18: a damaged or
+/// VDB files are checked byte by byte before OpenVDB parses any of them (a damaged or
 /// half-copied file must give an error, never crash, stall or exhaust memory).
 ///
 /// Why a check and not a patched OpenVDB or a forked reader: OpenVDB 10.0.1 (Debian's) trusts

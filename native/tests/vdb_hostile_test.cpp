@@ -1,5 +1,5 @@
 /// \file vdb_hostile_test.cpp
-/// Hostile VDB files (issue 18): files made by OpenVDB's own writer (fuzz/vdb_seeds.h), then
+/// Hostile VDB files: files made by OpenVDB's own writer (fuzz/vdb_seeds.h), then
 /// truncated and changed at every byte of their headers and throughout, given Blosc chunks that claim more than
 /// the leaf holds, voxels near 2^30, a NaN voxel size and a grid type that is not UTF-8. Every
 /// VDB reader of Plume either reads the file or throws std::runtime_error naming the file in

@@ -1,4 +1,4 @@
-"""Hostile VDB files from Python (issue 18): a frame written by Plume, then truncated at every
+"""Hostile VDB files from Python: a frame written by Plume, then truncated at every
 length and given a grid type that is not UTF-8. Every reader raises RuntimeError naming the
 file with a readable message (never MemoryError, an empty RuntimeError() or a crash)."""
 import pytest
