@@ -150,6 +150,27 @@ class KillResumeTest(unittest.TestCase):
                 self.assertTrue(np.array_equal(a["values"], b["values"]),
                                 f"frame {f} {grid}: the killed-and-resumed bake differs")
 
+    def test_next_bake_removes_a_killed_writes_temporaries(self):
+        """What a kill inside a write leaves (the add-on's <name>.<pid>_<hex>.tmp, a native
+        writer's <name>.tmp) is removed by the next job holding the folder's lock; Plume's own
+        hidden files are not touched."""
+        cache = os.path.join(self.tmp, "cache")
+        add_sphere_source()
+        dom = add_domain(resolution=16, frame_end=3, cache_directory=cache + "/")
+        select_only(dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        folder = os.path.join(cache, "Domain")
+        left = ["manifest.json.4194303_0badcafe.tmp", "volume_0004.vdb.tmp", "state.bin.tmp"]
+        for name in left + [".plume_probe_keep.tmp"]:
+            with open(os.path.join(folder, name), "wb") as f:
+                f.write(b"half a file")
+        dom.plume.domain.frame_end = 5
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        names = os.listdir(folder)
+        self.assertFalse(set(left) & set(names), names)
+        self.assertIn(".plume_probe_keep.tmp", names)
+        self.assertEqual(manifest(cache)["last_complete_frame"], 5)
+
 
 if __name__ == "__main__":
     run(KillResumeTest)

@@ -39,6 +39,25 @@ def temporary_path(path):
     return f"{path}.{os.getpid()}_{uuid.uuid4().hex[:8]}{TMP_SUFFIX}"
 
 
+def sweep_temporaries(folder):
+    """Removes the unfinished writes a killed process left in cache folder `folder` and its
+    subfolders (``*.tmp``: this module's, and the native writers' ``<name>.tmp``), but not
+    Plume's hidden files (lock records, probes: their owners handle them) nor job staging
+    folders (staging.sweep). Only safe while holding the folder's lock (jobs/folder_lock.py):
+    then no other writer can own them. Returns how many were removed."""
+    removed = 0
+    for root, dirs, names in os.walk(folder):
+        dirs[:] = [d for d in dirs if not d.startswith(".plume_job_")]
+        for name in names:
+            if name.endswith(TMP_SUFFIX) and not name.startswith("."):
+                try:
+                    os.remove(os.path.join(root, name))
+                    removed += 1
+                except OSError:
+                    pass
+    return removed
+
+
 def sync_folder(folder):
     """fsync of a directory, so renames into it are durable (a no-op where not supported)."""
     try:

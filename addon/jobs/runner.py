@@ -31,7 +31,7 @@ import time
 from dataclasses import dataclass
 from typing import Optional
 
-from ..files import no_room
+from ..files import no_room, sweep_temporaries
 from ..settings import BakeError
 from . import folder_lock, registry
 from .staging import Staging
@@ -204,9 +204,11 @@ class JobRunner(abc.ABC):
         """Makes the job the one writer of cache folder `folder` (folder_lock.py) until it ends
         in any way (registry.release()); LockHeld naming the holder when another Blender or job
         writes it, BakeError naming `setting` when the folder cannot be written. Call it in
-        prepare() before anything is written."""
+        prepare() before anything is written. Once held, the unfinished writes a killed writer
+        left there are removed (files.sweep_temporaries)."""
         self.folder_locks.append(folder_lock.acquire(folder, self.title, setting=setting,
                                                      on_lost=self.cancel))
+        sweep_temporaries(folder)
 
     def release_folders(self):
         """Drops the job's cache folder locks (registry.release() calls it); safe twice."""
