@@ -272,6 +272,21 @@ def assert_smoke_renders(test, scene, smoke, path_with, path_without):
     test.assertLess(float(a.mean()), 0.95, "render is white")
 
 
+def assert_same_frames(test, path_of, a, b, frames, grids=("density", "velocity")):
+    """Frames `frames` of two bakes are equal bit for bit, grid by grid: path_of(folder, frame)
+    is a frame's VDB file, `a` and `b` the two bakes' folders (a resumed and a straight one)."""
+    nat = native()
+    for f in frames:
+        for grid in grids:
+            x = nat.read_vdb_grid(path_of(a, f), grid)
+            y = nat.read_vdb_grid(path_of(b, f), grid)
+            test.assertEqual(tuple(x["min"]), tuple(y["min"]), f"frame {f} {grid}")
+            test.assertEqual(x["values"].shape, y["values"].shape, f"frame {f} {grid}")
+            if not np.array_equal(x["values"], y["values"]):
+                test.fail(f"frame {f} {grid}: the bakes differ (max |diff| "
+                          f"{np.abs(x['values'] - y['values']).max()})")
+
+
 def run(*cases):
     """Runs the TestCases (or the names given after "--"), prints "N passed, N failed" alone on the last line, exits 1 on failure."""
     loader = unittest.defaultTestLoader

@@ -26,10 +26,9 @@ import unittest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
-import numpy as np  # noqa: E402
 
-from helpers import (add_domain, add_sphere_source, native, reset_scene, rmtree,  # noqa: E402
-                     run, select_only, temp_dir)
+from helpers import (add_domain, add_sphere_source, assert_same_frames,  # noqa: E402
+                     reset_scene, rmtree, run, select_only, temp_dir)
 
 RESOLUTION = 24
 FRAMES = 8
@@ -111,14 +110,7 @@ class DiskFullTest(unittest.TestCase):
         return folder
 
     def assert_same_grids(self, folder, straight, frames):
-        nat = native()
-        for f in frames:
-            for grid in ("density", "velocity"):
-                a = nat.read_vdb_grid(volume(folder, f), grid)
-                b = nat.read_vdb_grid(volume(straight, f), grid)
-                self.assertEqual(tuple(a["min"]), tuple(b["min"]), f"frame {f} {grid}")
-                self.assertEqual(a["values"].shape, b["values"].shape, f"frame {f} {grid}")
-                self.assertTrue(np.array_equal(a["values"], b["values"]), f"frame {f} {grid}")
+        assert_same_frames(self, volume, folder, straight, frames)
 
     def run_out_and_resume(self, cache, run_out, make_room, reason):
         """Bakes into `cache`, running out of room after frame K - 1, checks what is left,

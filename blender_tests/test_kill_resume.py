@@ -26,10 +26,9 @@ import unittest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
-import numpy as np  # noqa: E402
 
-from helpers import (add_domain, add_sphere_source, native, reset_scene, rmtree,  # noqa: E402
-                     run, select_only, temp_dir)
+from helpers import (add_domain, add_sphere_source, assert_same_frames, native,  # noqa: E402
+                     reset_scene, rmtree, run, select_only, temp_dir)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CHILD = os.path.join(HERE, "children", "bake_scene.py")
@@ -141,14 +140,7 @@ class KillResumeTest(unittest.TestCase):
         dom = add_domain(resolution=RESOLUTION, frame_end=FRAMES, cache_directory=straight + "/")
         select_only(dom)
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        nat = native()
-        for f in range(1, FRAMES + 1):
-            for grid in GRIDS:
-                a = nat.read_vdb_grid(frame_file(killed, f), grid)
-                b = nat.read_vdb_grid(frame_file(straight, f), grid)
-                self.assertEqual(tuple(a["min"]), tuple(b["min"]), f"frame {f} {grid}")
-                self.assertTrue(np.array_equal(a["values"], b["values"]),
-                                f"frame {f} {grid}: the killed-and-resumed bake differs")
+        assert_same_frames(self, frame_file, killed, straight, range(1, FRAMES + 1), GRIDS)
 
     def test_next_bake_removes_a_killed_writes_temporaries(self):
         """What a kill inside a write leaves (the add-on's <name>.<pid>_<hex>.tmp, a native
