@@ -293,6 +293,22 @@ class BakeSnapshot:
         return h.hexdigest()
 
 
+def physical_buoyancy(alpha, beta, units, longest_side):
+    """(α, β) for the solver, f = -g (α ρ + β (T - T_amb)), from the domain's α and β in `units`:
+    'PHYSICAL' as they are; 'MANTAFLOW' as Mantaflow's Density and Heat, divided by the domain's
+    longest side L in metres. Mantaflow's smoke script calls addBuoyancy(gravity=g_grid,
+    coefficient=α / L, scale=False), its velocity step Δu = -g_grid Δt α/L ρ in cells per its
+    time unit, with g_grid = g (res / L) (1 s / 2.5 time units)²; back in metres and seconds
+    (u = u_grid (L / res) 2.5) the acceleration is g α ρ / L, independent of the resolution."""
+    if units == 'PHYSICAL':
+        return float(alpha), float(beta)
+    if units != 'MANTAFLOW':
+        raise BakeError(f"buoyancy_units must be 'PHYSICAL' or 'MANTAFLOW' (got {units!r})")
+    if not longest_side > 0.0:
+        raise BakeError(f"the domain's longest side must be > 0 m (got {longest_side})")
+    return float(alpha) / longest_side, float(beta) / longest_side
+
+
 def domain_grid(bbox_min, bbox_max, resolution):
     """Cells per axis, cell size and origin of a domain box: the
     longest axis gets `resolution` cells, the others round(dim / cell_size), at least 2."""

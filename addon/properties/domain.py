@@ -58,6 +58,16 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     beta: FloatProperty(
         name="Heat Buoyancy (β)", default=1.0, soft_min=-10.0, soft_max=10.0,
         description="β: buoyancy from temperature, f = -g (α ρ + β (T - T_amb)) (Fedkiw 2001 eq. 8)")
+    buoyancy_units: EnumProperty(
+        name="Buoyancy Units", default='PHYSICAL',
+        description="What α and β mean: Plume's physical units, or Mantaflow's (a scene moved "
+                    "from a Mantaflow domain keeps its α and β and rises as high)",
+        items=(('PHYSICAL', "Physical", "f = -g (α ρ + β (T - T_amb)): α = 1 lifts smoke of "
+                                        "density 1 with the acceleration g"),
+               ('MANTAFLOW', "Mantaflow", "α and β as in Mantaflow's Density and Heat: its "
+                                          "buoyancy is g α ρ / L, L the domain's longest side "
+                                          "in metres (smoke_script.h: alpha / domain size), so "
+                                          "Plume bakes with α / L and β / L")))
     ambient_temperature: FloatProperty(
         name="Ambient Temperature", default=0.0, soft_min=-10.0, soft_max=10.0,
         description="T_amb: temperature of the surrounding air (T_0 of the fire paper)")

@@ -6,7 +6,7 @@ import dataclasses
 
 from ..mantaflow_cache import BORDER_SETTINGS, MantaflowSource
 from ..settings import (BOUNDARY_SIDES, BakeError, BakeSnapshot, SolverSettings, domain_grid,
-                        validate_python_side)
+                        physical_buoyancy, validate_python_side)
 from .flowgraph import pathline_settings
 from .scene import (absolute_folder, active_domain, cache_folder_of, domain_bbox,
                     emitter_snapshots, flames_cache_folder, from_properties)
@@ -18,11 +18,13 @@ def solver_settings(domain, scene, cells, cell_size, origin):
     other field copied from the same-named domain property."""
     d = domain.plume.domain
     fps = scene.render.fps / scene.render.fps_base
+    alpha, beta = physical_buoyancy(d.alpha, d.beta, d.buoyancy_units,
+                                    max(cells) * float(cell_size))
     return from_properties(
         SolverSettings, d, resolution=tuple(cells), cell_size=float(cell_size),
         origin=tuple(origin),
         boundaries=tuple(getattr(d, "boundary_" + side) for side in BOUNDARY_SIDES),
-        frame_dt=float(d.time_scale) / fps)
+        frame_dt=float(d.time_scale) / fps, alpha=alpha, beta=beta)
 
 
 def mantaflow_source(domain, scene):

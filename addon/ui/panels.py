@@ -84,6 +84,7 @@ class PHYSICS_PT_plume_forces(PlumeDomainPanel, bpy.types.Panel):
         col = layout.column(align=True)
         col.prop(d, "alpha")
         col.prop(d, "beta")
+        col.prop(d, "buoyancy_units")
         col.prop(d, "ambient_temperature")
         layout.prop(d, "gravity")
         layout.prop(d, "vorticity")

@@ -1,43 +1,51 @@
 """Bake time of Mantaflow vs Plume on the same smoke scene, in one Blender process.
 
-    blender -b --factory-startup --python examples/smoke/compare_mantaflow.py -- RES FRAMES
+    blender -b --factory-startup --python examples/smoke/compare_mantaflow.py -- [MODE] RES FRAMES
     blender_tests/run.py --blender 4.5 --script examples/smoke/compare_mantaflow.py -- RES FRAMES
 
-Scene (built twice): a 2 m cube domain standing on the floor (z 0..2), a UV sphere of radius
-0.16 m at (0, 0, 0.3) emitting smoke (density 1, temperature 1), RES cells along every axis,
-frames 1..FRAMES at the factory 24 fps, one solver step per frame, vorticity, alpha and beta equal
-in both, closed floor and open sides/top in both.
+Scene (built once per bake): a 2 m cube domain standing on the floor (z 0..2), a UV sphere of
+radius 0.16 m at (0, 0, 0.3) emitting smoke (density 1, temperature 1), RES cells along every
+axis, frames 1..FRAMES at the factory 24 fps, vorticity, alpha and beta equal in both, closed
+floor and open sides/top in both. Mantaflow: Quick Smoke on the sphere, then the domain is
+moved/scaled onto the cube; resolution_max RES, cache_type 'MODULAR', OpenVDB with full 32-bit
+floats (Plume writes float32), noise, mesh and particles off, its default advection
+(MacCormack), baked with bpy.ops.fluid.bake_data() into a temp folder. Plume: a new cube domain
+per configuration with the same sphere as SOURCE, baked with bpy.ops.plume.bake().
 
-1. Mantaflow: Quick Smoke on the sphere, then the domain is moved/scaled onto the cube above;
-   resolution_max RES, adaptive time steps off, timesteps_min = timesteps_max = 1, cache_type
-   'MODULAR', cache_data_format 'OPENVDB' with full 32-bit floats (Plume writes float32), noise,
-   mesh and particles off, default advection (MacCormack), baked with bpy.ops.fluid.bake_data()
-   into a temp folder.
-2. Plume, twice, each time on a new cube domain with the same sphere as SOURCE, pressure
-   tolerance 1e-3, substeps 1 and no CFL sub-stepping, baked with bpy.ops.plume.bake() into a
-   temp folder:
-   a. "comparable": MacCormack advection, trilinear interpolation, Euler back-traces. These are
-      the settings Mantaflow runs in Blender 3.4 (intern/mantaflow/intern/strings/smoke_script.h:
-      advectSemiLagrange(..., order=2) for density, heat and velocity, i.e. MacCormack with
-      strength 1 and the defaults orderSpace=1 (trilinear) and orderTrace=1: one Euler step
-      back from each grid point with the velocity at that point, getCentered() for cells and
-      getAtMACX/Y/Z() for faces, which are exact face averages; and solvePressure() with its
-      multigrid-preconditioned CG to cgAccuracy 1e-3). Plume's Trace.EULER uses the same exact
-      face averages, so both solvers do the same work per cell: two trilinear passes and a
-      clamp per field, and an MGPCG solve to 1e-3. The one difference: Mantaflow's default
-      limiter (clampMode 2) falls back to the forward value where the corrected one leaves the
-      range, Plume clamps it (Selle et al. 2008 §4, the first limiter).
-   b. "defaults": Plume's default advection, BFECC + monotonic cubic sampling + midpoint (RK2)
-      traces: sharper, and about three times the work per step.
+MODE (the first Plume configuration of a mode is the one the last line's ratio is for):
+
+* none, "matched numerics": one step per frame in both (Mantaflow's adaptive time steps off,
+  timesteps_min = timesteps_max = 1; Plume substeps 1, no CFL steps), pressure tolerance 1e-3.
+  a. "comparable": MacCormack advection, trilinear interpolation, Euler back-traces. These are
+     the settings Mantaflow runs in Blender 3.4 (intern/mantaflow/intern/strings/smoke_script.h:
+     advectSemiLagrange(..., order=2) for density, heat and velocity, i.e. MacCormack with
+     strength 1 and the defaults orderSpace=1 (trilinear) and orderTrace=1: one Euler step
+     back from each grid point with the velocity at that point, getCentered() for cells and
+     getAtMACX/Y/Z() for faces, which are exact face averages; and solvePressure() with its
+     multigrid-preconditioned CG to cgAccuracy 1e-3). Plume's Trace.EULER uses the same exact
+     face averages, so both solvers do the same work per cell: two trilinear passes and a
+     clamp per field, and an MGPCG solve to 1e-3. The one difference: Mantaflow's default
+     limiter (clampMode 2) falls back to the forward value where the corrected one leaves the
+     range, Plume clamps it (Selle et al. 2008 §4, the first limiter).
+  b. Plume's default advection (BFECC + monotonic cubic + midpoint traces), one step per frame.
+* --defaults, "defaults against defaults": Mantaflow as Quick Smoke makes it (adaptive time
+  steps, CFL 4, 1..4 steps a frame), Plume with its domain defaults (BFECC, monotonic cubic,
+  midpoint traces, tolerance 1e-4, CFL steps at 4). Then Plume again with Buoyancy Units
+  'MANTAFLOW' (α and β read as Mantaflow reads them: the plume Mantaflow makes), with its
+  defaults and with Mantaflow's numerics.
+* --adaptive: as --defaults (the first two Plume bakes), with both adaptive domains on.
+
+Every bake prints the height of its density centroid at frame min(20, FRAMES) and, for Plume,
+its rise above the source centre relative to Mantaflow's (1.00 = the same plume height).
 
 Each bake is timed with time.perf_counter() around the bake operator only (wall clock, VDB
-writing included). Both caches are checked (one VDB per frame, smoke in the last frame) and the
-script fails (exit code 1) otherwise. Peak memory: ru_maxrss is the peak of the whole process and
-cannot be split between two bakes in one process; on Linux the peak RSS (VmHWM) is reset through
-/proc/self/clear_refs before each bake instead, and the cache sizes are printed too. Both
-Plume configurations are printed with their ratio; the last line printed is exactly
-``ratio: X`` with X = Mantaflow s/frame / Plume s/frame of the comparable configuration (2
-decimals).
+writing included). Both caches are checked (one VDB per frame, smoke in the last frame; one
+Mantaflow step per frame in the matched mode) and the script fails (exit code 1) otherwise. Peak
+memory: ru_maxrss is the peak of the whole process and cannot be split between two bakes in one
+process; on Linux the peak RSS (VmHWM) is reset through /proc/self/clear_refs before each bake
+instead, and the cache sizes are printed too. Every Plume configuration is printed with its
+ratio (Mantaflow s/frame / Plume s/frame); the last line printed is exactly ``ratio: X`` for
+the mode's first configuration (2 decimals).
 
 Needs the Plume add-on installed (BLENDER_USER_SCRIPTS/addons/plume or
 ~/.config/blender/3.4/scripts/addons/plume). Set PLUME_COMPARE_KEEP=1 to keep the cache folders.
@@ -55,11 +63,20 @@ import traceback
 
 import addon_utils
 import bpy
+import numpy as np
 
 USAGE = ("usage: blender -b --factory-startup --python "
-         "examples/smoke/compare_mantaflow.py -- RES FRAMES\n"
+         "examples/smoke/compare_mantaflow.py -- [--defaults | --adaptive] RES FRAMES\n"
+         "  --defaults  each tool's own defaults: Mantaflow's Quick Smoke (adaptive time steps)\n"
+         "              against Plume's defaults (BFECC, cubic, midpoint, 1e-4, CFL steps)\n"
+         "  --adaptive  as --defaults, with both tools' adaptive domains on\n"
+         "              (without either: Mantaflow's numerics in both, one step per frame)\n"
          "  RES     cells along each axis of the 2 m cube domain, integer in [8, 1024]\n"
          "  FRAMES  frames to bake (1..FRAMES), integer >= 1")
+
+#: The modes: the Plume configurations each bakes (the first is the one the last line's ratio is
+#: for) and whether Mantaflow keeps its own defaults.
+MODES = ("matched", "defaults", "adaptive")
 
 # Shared scene and physics settings (same value in both solvers).
 DOMAIN_SIZE = 2.0                  # m, cube standing on the floor
@@ -73,12 +90,27 @@ ALPHA = 1.0                        # density buoyancy (both: > 0 makes dense smo
 BETA = 1.0                         # heat buoyancy
 PRESSURE_TOLERANCE = 1e-3          # Plume; Mantaflow's fixed gas cgAccuracy is also 1e-3
 
-#: Plume's advection settings per configuration (see the docstring); the first is the one the
-#: last line's ratio is for.
-PLUME_CONFIGS = (
-    ("comparable", dict(advection='MACCORMACK', interpolation='LINEAR', trace='EULER')),
-    ("defaults", dict(advection='BFECC', interpolation='MONOTONIC_CUBIC', trace='MIDPOINT')),
-)
+#: Plume's settings per configuration and mode (see the docstring); the first of a mode is the
+#: one the last line's ratio is for. "matched": Mantaflow's numerics, one step per frame;
+#: "defaults": the domain's defaults (CFL steps, tolerance 1e-4); "+ Mantaflow buoyancy": the
+#: same with α and β read in Mantaflow's units (Buoyancy Units), the plume Mantaflow makes.
+MATCHED = dict(advection='MACCORMACK', interpolation='LINEAR', trace='EULER',
+               pressure_tolerance=PRESSURE_TOLERANCE, substeps=1, use_cfl=False)
+PLUME_DEFAULTS = dict(advection='BFECC', interpolation='MONOTONIC_CUBIC', trace='MIDPOINT')
+PLUME_CONFIGS = {
+    "matched": (("comparable", MATCHED),
+                ("defaults, one step per frame",
+                 dict(PLUME_DEFAULTS, pressure_tolerance=PRESSURE_TOLERANCE, substeps=1, use_cfl=False))),
+    "defaults": (("defaults", dict(PLUME_DEFAULTS)),
+                 ("defaults + Mantaflow buoyancy", dict(PLUME_DEFAULTS,
+                                                        buoyancy_units='MANTAFLOW')),
+                 ("comparable + Mantaflow buoyancy", dict(MATCHED, buoyancy_units='MANTAFLOW'))),
+    "adaptive": (("defaults, adaptive domain", dict(PLUME_DEFAULTS, adaptive_domain=True)),
+                 ("defaults + Mantaflow buoyancy, adaptive domain",
+                  dict(PLUME_DEFAULTS, buoyancy_units='MANTAFLOW', adaptive_domain=True))),
+}
+#: Frame whose density centroid is compared (the issue's "after 20 frames"), or the last one.
+CENTROID_FRAME = 20
 
 MANTA_DOMAIN = "MantaDomain"
 PLUME_DOMAIN = "PlumeDomain"
@@ -91,8 +123,15 @@ class CompareError(Exception):
 
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    flags = [a for a in argv if a.startswith("--")]
+    argv = [a for a in argv if not a.startswith("--")]
+    mode = "matched"
+    for flag in flags:
+        if flag not in ("--defaults", "--adaptive") or mode != "matched":
+            sys.exit(f"{USAGE}\nerror: unknown or second mode flag {flag!r}")
+        mode = flag[2:]
     if len(argv) != 2:
-        sys.exit(f"{USAGE}\nerror: expected 2 arguments after '--', got {len(argv)}: {argv}")
+        sys.exit(f"{USAGE}\nerror: expected RES and FRAMES after '--', got {argv}")
     values = []
     for name, text in zip(("RES", "FRAMES"), argv):
         try:
@@ -104,7 +143,7 @@ def parse_args():
         sys.exit(f"{USAGE}\nerror: RES must be in [8, 1024] (got {res})")
     if frames < 1:
         sys.exit(f"{USAGE}\nerror: FRAMES must be at least 1 (got {frames})")
-    return res, frames
+    return mode, res, frames
 
 
 # --- memory -------------------------------------------------------------------------------------
@@ -177,10 +216,28 @@ def check_vdb_frames(kind, paths, native):
     return peak
 
 
+def density_centroid_z(path, native, res):
+    """Height above the floor (m) of the density centroid of a frame's VDB. Both caches index the
+    domain's cells from its minimum corner (Mantaflow in its own index space, Plume with its
+    world transform); the height of cell k's centre is (k + 0.5) Δx with Δx = 2 m / RES. An
+    adaptive Mantaflow domain writes its box's grid: its VDB's index minimum is the box's."""
+    grid = native.read_vdb_grid(path, "density")
+    values = grid["values"]
+    total = float(values.sum(dtype="float64"))
+    if not total > 0.0:
+        raise CompareError(f"{path}: no density to take a centroid of")
+    layers = values.sum(axis=(0, 1), dtype="float64")
+    index = float((layers * np.arange(len(layers))).sum()) / total + grid["min"][2]
+    return (index + 0.5) * DOMAIN_SIZE / res
+
+
 # --- Mantaflow ----------------------------------------------------------------------------------
 
-def build_mantaflow(res, frames, cache_dir):
-    """Quick Smoke on a small sphere, domain moved onto the shared 2 m cube. Returns (domain, sphere)."""
+def build_mantaflow(res, frames, cache_dir, mode):
+    """Quick Smoke on a small sphere, domain moved onto the shared 2 m cube. Returns (domain, sphere).
+    "matched": one step per frame; "defaults" keeps Quick Smoke's adaptive time steps (CFL 4,
+    1 to 4 steps a frame); "adaptive" also turns its adaptive domain on (its default margin and
+    threshold)."""
     bpy.ops.mesh.primitive_uv_sphere_add(radius=SOURCE_RADIUS, location=SOURCE_CENTER)
     sphere = bpy.context.active_object
     sphere.name = "SmokeSource"
@@ -199,11 +256,12 @@ def build_mantaflow(res, frames, cache_dir):
     ds = next(m for m in dom.modifiers if m.type == 'FLUID').domain_settings
     ds.domain_type = 'GAS'
     ds.resolution_max = res
-    ds.use_adaptive_timesteps = False
-    ds.timesteps_min = 1
-    ds.timesteps_max = 1
+    if mode == "matched":
+        ds.use_adaptive_timesteps = False
+        ds.timesteps_min = 1
+        ds.timesteps_max = 1
     ds.time_scale = 1.0
-    ds.use_adaptive_domain = False
+    ds.use_adaptive_domain = mode == "adaptive"
     ds.use_noise = False
     ds.use_dissolve_smoke = False
     ds.use_guide = False
@@ -266,9 +324,15 @@ def read_manta_config(path):
     return res, dt, time_total
 
 
-def check_mantaflow(cache_dir, res, frames, native):
-    data = [os.path.join(cache_dir, "data", f"fluid_data_{f:04d}.vdb") for f in range(1, frames + 1)]
+def manta_frame(cache_dir, frame):
+    return os.path.join(cache_dir, "data", f"fluid_data_{frame:04d}.vdb")
+
+
+def check_mantaflow(cache_dir, res, frames, native, mode):
+    data = [manta_frame(cache_dir, f) for f in range(1, frames + 1)]
     peak = check_vdb_frames("Mantaflow", data, native)
+    if mode != "matched":
+        return peak, None  # its own adaptive time steps: no step count to check
     # One step per frame: dt must be the whole frame and the simulated time frames * dt.
     fps = bpy.context.scene.render.fps / bpy.context.scene.render.fps_base
     frame_length = 0.1 * (25.0 / fps)  # fluid.c: DT_DEFAULT * (25 / fps) * time_scale
@@ -299,7 +363,8 @@ def remove_mantaflow(dom, sphere):
 
 # --- Plume --------------------------------------------------------------------------------------
 
-def build_plume(res, frames, cache_dir, sphere, name, advection):
+def build_plume(res, frames, cache_dir, sphere, name, config):
+    """A Plume domain on the shared cube; `config` sets domain properties over their defaults."""
     bpy.ops.mesh.primitive_cube_add(size=DOMAIN_SIZE, location=DOMAIN_CENTER)
     dom = bpy.context.active_object
     dom.name = name
@@ -310,16 +375,10 @@ def build_plume(res, frames, cache_dir, sphere, name, advection):
     d.frame_start, d.frame_end = 1, frames
     d.time_scale = 1.0
     d.cache_directory = cache_dir
-    d.advection = advection["advection"]
-    d.interpolation = advection["interpolation"]
-    d.trace = advection["trace"]
     d.vorticity = VORTICITY
     d.alpha = ALPHA
     d.beta = BETA
     d.gravity = (0.0, 0.0, -9.81)
-    d.pressure_tolerance = PRESSURE_TOLERANCE
-    d.substeps = 1
-    d.use_cfl = False
     d.threads = 0
     d.combustion = False
     d.density_dissipation = 0.0
@@ -327,6 +386,10 @@ def build_plume(res, frames, cache_dir, sphere, name, advection):
     for side in ("neg_x", "pos_x", "neg_y", "pos_y", "pos_z"):
         setattr(d, "boundary_" + side, 'OPEN')
     d.boundary_neg_z = 'CLOSED'
+    for key, value in config.items():
+        if not hasattr(d, key):
+            raise CompareError(f"this Plume has no domain setting {key!r}")
+        setattr(d, key, value)
 
     select_only(sphere)
     bpy.ops.plume.role_set(role='SOURCE')
@@ -365,7 +428,7 @@ def report(name, seconds, frames, cache_bytes, vdb_bytes, rss0, peak, extra=""):
           f"peak RSS during bake {mem}", flush=True)
 
 
-def run(res, frames, work):
+def run(mode, res, frames, work):
     mod = addon_utils.enable("plume", default_set=True)
     if mod is None or not hasattr(bpy.ops.plume, "bake"):
         raise CompareError("the plume add-on is not installed (see README: install_addon)")
@@ -382,42 +445,50 @@ def run(res, frames, work):
     plume_dir = os.path.join(work, "plume")
     os.makedirs(manta_dir)
     os.makedirs(plume_dir)
-    print(f"compare_mantaflow: Blender {bpy.app.version_string}, {res}^3 cells, {frames} frames "
-          f"at {scene.render.fps} fps, caches in {work}", flush=True)
+    centroid_frame = min(CENTROID_FRAME, frames)
+    print(f"compare_mantaflow: Blender {bpy.app.version_string}, mode {mode}, {res}^3 cells, "
+          f"{frames} frames at {scene.render.fps} fps, caches in {work}", flush=True)
 
     # 1. Mantaflow
-    manta_dom, sphere = build_mantaflow(res, frames, manta_dir)
+    manta_dom, sphere = build_mantaflow(res, frames, manta_dir, mode)
     rss0 = reset_peak_rss()
     manta_s = bake_mantaflow(manta_dom)
     manta_peak = peak_rss_since_reset() if rss0 is not None else None
     manta_rss0 = rss0
-    manta_density, _ = check_mantaflow(manta_dir, res, frames, _native)
+    manta_density, _ = check_mantaflow(manta_dir, res, frames, _native, mode)
+    manta_z = density_centroid_z(manta_frame(manta_dir, centroid_frame), _native, res)
     manta_cache = folder_bytes(manta_dir)
     manta_vdb = folder_bytes(os.path.join(manta_dir, "data"), r"fluid_data_\d+\.vdb")
     remove_mantaflow(manta_dom, sphere)
     scene.frame_set(1)
 
     report("mantaflow", manta_s, frames, manta_cache, manta_vdb, manta_rss0, manta_peak,
-           f", max density {manta_density:.3g}")
+           f", max density {manta_density:.3g}, density centroid at frame {centroid_frame} "
+           f"{manta_z:.3f} m")
 
     # 2. Plume, once per configuration, each on its own domain (removed after its bake)
     ratios = []
-    for config, advection in PLUME_CONFIGS:
-        name = f"{PLUME_DOMAIN}_{config}"
-        plume_dom = build_plume(res, frames, plume_dir + os.sep, sphere, name, advection)
+    for config, settings in PLUME_CONFIGS[mode]:
+        name = f"{PLUME_DOMAIN}_{len(ratios)}"
+        plume_dom = build_plume(res, frames, plume_dir + os.sep, sphere, name, settings)
         rss0 = reset_peak_rss()
         plume_s = bake_plume(plume_dom)
         plume_peak = peak_rss_since_reset() if rss0 is not None else None
         plume_folder = os.path.join(plume_dir, plume_dom.name)
         plume_density = check_plume(plume_folder, frames, _native)
+        plume_z = density_centroid_z(os.path.join(plume_folder, f"volume_{centroid_frame:04d}.vdb"),
+                                     _native, res)
         plume_cache = folder_bytes(plume_folder)
         plume_vdb = folder_bytes(plume_folder, r"volume_\d+\.vdb")
         state_bytes = folder_bytes(plume_folder, r"state\.bin")
         ratio = (manta_s / frames) / (plume_s / frames)
-        settings = ", ".join(f"{k} {v}" for k, v in advection.items())
-        report(f"plume {config} ({settings})", plume_s, frames, plume_cache, plume_vdb, rss0,
-               plume_peak, f", max density {plume_density:.3g}, incl. state.bin checkpoint "
-               f"{state_bytes / MIB:.1f} MiB; ratio {ratio:.2f}")
+        rise = (plume_z - SOURCE_CENTER[2]) / (manta_z - SOURCE_CENTER[2])
+        described = ", ".join(f"{k} {v}" for k, v in settings.items())
+        report(f"plume {config} ({described})", plume_s, frames, plume_cache, plume_vdb, rss0,
+               plume_peak, f", max density {plume_density:.3g}, density centroid at frame "
+               f"{centroid_frame} {plume_z:.3f} m (rise above the source {rise:.2f}x "
+               f"Mantaflow's), incl. state.bin checkpoint {state_bytes / MIB:.1f} MiB; "
+               f"ratio {ratio:.2f}")
         ratios.append(ratio)
         mesh = plume_dom.data
         bpy.data.objects.remove(plume_dom, do_unlink=True)
@@ -427,15 +498,15 @@ def run(res, frames, work):
     if rss0 is None:
         print("note: ru_maxrss is the peak of the whole process and cannot be split between "
               "the bakes; compare the cache sizes instead", flush=True)
-    return ratios[0]  # the comparable configuration
+    return ratios[0]
 
 
 def main():
-    res, frames = parse_args()
+    mode, res, frames = parse_args()
     work = tempfile.mkdtemp(prefix="plume_vs_mantaflow_")
     keep = os.environ.get("PLUME_COMPARE_KEEP", "") not in ("", "0")
     try:
-        ratio = run(res, frames, work)
+        ratio = run(mode, res, frames, work)
     except Exception as e:  # noqa: BLE001 - any failure must end the run with exit code 1
         traceback.print_exc()
         print(f"compare_mantaflow: FAILED: {e}", file=sys.stderr, flush=True)
