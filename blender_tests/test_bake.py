@@ -214,6 +214,23 @@ class BakeTest(unittest.TestCase):
         self.assertEqual(manifest(cache)["last_run"]["computed_frames"], [1, 2, 3])
         self.assertFalse(manifest(cache)["last_run"]["resumed"])
 
+    def test_mantaflow_buoyancy_units(self):
+        # Buoyancy Units 'MANTAFLOW' reads α and β as Mantaflow does: its buoyancy is g α ρ / L
+        # (L = the domain's longest side, 2 m here), so the bake equals a 'PHYSICAL' one with
+        # α / 2 and β / 2 bit for bit, and the manifest records the physical values.
+        folders = []
+        for units, alpha, beta in (('MANTAFLOW', 1.0, 0.5), ('PHYSICAL', 0.5, 0.25)):
+            reset_scene()
+            cache = os.path.join(self.tmp, units)
+            dom = build_scene(cache, frame_end=3, obstacle=False)
+            d = dom.plume.domain
+            d.buoyancy_units, d.alpha, d.beta = units, alpha, beta
+            self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+            solver = manifest(cache)["settings"]["solver"]
+            self.assertEqual((solver["alpha"], solver["beta"]), (0.5, 0.25))
+            folders.append(cache)
+        assert_same_frames(self, frame_file, folders[0], folders[1], range(1, 4))
+
 
 if __name__ == "__main__":
     run(BakeTest)
