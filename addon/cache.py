@@ -97,8 +97,8 @@ def read_manifest(folder):
     return files.read_manifest(folder, KIND)
 
 
-def write_manifest(folder, data):
-    files.write_manifest(folder, data)
+def write_manifest(folder, data, durable=True):
+    files.write_manifest(folder, data, durable=durable)
 
 
 def volume_frames(folder):

@@ -72,14 +72,17 @@ def sync_folder(folder):
         os.close(fd)
 
 
-def write_bytes(path, data: bytes):
-    """Writes `data` to `path` atomically (temporary name, fsync, rename, folder fsync)."""
+def write_bytes(path, data: bytes, durable=True):
+    """Writes `data` to `path` atomically (temporary name, fsync, rename, folder fsync). Not
+    `durable`: no fsyncs (still atomic against a killed process, whose writes the kernel keeps;
+    a power cut may leave the previous version, or on some file systems an empty file)."""
     tmp = temporary_path(path)
     try:
         with open(tmp, "wb") as f:
             f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
+            if durable:
+                f.flush()
+                os.fsync(f.fileno())
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -87,7 +90,8 @@ def write_bytes(path, data: bytes):
         except OSError:
             pass
         raise
-    sync_folder(os.path.dirname(os.path.abspath(path)))
+    if durable:
+        sync_folder(os.path.dirname(os.path.abspath(path)))
     return path
 
 

@@ -76,8 +76,8 @@ def read_manifest(folder, kind, name=MANIFEST_NAME):
     return data
 
 
-def write_manifest(folder, data, name=MANIFEST_NAME):
+def write_manifest(folder, data, name=MANIFEST_NAME, durable=True):
     """Writes `data` (with its "kind" and "format_version") as the folder's manifest `name`,
-    atomically."""
+    atomically; fsynced when `durable` (see write_bytes)."""
     text = json.dumps(data, indent=1, sort_keys=True)
-    write_bytes(manifest_path(folder, name), text.encode("utf-8"))
+    write_bytes(manifest_path(folder, name), text.encode("utf-8"), durable)
