@@ -1,11 +1,14 @@
 """Plume demo: a smoke plume rising from a small sphere, baked and rendered headless.
 
     blender -b --factory-startup --python examples/smoke/demo_plume.py -- OUT_DIR [FRAMES]
+        [--resolution N] [--still WIDTH HEIGHT SAMPLES]
 
 Builds the scene (domain cube, sphere source near the floor, camera, sun, dark world), saves it as
 OUT_DIR/demo_plume.blend (so the cache path is '//'-relative), bakes a 50^3 plume (BFECC,
-monotonic cubic, vorticity confinement) into OUT_DIR/plume_cache, renders OUT_DIR/plume_####.png
-with Cycles on the CPU and prints the bake and render times. Needs the add-on installed
+monotonic cubic, vorticity confinement; --resolution: N^3) into OUT_DIR/plume_cache, renders
+OUT_DIR/plume_####.png with Cycles on the CPU and prints the bake and render times. --still
+renders only the last frame, WIDTH x HEIGHT with SAMPLES samples (the README's 256^3 picture:
+`-- out 72 --resolution 256 --still 960 720 64`). Needs the add-on installed
 (BLENDER_USER_SCRIPTS/addons/plume or ~/.config/blender/3.4/scripts/addons/plume).
 """
 
@@ -28,15 +31,25 @@ SAMPLES = 16
 
 
 def parse_args():
+    import argparse
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    if not argv:
-        sys.exit("usage: blender -b --factory-startup --python examples/smoke/demo_plume.py -- "
-                 "OUT_DIR [FRAMES]")
-    out_dir = os.path.abspath(argv[0])
-    frames = int(argv[1]) if len(argv) > 1 else DEFAULT_FRAMES
-    if frames < 1:
-        sys.exit("FRAMES must be at least 1")
-    return out_dir, frames
+    parser = argparse.ArgumentParser(
+        prog="blender -b --factory-startup --python examples/smoke/demo_plume.py --")
+    parser.add_argument("out_dir")
+    parser.add_argument("frames", nargs="?", type=int, default=DEFAULT_FRAMES)
+    parser.add_argument("--resolution", type=int, default=RESOLUTION,
+                        help="cells along each axis of the 2 m domain (default 50)")
+    parser.add_argument("--still", type=int, nargs=3, metavar=("WIDTH", "HEIGHT", "SAMPLES"),
+                        help="render only the last frame, at this size and sample count")
+    args = parser.parse_args(argv)
+    if args.frames < 1:
+        parser.error("FRAMES must be at least 1")
+    if not 8 <= args.resolution <= 512:
+        parser.error(f"--resolution must be in [8, 512] (got {args.resolution})")
+    if args.still and (min(args.still[:2]) < 16 or args.still[2] < 1):
+        parser.error("--still: WIDTH and HEIGHT must be >= 16, SAMPLES >= 1")
+    args.out_dir = os.path.abspath(args.out_dir)
+    return args
 
 
 def clear_scene():
@@ -44,9 +57,9 @@ def clear_scene():
         bpy.data.objects.remove(ob, do_unlink=True)
 
 
-def make_domain(frames):
-    # 2 m cube standing on the floor: 50 cells of 4 cm on every axis.
-    dom = scene_kit.domain_cube("PlumeDomain", 2.0, (0.0, 0.0, 1.0), RESOLUTION, frames)
+def make_domain(frames, resolution):
+    # 2 m cube standing on the floor: 50 cells of 4 cm on every axis (by default).
+    dom = scene_kit.domain_cube("PlumeDomain", 2.0, (0.0, 0.0, 1.0), resolution, frames)
     d = dom.plume.domain
     d.advection = 'BFECC'
     d.interpolation = 'MONOTONIC_CUBIC'
@@ -108,21 +121,23 @@ def make_camera_and_light(scene):
     bg.inputs["Strength"].default_value = 1.0
 
 
-def setup_render(scene, out_dir, frames):
+def setup_render(scene, out_dir, frames, still):
+    width, height, samples = still or (RESOLUTION_X, RESOLUTION_Y, SAMPLES)
     scene.render.engine = 'CYCLES'
     scene.cycles.device = 'CPU'
-    scene.cycles.samples = SAMPLES
+    scene.cycles.samples = samples
     scene.cycles.use_denoising = False
     scene.cycles.use_adaptive_sampling = False
-    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION_X, RESOLUTION_Y
+    scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = 'PNG'
     scene.render.filepath = os.path.join(out_dir, "plume_####")
-    scene.frame_start, scene.frame_end = 1, frames
+    scene.frame_start, scene.frame_end = (frames if still else 1), frames
 
 
 def main():
-    out_dir, frames = parse_args()
+    args = parse_args()
+    out_dir, frames = args.out_dir, args.frames
     os.makedirs(out_dir, exist_ok=True)
     if addon_utils.enable("plume", default_set=True) is None:
         sys.exit("the plume add-on is not installed (see README)")
@@ -130,9 +145,9 @@ def main():
     scene = bpy.context.scene
     make_floor()
     make_source(frames)
-    dom = make_domain(frames)
+    dom = make_domain(frames, args.resolution)
     make_camera_and_light(scene)
-    setup_render(scene, out_dir, frames)
+    setup_render(scene, out_dir, frames, args.still)
     bpy.context.preferences.filepaths.save_version = 0  # no demo_plume.blend1 next to it
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(out_dir, "demo_plume.blend"))
 
@@ -146,9 +161,11 @@ def main():
     t0 = time.perf_counter()
     bpy.ops.render.render(animation=True)
     render_s = time.perf_counter() - t0
-    print(f"Plume demo: {frames} frames of a {RESOLUTION}^3 plume; bake {bake_s:.1f} s "
+    rendered = scene.frame_end - scene.frame_start + 1
+    print(f"Plume demo: {frames} frames of a {args.resolution}^3 plume; bake {bake_s:.1f} s "
           f"({bake_s / frames:.2f} s/frame), render {render_s:.1f} s "
-          f"({render_s / frames:.2f} s/frame, {RESOLUTION_X}x{RESOLUTION_Y}, {SAMPLES} samples) "
+          f"({render_s / rendered:.2f} s/frame, {scene.render.resolution_x}x"
+          f"{scene.render.resolution_y}, {scene.cycles.samples} samples) "
           f"-> {os.path.join(out_dir, 'plume_####.png')}", flush=True)
 
 
