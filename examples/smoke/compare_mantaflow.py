@@ -216,19 +216,28 @@ def check_vdb_frames(kind, paths, native):
     return peak
 
 
-def density_centroid_z(path, native, res):
+def density_centroid_z(path, native, res, box_min_z=0):
     """Height above the floor (m) of the density centroid of a frame's VDB. Both caches index the
     domain's cells from its minimum corner (Mantaflow in its own index space, Plume with its
     world transform); the height of cell k's centre is (k + 0.5) Δx with Δx = 2 m / RES. An
-    adaptive Mantaflow domain writes its box's grid: its VDB's index minimum is the box's."""
+    adaptive Mantaflow domain indexes the cells of its box: `box_min_z` is the box's first
+    cell (res_min of its config file)."""
     grid = native.read_vdb_grid(path, "density")
     values = grid["values"]
     total = float(values.sum(dtype="float64"))
     if not total > 0.0:
         raise CompareError(f"{path}: no density to take a centroid of")
     layers = values.sum(axis=(0, 1), dtype="float64")
-    index = float((layers * np.arange(len(layers))).sum()) / total + grid["min"][2]
+    index = float((layers * np.arange(len(layers))).sum()) / total + grid["min"][2] + box_min_z
     return (index + 0.5) * DOMAIN_SIZE / res
+
+
+def manta_centroid_z(cache_dir, frame, native, res):
+    """density_centroid_z() of a Mantaflow frame, its adaptive box read from its config."""
+    from plume import mantaflow_cache
+    config = mantaflow_cache.read_config(
+        os.path.join(cache_dir, "config", f"config_{frame:04d}.uni"))
+    return density_centroid_z(manta_frame(cache_dir, frame), native, res, config.res_min[2])
 
 
 # --- Mantaflow ----------------------------------------------------------------------------------
@@ -456,7 +465,7 @@ def run(mode, res, frames, work):
     manta_peak = peak_rss_since_reset() if rss0 is not None else None
     manta_rss0 = rss0
     manta_density, _ = check_mantaflow(manta_dir, res, frames, _native, mode)
-    manta_z = density_centroid_z(manta_frame(manta_dir, centroid_frame), _native, res)
+    manta_z = manta_centroid_z(manta_dir, centroid_frame, _native, res)
     manta_cache = folder_bytes(manta_dir)
     manta_vdb = folder_bytes(os.path.join(manta_dir, "data"), r"fluid_data_\d+\.vdb")
     remove_mantaflow(manta_dom, sphere)
