@@ -25,7 +25,7 @@ void DensityParams::validate() const {
     throw std::invalid_argument("cutoff must be in (0, 20] falloff lengths (got " + std::to_string(cutoff) + ")");
 }
 
-double ProfileDensity::distance2ToSegment(int segment, glm::dvec2 p, glm::dvec2* closest) const {
+inline double ProfileDensity::distance2ToSegment(int segment, glm::dvec2 p, glm::dvec2* closest) const {
   const glm::dvec2 a = mSegA[std::size_t(segment)];
   const glm::dvec2 ab = mSegAb[std::size_t(segment)];
   const double len2 = mSegLen2[std::size_t(segment)];

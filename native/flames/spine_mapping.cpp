@@ -112,7 +112,7 @@ SpineFrame::SpineFrame(const Flame& flame, int perSegment) : mLine(spinePolyline
   }
 }
 
-int SpineFrame::locate(double arc, double* f) const {
+inline int SpineFrame::locate(double arc, double* f) const {
   // The last point k <= m - 2 with mArc[k] <= arc (0 if none): the bucket's start, then a step
   // or two either way (rounding at a bucket edge, several points in one bucket).
   const std::size_t m = mArc.size();
@@ -125,7 +125,7 @@ int SpineFrame::locate(double arc, double* f) const {
   return int(k);
 }
 
-void SpineFrame::frameAtArc(double arc, std::size_t k, double f, Point* p) const {
+inline void SpineFrame::frameAtArc(double arc, std::size_t k, double f, Point* p) const {
   p->t = glm::normalize(mT[k] + f * mDt[k]);
   const glm::dvec3 nn = mN[k] + f * mDn[k];
   p->n = glm::normalize(nn - glm::dot(nn, p->t) * p->t);
