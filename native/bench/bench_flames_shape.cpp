@@ -7,10 +7,15 @@
 // (counter proc_cpu_ms, all threads). *Shape reuses the frame's arrays as a bake's frame loop does
 // (one untimed warm-up frame first); *ShapeCold starts each frame from empty arrays (first-touch
 // allocation included). On a shared machine take the minimum of repetitions:
+// BM_TorchFrame is the torch's whole per-frame budget in one loop: one structure step of the torch
+// of plume_bench_flames (FlameSystem, after 48 warm-up frames) plus the shape of the 5 flames
+// above, both limited to the argument's thread count (1: one core).
 // Run: build/native/plume_bench_flames_shape --benchmark_repetitions=5
+#include "core/parallel.h"
 #include "core/rng.h"
 #include "flames/flame_raster.h"
 #include "flames/flame_shape.h"
+#include "tests/flames_scenes.h"
 
 #include <benchmark/benchmark.h>
 
@@ -127,6 +132,28 @@ void runRaster(benchmark::State& state, const std::vector<Flame>& flames, const 
   state.counters["voxels"] = double(voxels);
 }
 
+/// Structure step + shape per frame with `threads` threads (ThreadLimit covers the step; the
+/// shaper applies its own params.threads).
+void BM_TorchFrame(benchmark::State& state) {
+  const int threads = int(state.range(0));
+  ThreadLimit limit(threads);
+  FlameSystem system = testing::torchFlames(1, 16);
+  for (int i = 0; i < 48; ++i) system.step(1.0 / 24.0);
+  const std::vector<Flame> flames = torchFlames();
+  const FlameShaper shaper({FlameProfile::library(ProfileShape::Torch)}, torchParams(threads));
+  const FlameCamera camera = benchCamera();
+  FlameShapeFrame frame;
+  double t = 0.0;
+  shaper.shape(flames, t, camera, frame);
+  for (auto _ : state) {
+    system.step(1.0 / 24.0);
+    shaper.shape(flames, t, camera, frame);
+    benchmark::DoNotOptimize(frame.particles.positions.data());
+    t += 1.0 / 24.0;
+  }
+  state.counters["particles"] = double(frame.particles.size());
+}
+
 void BM_TorchShape(benchmark::State& state) {
   runShape(state, torchFlames(), torchParams(int(state.range(0))), ProfileShape::Torch, false);
 }
@@ -143,6 +170,7 @@ void BM_DragonRaster(benchmark::State& state) {
   runRaster(state, dragonFlames(), dragonParams(int(state.range(0))), ProfileShape::Campfire, 0.02f);
 }
 
+BENCHMARK(BM_TorchFrame)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TorchShape)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DragonShape)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_DragonShapeCold)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);

@@ -69,23 +69,29 @@ glm::dvec3 FlowNoise::noise(const glm::dvec3& q, double phi) const {
   const std::uint64_t hx[2] = {std::uint64_t(ix) * 0x9E3779B97F4A7C15ull, std::uint64_t(ix + 1) * 0x9E3779B97F4A7C15ull};
   const std::uint64_t hy[2] = {std::uint64_t(iy) * 0xC2B2AE3D27D4EB4Full, std::uint64_t(iy + 1) * 0xC2B2AE3D27D4EB4Full};
   const std::uint64_t hz[2] = {std::uint64_t(iz) * 0x165667B19E3779F9ull, std::uint64_t(iz + 1) * 0x165667B19E3779F9ull};
+  // Per axis and side, the offsets d and the weights (the same float values the corners form).
+  const float dx[2] = {f.x - 0.f, f.x - 1.f}, dy[2] = {f.y - 0.f, f.y - 1.f}, dz[2] = {f.z - 0.f, f.z - 1.f};
+  const float wx[2] = {1.f - w.x, w.x}, wy[2] = {1.f - w.y, w.y}, wz[2] = {1.f - w.z, w.z};
+  const std::uint64_t sx[2] = {mSeed ^ hx[0], mSeed ^ hx[1]};
   glm::vec3 sum(0.f);
-  for (int corner = 0; corner < 8; ++corner) {
-    const int a = corner & 1, b = (corner >> 1) & 1, e = corner >> 2;
-    const std::uint64_t h = mixLattice(mSeed ^ hx[a] ^ hy[b] ^ hz[e]);
-    const glm::vec3 d(f.x - float(a), f.y - float(b), f.z - float(e));
+  auto corner = [&](int a, int b, int e) {
+    const std::uint64_t h = mixLattice(sx[a] ^ hy[b] ^ hz[e]);
     // Rotation about the profile axis by ±φ (bit 12 picks the sense): (gx, gy) · (dx, dy) with
     // g turned by ±φ is g · (d turned by ∓φ), so d turns once for the three components.
-    const float sn = s * (1.f - 2.f * float((h >> 12) & 1));  // branch-free: the bit is random
-    const float rx = c * d.x + sn * d.y, ry = c * d.y - sn * d.x;
-    glm::vec3 value;
-    for (int comp = 0; comp < 3; ++comp) {
-      const float* g = kGradients[(h >> (4 * comp)) & 15];
-      value[comp] = g[0] * rx + g[1] * ry + g[2] * d.z;
-    }
-    const float weight = (a ? w.x : 1.f - w.x) * (b ? w.y : 1.f - w.y) * (e ? w.z : 1.f - w.z);
+    // s · (1 − 2·bit) is ±s exactly.
+    const float sn = (h >> 12) & 1 ? -s : s;
+    const float rx = c * dx[a] + sn * dy[b], ry = c * dy[b] - sn * dx[a];
+    const float* g0 = kGradients[h & 15];
+    const float* g1 = kGradients[(h >> 4) & 15];
+    const float* g2 = kGradients[(h >> 8) & 15];
+    const glm::vec3 value(g0[0] * rx + g0[1] * ry + g0[2] * dz[e], g1[0] * rx + g1[1] * ry + g1[2] * dz[e],
+                          g2[0] * rx + g2[1] * ry + g2[2] * dz[e]);
+    const float weight = wx[a] * wy[b] * wz[e];
     sum += weight * value;
-  }
+  };
+  // Corners in the order corner = a + 2b + 4e (the sum's order).
+  corner(0, 0, 0), corner(1, 0, 0), corner(0, 1, 0), corner(1, 1, 0);
+  corner(0, 0, 1), corner(1, 0, 1), corner(0, 1, 1), corner(1, 1, 1);
   return glm::dvec3(sum);
 }
 

@@ -25,11 +25,10 @@ void DensityParams::validate() const {
     throw std::invalid_argument("cutoff must be in (0, 20] falloff lengths (got " + std::to_string(cutoff) + ")");
 }
 
-double ProfileDensity::distance2ToSegment(int segment, glm::dvec2 p, glm::dvec2* closest) const {
-  const glm::dvec2 a = mProfile.meridian()[std::size_t(segment)];
-  const glm::dvec2 b = mProfile.meridian()[std::size_t(segment) + 1];
-  const glm::dvec2 ab = b - a;
-  const double len2 = glm::dot(ab, ab);
+inline double ProfileDensity::distance2ToSegment(int segment, glm::dvec2 p, glm::dvec2* closest) const {
+  const glm::dvec2 a = mSegA[std::size_t(segment)];
+  const glm::dvec2 ab = mSegAb[std::size_t(segment)];
+  const double len2 = mSegLen2[std::size_t(segment)];
   const double t = len2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
   *closest = a + t * ab;
   const glm::dvec2 d = p - *closest;
@@ -53,6 +52,13 @@ ProfileDensity::ProfileDensity(const FlameProfile& profile, const DensityParams&
   mZMax = mZMin + mNz * mCell;
   const int segments = int(profile.meridian().size()) - 1;
   const int cells = mNr * mNz;
+  for (int j = 0; j < segments; ++j) {
+    const glm::dvec2 a = profile.meridian()[std::size_t(j)], b = profile.meridian()[std::size_t(j) + 1];
+    mSegA.push_back(a);
+    mSegAb.push_back(b - a);
+    mSegLen2.push_back(glm::dot(b - a, b - a));
+  }
+  for (int c = 0; c < cells; ++c) mCellOrigin.emplace_back((c % mNr) * mCell, mZMin + (c / mNr) * mCell);
 
   // Candidates: segment j can be closest to a point of a cell (centre c, half-diagonal hd) only
   // if dist(c, j) - hd <= min_k dist(c, k) + hd (the nearest distance in the cell is at most
@@ -164,7 +170,7 @@ ProfileSample ProfileDensity::sample(double u, Rng& rng) const {
   while (k > 0 && mCumulative[std::size_t(k) - 1] > u) --k;
   while (k < size && mCumulative[std::size_t(k)] <= u) ++k;
   const int c = mOrder[std::size_t(std::min(k, size - 1))];
-  const double r0 = (c % mNr) * mCell, z0 = mZMin + (c / mNr) * mCell;
+  const double r0 = mCellOrigin[std::size_t(c)].x, z0 = mCellOrigin[std::size_t(c)].y;
   const double bound = mCellMaxDensity[std::size_t(c)], l2 = mParams.falloff * mParams.falloff;
   ProfileSample s;
   // Rejection inside the cell: uniform in volume (ρ drawn ∝ ρ), accepted with d / bound. A cell

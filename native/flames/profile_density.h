@@ -88,6 +88,9 @@ class ProfileDensity {
   double mShell = 0.0;  ///< cutoff · ℓ
   double mRhoMax = 0.0, mZMin = 0.0, mZMax = 0.0, mCell = 0.0;
   int mNr = 0, mNz = 0;
+  std::vector<glm::dvec2> mSegA, mSegAb;  ///< per meridian segment: its start a and b − a
+  std::vector<double> mSegLen2;           ///< per meridian segment: |b − a|²
+  std::vector<glm::dvec2> mCellOrigin;    ///< per cell: its (ρ, z) corner
   std::vector<int> mCandidateStart;   ///< per cell, into mCandidates (size cells + 1)
   std::vector<int> mCandidates;       ///< segment indices
   std::vector<int> mOrder;            ///< cells by increasing mean d: the strata's order

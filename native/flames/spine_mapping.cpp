@@ -84,6 +84,13 @@ SpineFrame::SpineFrame(const Flame& flame, int perSegment) : mLine(spinePolyline
   }
   mLower = mUpper = mLine.x[0];
   for (const glm::dvec3& x : mLine.x) mLower = glm::min(mLower, x), mUpper = glm::max(mUpper, x);
+  mDx.resize(m - 1), mDt.resize(m - 1), mDn.resize(m - 1), mLen2.resize(m - 1);
+  for (std::size_t k = 0; k + 1 < m; ++k) {
+    mDx[k] = mLine.x[k + 1] - mLine.x[k];
+    mDt[k] = mT[k + 1] - mT[k];
+    mDn[k] = mN[k + 1] - mN[k];
+    mLen2[k] = glm::dot(mDx[k], mDx[k]);
+  }
   // Arc-length buckets: bucket b starts at arc b / scale; it holds the last point at or below.
   const int buckets = kBucketsPerSegment * int(m - 1);
   mBucketScale = length() > 0.0 ? buckets / length() : 0.0;
@@ -105,7 +112,7 @@ SpineFrame::SpineFrame(const Flame& flame, int perSegment) : mLine(spinePolyline
   }
 }
 
-int SpineFrame::locate(double arc, double* f) const {
+inline int SpineFrame::locate(double arc, double* f) const {
   // The last point k <= m - 2 with mArc[k] <= arc (0 if none): the bucket's start, then a step
   // or two either way (rounding at a bucket edge, several points in one bucket).
   const std::size_t m = mArc.size();
@@ -118,22 +125,26 @@ int SpineFrame::locate(double arc, double* f) const {
   return int(k);
 }
 
+inline void SpineFrame::frameAtArc(double arc, std::size_t k, double f, Point* p) const {
+  p->t = glm::normalize(mT[k] + f * mDt[k]);
+  const glm::dvec3 nn = mN[k] + f * mDn[k];
+  p->n = glm::normalize(nn - glm::dot(nn, p->t) * p->t);
+  p->b = glm::cross(p->t, p->n);
+  if (arc < 0.0) {
+    p->c = mLine.x.front() + arc * mT.front();
+  } else if (arc > length()) {
+    p->c = mLine.x.back() + (arc - length()) * mT.back();
+  } else {
+    p->c = mLine.x[k] + f * mDx[k];
+  }
+}
+
 SpineFrame::Point SpineFrame::at(double s) const {
   const double arc = s * length();
   double f;
   const std::size_t k = std::size_t(locate(arc, &f));
   Point p;
-  p.t = glm::normalize(mT[k] + f * (mT[k + 1] - mT[k]));
-  const glm::dvec3 nn = mN[k] + f * (mN[k + 1] - mN[k]);
-  p.n = glm::normalize(nn - glm::dot(nn, p.t) * p.t);
-  p.b = glm::cross(p.t, p.n);
-  if (arc < 0.0) {
-    p.c = mLine.x.front() + arc * mT.front();
-  } else if (arc > length()) {
-    p.c = mLine.x.back() + (arc - length()) * mT.back();
-  } else {
-    p.c = mLine.x[k] + f * (mLine.x[k + 1] - mLine.x[k]);
-  }
+  frameAtArc(arc, k, f, &p);
   // locate() clamps f to [0, 1], so velocity and age stop at the ends.
   p.v = mLine.v[k] + f * (mLine.v[k + 1] - mLine.v[k]);
   p.age = mLine.age[k] + f * (mLine.age[k + 1] - mLine.age[k]);
@@ -153,7 +164,11 @@ void SpineFrame::frameAt(double s, glm::dvec3* c, glm::dvec3* t, glm::dvec3* n, 
 }
 
 glm::dvec3 SpineFrame::map(const glm::dvec3& p, double aspect, double radius) const {
-  const Point q = at(p.z / aspect);
+  const double arc = p.z / aspect * length();
+  double f;
+  const std::size_t k = std::size_t(locate(arc, &f));
+  Point q;
+  frameAtArc(arc, k, f, &q);
   return q.c + radius * (p.x * q.n + p.y * q.b);
 }
 
@@ -186,8 +201,8 @@ double SpineFrame::closest(const glm::dvec3& x, double* distance, double within)
     const glm::dvec3 toCentre = x - glm::dvec3(sphere);
     if (glm::dot(toCentre, toCentre) > (sphere.w + reach) * (sphere.w + reach)) continue;
     for (std::size_t k = g * kGroup; k < std::min(segments, (g + 1) * kGroup); ++k) {
-      const glm::dvec3 a = mLine.x[k], ab = mLine.x[k + 1] - a, ax = x - a;
-      const double len2 = glm::dot(ab, ab);
+      const glm::dvec3 &a = mLine.x[k], &ab = mDx[k], ax = x - a;
+      const double len2 = mLen2[k];
       const double t = len2 > 0.0 ? std::clamp(glm::dot(ax, ab) / len2, 0.0, 1.0) : 0.0;
       const glm::dvec3 d = ax - t * ab;
       const double d2 = glm::dot(d, d);

@@ -67,7 +67,13 @@ class SpineFrame {
 
  private:
   int locate(double arc, double* f) const;
+  /// at()'s curve and frame at arc length `arc` (k, f from locate()), without velocity and age.
+  void frameAtArc(double arc, std::size_t k, double f, Point* p) const;
   SpinePolyline mLine;
+  /// Per polyline segment k: x[k+1] − x[k], its squared length, T[k+1] − T[k] and N[k+1] − N[k]
+  /// (the very differences at() and closest() would form per call, computed once).
+  std::vector<glm::dvec3> mDx, mDt, mDn;
+  std::vector<double> mLen2;
   std::vector<double> mArc;          ///< cumulative arc length at each polyline point
   std::vector<int> mBucket;          ///< per arc-length bucket, the last point at or below its start
   double mBucketScale = 0.0;         ///< buckets per metre of arc
