@@ -1,5 +1,8 @@
 #include "solver/block_mask.h"
 
+#include <algorithm>
+#include <cstring>
+
 namespace plume {
 
 void BlockMask::build(const ScalarGrid& field, float background) {
@@ -48,6 +51,56 @@ void BlockMask::merge(const BlockMask& other) {
 void BlockMask::setAll(glm::ivec3 size) {
   mBlocks = (size + kBlock - 1) / kBlock;
   mActive.assign(std::size_t(mBlocks.x) * mBlocks.y * mBlocks.z, 1);
+}
+
+void CleanStencils::build(const ScalarGrid& field, float background) {
+  const glm::ivec3 n = field.size();
+  mDirty.resize(field.count());
+  mScratch.resize(field.count());
+  std::uint32_t bg;
+  std::memcpy(&bg, &background, sizeof bg);
+  const auto* bits = reinterpret_cast<const std::uint32_t*>(field.data());
+  const std::size_t sy = std::size_t(n.x), sz = std::size_t(n.x) * std::size_t(n.y);
+  // Separable: along x (cells i-1 .. i+2 of a row), then y, then z; each pass reads one buffer
+  // and writes the other, so that the z-slices run in parallel.
+  parallelFor(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j) {
+      const std::uint32_t* row = bits + std::size_t(k) * sz + std::size_t(j) * sy;
+      std::uint8_t* out = mScratch.data() + std::size_t(k) * sz + std::size_t(j) * sy;
+      auto off = [&](int i) -> std::uint8_t { return i < n.x && row[i] != bg ? 1 : 0; };
+      std::uint8_t before = 0, at = off(0), next = off(1), last = off(2);
+      for (int i = 0; i < n.x; ++i) {
+        out[i] = before | at | next | last;
+        before = at;
+        at = next;
+        next = last;
+        last = off(i + 3);
+      }
+    }
+  });
+  parallelFor(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j) {
+      std::uint8_t* out = mDirty.data() + std::size_t(k) * sz + std::size_t(j) * sy;
+      const int b0 = std::max(j - 1, 0), b1 = std::min(j + 2, n.y - 1);
+      const std::uint8_t* first = mScratch.data() + std::size_t(k) * sz + std::size_t(b0) * sy;
+      std::copy(first, first + sy, out);
+      for (int b = b0 + 1; b <= b1; ++b) {
+        const std::uint8_t* in = mScratch.data() + std::size_t(k) * sz + std::size_t(b) * sy;
+        for (std::size_t i = 0; i < sy; ++i) out[i] |= in[i];
+      }
+    }
+  });
+  parallelFor(0, n.z, [&](int k) {
+    std::uint8_t* out = mScratch.data() + std::size_t(k) * sz;
+    const int c0 = std::max(k - 1, 0), c1 = std::min(k + 2, n.z - 1);
+    const std::uint8_t* first = mDirty.data() + std::size_t(c0) * sz;
+    std::copy(first, first + sz, out);
+    for (int c = c0 + 1; c <= c1; ++c) {
+      const std::uint8_t* in = mDirty.data() + std::size_t(c) * sz;
+      for (std::size_t i = 0; i < sz; ++i) out[i] |= in[i];
+    }
+  });
+  std::swap(mDirty, mScratch);
 }
 
 float BlockMask::fill() const {

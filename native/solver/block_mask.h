@@ -37,6 +37,22 @@ class BlockMask {
   std::vector<std::uint8_t> mActive, mRaw;
 };
 
+/// Cells whose monotonic cubic stencil (i-1 .. i+2 on each axis, clamped into the grid) holds
+/// the field's background value only, bit for bit: the cubic (and trilinear) sample of a point
+/// in such a cell is that value exactly, so the cubic advection passes skip the sampling of a
+/// run whose points all fall in such cells. In a rising plume most cells are such cells, even in
+/// the active blocks (dilated by 16 cells around the smoke: 80–93% of their cells at 64³).
+class CleanStencils {
+ public:
+  /// Marks the cells of `field`; allocates on the first call for a grid of this size only.
+  void build(const ScalarGrid& field, float background);
+  /// Per cell (linear index): 0 when its stencil is all background.
+  const std::uint8_t* dirty() const { return mDirty.data(); }
+
+ private:
+  std::vector<std::uint8_t> mDirty, mScratch;
+};
+
 /// Calls run(setup(j, k), i0, i1, j, k) for the x-runs [i0, i1) of each row of a grid of n
 /// samples that lie in active blocks of `mask` (nullptr: all), and idle(i0, i1, j, k) for the
 /// others; setup(j, k) runs once per row, for what the runs of a row share. Runs are at most

@@ -243,6 +243,13 @@ void SmokeSolver::addForces(float dt) {
 void SmokeSolver::advect(float dt) {
   const Advection scheme = mParams.advection;
   const Interpolation interp = mParams.interpolation;
+  // With BFECC the velocity is carried with trilinear samples, the scalars with `interp`: the
+  // error correction makes trilinear BFECC second order, and on a smooth field, which the
+  // velocity is next to the smoke's edges, it keeps nearly what cubic BFECC keeps (a Gaussian
+  // carried around a rotation: advection_velocity_test.cpp). Three quarters of the cubic samples
+  // of a step were the velocity's (unmasked, three components); examples/smoke/README.md
+  // "Performance".
+  const Interpolation velocityInterp = scheme == Advection::Bfecc ? Interpolation::Linear : interp;
   const float h = mParams.cellSize;
   // Scalars first, all carried by the same (pre-advection) velocity along one shared trace.
   struct Field {
@@ -315,7 +322,7 @@ void SmokeSolver::advect(float dt) {
     mAdvector.trace(mVelocity, comp.size(), kOffsets[a], dt, h, scheme, nullptr, mParams.trace,
                     open);
     const float ambient = windy && !windField ? mParams.wind[a] : 0.f;
-    mAdvector.advect(comp, mVelocityTmp.component(a), interp, nullptr, ambient,
+    mAdvector.advect(comp, mVelocityTmp.component(a), velocityInterp, nullptr, ambient,
                      windField ? &mWindFaces.component(a) : nullptr);
   }
   std::swap(mVelocity, mVelocityTmp);
