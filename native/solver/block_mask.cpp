@@ -5,7 +5,7 @@
 
 namespace plume {
 
-void BlockMask::build(const ScalarGrid& field, float background) {
+void BlockMask::build(const ScalarGrid& field, float background, int dilation) {
   const glm::ivec3 n = field.size();
   mBlocks = (n + kBlock - 1) / kBlock;
   const std::size_t count = std::size_t(mBlocks.x) * mBlocks.y * mBlocks.z;
@@ -27,9 +27,9 @@ void BlockMask::build(const ScalarGrid& field, float background) {
     for (int bj = 0; bj < mBlocks.y; ++bj)
       for (int bi = 0; bi < mBlocks.x; ++bi) {
         std::uint8_t any = 0;
-        for (int dk = -kDilation; dk <= kDilation && !any; ++dk)
-          for (int dj = -kDilation; dj <= kDilation && !any; ++dj)
-            for (int di = -kDilation; di <= kDilation && !any; ++di) {
+        for (int dk = -dilation; dk <= dilation && !any; ++dk)
+          for (int dj = -dilation; dj <= dilation && !any; ++dj)
+            for (int di = -dilation; di <= dilation && !any; ++di) {
               const int a = bi + di, b = bj + dj, c = bk + dk;
               if (a < 0 || b < 0 || c < 0 || a >= mBlocks.x || b >= mBlocks.y || c >= mBlocks.z)
                 continue;
@@ -63,19 +63,18 @@ void CleanStencils::build(const ScalarGrid& field, float background) {
   const std::size_t sy = std::size_t(n.x), sz = std::size_t(n.x) * std::size_t(n.y);
   // Separable: along x (cells i-1 .. i+2 of a row), then y, then z; each pass reads one buffer
   // and writes the other, so that the z-slices run in parallel.
+  // mDirty holds each cell's own test until the y pass overwrites it.
   parallelFor(0, n.z, [&](int k) {
+    const std::size_t s = std::size_t(k) * sz;
+    for (std::size_t c = 0; c < sz; ++c) mDirty[s + c] = bits[s + c] != bg ? 1 : 0;
     for (int j = 0; j < n.y; ++j) {
-      const std::uint32_t* row = bits + std::size_t(k) * sz + std::size_t(j) * sy;
-      std::uint8_t* out = mScratch.data() + std::size_t(k) * sz + std::size_t(j) * sy;
-      auto off = [&](int i) -> std::uint8_t { return i < n.x && row[i] != bg ? 1 : 0; };
-      std::uint8_t before = 0, at = off(0), next = off(1), last = off(2);
-      for (int i = 0; i < n.x; ++i) {
-        out[i] = before | at | next | last;
-        before = at;
-        at = next;
-        next = last;
-        last = off(i + 3);
-      }
+      const std::uint8_t* in = mDirty.data() + s + std::size_t(j) * sy;
+      std::uint8_t* out = mScratch.data() + s + std::size_t(j) * sy;
+      auto at = [&](int i) -> std::uint8_t { return i >= 0 && i < n.x ? in[i] : 0; };
+      const int inner = n.x - 2;  // cells i with i-1 .. i+2 inside the row: 1 .. n.x-3
+      for (int i = 1; i < inner; ++i) out[i] = in[i - 1] | in[i] | in[i + 1] | in[i + 2];
+      for (int i : {0, inner, inner + 1})
+        if (i >= 0 && i < n.x) out[i] = at(i - 1) | at(i) | at(i + 1) | at(i + 2);
     }
   });
   parallelFor(0, n.z, [&](int k) {

@@ -13,14 +13,15 @@
 namespace plume {
 
 /// Blocks of 8³ samples that may hold something other than a field's background value after
-/// advection: blocks holding such a value, dilated by two blocks (16 cells).
+/// advection: blocks holding such a value, dilated by two blocks (16 cells) or as many as the
+/// step's reach asks for.
 class BlockMask {
  public:
   static constexpr int kBlock = 8;
   static constexpr int kDilation = 2;  ///< blocks; covers 2 × (trace + stencil) of BFECC
 
-  /// Marks the blocks of `field` with a value != background, then dilates.
-  void build(const ScalarGrid& field, float background);
+  /// Marks the blocks of `field` with a value != background, then dilates by `dilation` blocks.
+  void build(const ScalarGrid& field, float background, int dilation = kDilation);
   /// Union with another mask of the same grid.
   void merge(const BlockMask& other);
   /// Marks everything active.
