@@ -146,7 +146,7 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
   const bool skipClean = interpolation == Interpolation::MonotonicCubic;
   auto cleanOf = [&](const ScalarGrid* const* grids) -> const CleanStencils* {
     if (!skipClean) return nullptr;
-    for (std::size_t f = 0; f < count; ++f) mClean[f].build(*grids[f], background[f]);
+    for (std::size_t f = 0; f < count; ++f) mClean[f].build(*grids[f], background[f], mask);
     return mClean;
   };
   if (mScheme == Advection::SemiLagrangian) {

@@ -45,13 +45,15 @@ class BlockMask {
 /// the active blocks (dilated by 16 cells around the smoke: 80–93% of their cells at 64³).
 class CleanStencils {
  public:
-  /// Marks the cells of `field`; allocates on the first call for a grid of this size only.
-  void build(const ScalarGrid& field, float background);
+  /// Marks the cells of `field`, which must be its background outside the active blocks of
+  /// `mask` (nullptr: no mask); allocates on the first call for a grid of this size only.
+  void build(const ScalarGrid& field, float background, const BlockMask* mask);
   /// Per cell (linear index): 0 when its stencil is all background.
   const std::uint8_t* dirty() const { return mDirty.data(); }
 
  private:
   std::vector<std::uint8_t> mDirty, mScratch;
+  std::vector<std::uint8_t> mNear;  ///< per block: active or next to an active block
 };
 
 /// Calls run(setup(j, k), i0, i1, j, k) for the x-runs [i0, i1) of each row of a grid of n
