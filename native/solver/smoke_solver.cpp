@@ -246,8 +246,8 @@ void SmokeSolver::advect(float dt) {
   // With BFECC the velocity is carried with trilinear samples, the scalars with `interp`: the
   // error correction makes trilinear BFECC second order, and on a smooth field, which the
   // velocity is next to the smoke's edges, it keeps nearly what cubic BFECC keeps (a Gaussian
-  // carried around a rotation: advection_velocity_test.cpp). Three quarters of the cubic samples
-  // of a step were the velocity's (unmasked, three components); examples/smoke/README.md
+  // carried around a rotation: advection_velocity_test.cpp). The velocity's were 9 of the 15
+  // cubic passes of a step, a quarter of its time at 64³; examples/smoke/README.md
   // "Performance".
   const Interpolation velocityInterp = scheme == Advection::Bfecc ? Interpolation::Linear : interp;
   const float h = mParams.cellSize;
