@@ -147,9 +147,26 @@ void BM_Step(benchmark::State& state) { stepBenchmark(state, kBfecc); }
 void BM_StepMacCormack(benchmark::State& state) { stepBenchmark(state, kMacCormack); }
 /// The step with Mantaflow's settings (kComparable).
 void BM_StepComparable(benchmark::State& state) { stepBenchmark(state, kComparable); }
-BENCHMARK(BM_Step)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Step)->Arg(50)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_StepMacCormack)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_StepComparable)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+/// With Mantaflow's settings one step is one frame: at 256³ this row is the time per frame (VDB
+/// writing excluded); run it alone for its peak_rss_MB.
+BENCHMARK(BM_StepComparable)->Arg(50)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// A whole frame with Plume's defaults: as many steps as the CFL number 4 asks for
+/// (SmokeParams::useCfl), counted in substeps.
+void BM_FrameDefaults(benchmark::State& state) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false, kBfecc);
+  double substeps = 0.0;
+  for (auto _ : state) {
+    solver.advanceFrame();
+    substeps += solver.lastStats().substeps;
+  }
+  state.counters["substeps"] = substeps / double(state.iterations());
+  state.counters["peak_rss_MB"] = peakRssMb();
+  state.counters["rss_MB"] = rssMb();
+}
+BENCHMARK(BM_FrameDefaults)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// Times `stage` alone, each iteration from the state the previous stages of a step leave.
 template <typename Stage>

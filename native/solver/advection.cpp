@@ -19,15 +19,31 @@ inline void sampleRun(const ScalarGrid& src, const SamplePoints& traced, std::si
   else sampleMonotonicCubic(src, traced, first, count, out);
 }
 
+/// True when points first .. first+count-1 all fall in cells of `clean` with an all-background
+/// stencil.
+inline bool allClean(const CleanStencils& clean, const SamplePoints& traced, std::size_t first,
+                     int count) {
+  const std::uint32_t* index = traced.index() + first;
+  const std::uint8_t* dirty = clean.dirty();
+  std::uint8_t any = 0;
+  for (int m = 0; m < count; ++m) any |= dirty[index[m] & SamplePoints::kIndexMask];
+  return any == 0;
+}
+
 /// One semi-Lagrangian pass of `count` fields: dst[f](x) = src[f](trace(x)), then
 /// finish(f, c, n, values) applies the corrections and limiters of BFECC and MacCormack in
 /// place to the n values of a run starting at linear index c. The fields of a run are done one
 /// after the other while its split points are in L1. Full runs of trilinear samples go to
 /// fused(f, c, out), the same pass in one AVX2 kernel (linear_runs.h), where the CPU has it.
+///
+/// With `clean` (one CleanStencils of each src, built for this pass), a run whose points all
+/// fall in cells with an all-background stencil takes the background value without sampling:
+/// the value sampling gives there, bit for bit.
 template <typename Finish, typename Fused>
 void pass(const ScalarGrid* const* src, ScalarGrid* const* dst, const float* background,
           std::size_t count, const SamplePoints& traced, Interpolation interpolation,
-          const BlockMask* mask, const Finish& finish, const Fused& fused) {
+          const BlockMask* mask, const CleanStencils* clean, const Finish& finish,
+          const Fused& fused) {
   const ScalarGrid& first = *src[0];
   const bool useFused = interpolation == Interpolation::Linear && linearRunsAvailable();
   forEachRun(
@@ -41,7 +57,8 @@ void pass(const ScalarGrid* const* src, ScalarGrid* const* dst, const float* bac
             continue;
           }
           float values[kRun];
-          sampleRun(*src[f], traced, c, n, interpolation, values);
+          if (clean && allClean(clean[f], traced, c, n)) std::fill(values, values + n, background[f]);
+          else sampleRun(*src[f], traced, c, n, interpolation, values);
           finish(f, c, n, values);
           std::copy(values, values + n, dst[f]->data() + c);
         }
@@ -124,15 +141,23 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
   auto inflow = [&](ScalarGrid* const* grids) {
     blendInflow(grids, count, background, ambient, mBack, mask);
   };
+  // Cubic passes skip the runs whose stencils hold clean air only (most of a plume's domain, in
+  // the active blocks or without a mask); trilinear runs cost about what the test would.
+  const bool skipClean = interpolation == Interpolation::MonotonicCubic;
+  auto cleanOf = [&](const ScalarGrid* const* grids) -> const CleanStencils* {
+    if (!skipClean) return nullptr;
+    for (std::size_t f = 0; f < count; ++f) mClean[f].build(*grids[f], background[f], mask);
+    return mClean;
+  };
   if (mScheme == Advection::SemiLagrangian) {
-    pass(src, dst, background, count, mBack, interpolation, mask, kAsIs,
+    pass(src, dst, background, count, mBack, interpolation, mask, cleanOf(src), kAsIs,
          [&](std::size_t f, std::size_t c, float* out) { semiLagrangianRun(*src[f], mBack, c, out); });
     inflow(dst);
     return;
   }
   // φ̂ = A(φ): the semi-Lagrangian step along the back-traces.
   for (std::size_t f = 0; f < count; ++f) mForward[f].reshape(size);
-  pass(src, forward, background, count, mBack, interpolation, mask, kAsIs,
+  pass(src, forward, background, count, mBack, interpolation, mask, cleanOf(src), kAsIs,
        [&](std::size_t f, std::size_t c, float* out) { semiLagrangianRun(*src[f], mBack, c, out); });
   inflow(forward);
   // Where the air came in from outside, the result is φ̂ itself.
@@ -141,7 +166,7 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
     // Selle et al. 2008 eq. 7: φ = φ̂ + ½(φⁿ - φ̄) with φ̄ = A⁻¹(φ̂), fused with the reverse step,
     // then clamped to the range of φⁿ around the back-traced point (§4, first limiter).
     pass(
-        forward, dst, background, count, mFore, interpolation, mask,
+        forward, dst, background, count, mFore, interpolation, mask, cleanOf(forward),
         [&](std::size_t f, std::size_t c, int n, float* bar) {
           const ScalarGrid &phi = *src[f], &hat = *forward[f];
           for (int m = 0; m < n; ++m) bar[m] = hat[c + m] + 0.5f * (phi[c + m] - bar[m]);
@@ -156,7 +181,7 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
   // BFECC (Kim et al. 2005): φ̄ = A⁻¹(φ̂) and the corrected field φ + ½(φ - φ̄) in one pass...
   for (std::size_t f = 0; f < count; ++f) mBackward[f].reshape(size);
   pass(
-      forward, backward, background, count, mFore, interpolation, mask,
+      forward, backward, background, count, mFore, interpolation, mask, cleanOf(forward),
       [&](std::size_t f, std::size_t c, int n, float* bar) {
         const ScalarGrid& phi = *src[f];
         for (int m = 0; m < n; ++m) bar[m] = phi[c + m] + 0.5f * (phi[c + m] - bar[m]);
@@ -166,7 +191,7 @@ void Advector::advect(const Field* fields, std::size_t count, Interpolation inte
       });
   // ...then forward again from it, clamped to the range of the original φ (no new extrema).
   pass(
-      backward, dst, background, count, mBack, interpolation, mask,
+      backward, dst, background, count, mBack, interpolation, mask, cleanOf(backward),
       [&](std::size_t f, std::size_t c, int n, float* values) {
         clampToRange(*src[f], mBack, c, n, values);
       },

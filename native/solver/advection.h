@@ -66,6 +66,7 @@ class Advector {
  private:
   BackTracer mTracer;
   ScalarGrid mForward[kMaxFields], mBackward[kMaxFields];
+  CleanStencils mClean[kMaxFields];  ///< of the fields a cubic pass reads
   SamplePoints mBack, mFore;  ///< traced positions in the grid's index space, split
   Advection mScheme = Advection::SemiLagrangian;
 };

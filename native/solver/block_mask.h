@@ -13,14 +13,15 @@
 namespace plume {
 
 /// Blocks of 8³ samples that may hold something other than a field's background value after
-/// advection: blocks holding such a value, dilated by two blocks (16 cells).
+/// advection: blocks holding such a value, dilated by two blocks (16 cells) or as many as the
+/// step's reach asks for.
 class BlockMask {
  public:
   static constexpr int kBlock = 8;
   static constexpr int kDilation = 2;  ///< blocks; covers 2 × (trace + stencil) of BFECC
 
-  /// Marks the blocks of `field` with a value != background, then dilates.
-  void build(const ScalarGrid& field, float background);
+  /// Marks the blocks of `field` with a value != background, then dilates by `dilation` blocks.
+  void build(const ScalarGrid& field, float background, int dilation = kDilation);
   /// Union with another mask of the same grid.
   void merge(const BlockMask& other);
   /// Marks everything active.
@@ -35,6 +36,24 @@ class BlockMask {
  private:
   glm::ivec3 mBlocks{0};
   std::vector<std::uint8_t> mActive, mRaw;
+};
+
+/// Cells whose monotonic cubic stencil (i-1 .. i+2 on each axis, clamped into the grid) holds
+/// the field's background value only, bit for bit: the cubic (and trilinear) sample of a point
+/// in such a cell is that value exactly, so the cubic advection passes skip the sampling of a
+/// run whose points all fall in such cells. In a rising plume most cells are such cells, even in
+/// the active blocks (dilated by 16 cells around the smoke: 80–93% of their cells at 64³).
+class CleanStencils {
+ public:
+  /// Marks the cells of `field`, which must be its background outside the active blocks of
+  /// `mask` (nullptr: no mask); allocates on the first call for a grid of this size only.
+  void build(const ScalarGrid& field, float background, const BlockMask* mask);
+  /// Per cell (linear index): 0 when its stencil is all background.
+  const std::uint8_t* dirty() const { return mDirty.data(); }
+
+ private:
+  std::vector<std::uint8_t> mDirty, mScratch;
+  std::vector<std::uint8_t> mNear;  ///< per block: active or next to an active block
 };
 
 /// Calls run(setup(j, k), i0, i1, j, k) for the x-runs [i0, i1) of each row of a grid of n

@@ -243,6 +243,13 @@ void SmokeSolver::addForces(float dt) {
 void SmokeSolver::advect(float dt) {
   const Advection scheme = mParams.advection;
   const Interpolation interp = mParams.interpolation;
+  // With BFECC the velocity is carried with trilinear samples, the scalars with `interp`: the
+  // error correction makes trilinear BFECC second order, and on a smooth field, which the
+  // velocity is next to the smoke's edges, it keeps nearly what cubic BFECC keeps (a Gaussian
+  // carried around a rotation: advection_velocity_test.cpp). The velocity's were 9 of the 15
+  // cubic passes of a step, a quarter of its time at 64³; examples/smoke/README.md
+  // "Performance".
+  const Interpolation velocityInterp = scheme == Advection::Bfecc ? Interpolation::Linear : interp;
   const float h = mParams.cellSize;
   // Scalars first, all carried by the same (pre-advection) velocity along one shared trace.
   struct Field {
@@ -259,14 +266,16 @@ void SmokeSolver::advect(float dt) {
                            {&mSoot, 0.f, mParams.conserveMass}};
   const std::size_t fieldCount = mParams.combustion ? 4 : 2;  // fuel and soot only burn
   // Blocks far from any smoke stay clean air exactly, as long as nothing travels further than
-  // the mask's dilation in one step (BFECC reaches twice the trace plus two stencils).
-  const float reach = maxSpeed() * dt / h;
-  const float dilation = float(BlockMask::kBlock * BlockMask::kDilation);
+  // the mask's dilation in one step (BFECC reaches twice the trace plus two stencils): at least
+  // kDilation blocks, more for a long step (one step a frame) rather than no mask at all.
+  const float reach = 2.f * maxSpeed() * dt / h + 4.f;
+  constexpr int kMostBlocks = 6;  // beyond it the dilated mask is about the whole grid
+  const int blocks = std::max(BlockMask::kDilation, int(reach / float(BlockMask::kBlock)) + 1);
   const BlockMask* mask = nullptr;
-  if (2.f * reach + 4.f < dilation) {
-    mMask.build(*scalars[0].grid, scalars[0].background);
+  if (blocks <= kMostBlocks && reach < float(blocks * BlockMask::kBlock)) {
+    mMask.build(*scalars[0].grid, scalars[0].background, blocks);
     for (std::size_t f = 1; f < fieldCount; ++f) {
-      mMaskTmp.build(*scalars[f].grid, scalars[f].background);
+      mMaskTmp.build(*scalars[f].grid, scalars[f].background, blocks);
       mMask.merge(mMaskTmp);
     }
     mask = &mMask;
@@ -315,7 +324,7 @@ void SmokeSolver::advect(float dt) {
     mAdvector.trace(mVelocity, comp.size(), kOffsets[a], dt, h, scheme, nullptr, mParams.trace,
                     open);
     const float ambient = windy && !windField ? mParams.wind[a] : 0.f;
-    mAdvector.advect(comp, mVelocityTmp.component(a), interp, nullptr, ambient,
+    mAdvector.advect(comp, mVelocityTmp.component(a), velocityInterp, nullptr, ambient,
                      windField ? &mWindFaces.component(a) : nullptr);
   }
   std::swap(mVelocity, mVelocityTmp);
