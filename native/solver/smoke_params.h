@@ -43,6 +43,11 @@ struct SmokeParams {
   std::array<Boundary, 6> boundaries{Boundary::Open, Boundary::Open, Boundary::Open,
                                      Boundary::Open, Boundary::Closed, Boundary::Open};
 
+  // --- Adaptive domain (adaptive_domain.h; Mantaflow's Adaptive Domain) ---
+  bool adaptiveDomain = false;     ///< step only the box around the smoke (Mantaflow: use_adaptive_domain)
+  int adaptiveMargin = 6;          ///< cells of air around the smoke in the box (Mantaflow: adapt_margin)
+  float adaptiveThreshold = 0.005f;  ///< ρ, |T - T_amb|, F, S above which a cell holds smoke (Mantaflow: adapt_threshold)
+
   // --- Time ---
   float frameDt = 1.f / 24.f;  ///< seconds per frame (1/fps × time scale)
   int substeps = 1;            ///< minimum steps per frame
