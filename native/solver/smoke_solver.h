@@ -82,7 +82,8 @@ class SmokeSolver {
   /// Returns false when cancel() was called; the state is then mid-frame and must be discarded.
   /// `observer`, when given, is called around every step.
   bool advanceFrame(StepObserver* observer = nullptr);
-  /// One fractional step of length dt: the stages below, in order.
+  /// One fractional step of length dt: the stages below, in order, on the whole domain (the
+  /// adaptive domain applies in advanceFrame()).
   void step(float dt);
   /// Thread-safe: makes a running advanceFrame() return false after the current step.
   void cancel() { mCancel.store(true); }
