@@ -170,7 +170,8 @@ void AdaptiveDomain::resetOutside(SmokeSolver& full, const ActiveBox& box) const
                    windField ? &full.mWindFaces.component(a) : nullptr);
   }
   fillLeftBehind(full.temperature(), glm::ivec3(0), n, box.lo, box.size(), p.ambientTemperature);
-  for (ScalarGrid* g : {&full.density(), &full.fuel(), &full.soot(), &full.flame(), &full.pressure()})
+  for (ScalarGrid* g :
+       {&full.density(), &full.fuel(), &full.soot(), &full.flame(), &full.pressure()})
     fillLeftBehind(*g, glm::ivec3(0), n, box.lo, box.size(), 0.f);
 }
 

@@ -131,7 +131,8 @@ std::unique_ptr<SmokeSolver> wholeDomainRun(bool adaptive, int threads, int fram
   s.velocity = glm::vec3(0.1f, 0.f, 0.3f);
   // A source from floor to ceiling: the box is the whole domain.
   CellSet column;
-  for (int k = 0; k < res.z; ++k) column.cells.push_back(std::uint32_t(9 + res.x * (12 + res.y * k)));
+  for (int k = 0; k < res.z; ++k)
+    column.cells.push_back(std::uint32_t(9 + res.x * (12 + res.y * k)));
   solver->addSource(column, s);
   solver->addSource(ball(res, glm::vec3(0.f, 0.f, 4.f), 2.f), s);
   solver->addSource(ball(res, glm::vec3(20.f, 24.f, 4.f), 2.f), s);
