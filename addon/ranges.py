@@ -22,6 +22,8 @@ def _native_float_range(name):
 RANGES = {
     # a domain's grid bake (obj.plume.domain)
     "resolution": _native_range("resolution"),  # cells along the longest axis
+    "adaptive_margin": _native_range("adaptive_margin"),  # cells
+    "adaptive_threshold": _native_float_range("adaptive_threshold"),
     "emission_period": _native_range("emission_period"),
     #: 0 (keep every point source) or at least the 2 a surface needs
     "max_streaklines": (0, 1000000),

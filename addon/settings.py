@@ -36,6 +36,9 @@ class SolverSettings:
     cell_size: float = 1.0 / 32.0
     origin: Tuple[float, float, float] = (0.0, 0.0, 0.0)
     boundaries: Tuple[str, ...] = ("OPEN", "OPEN", "OPEN", "OPEN", "CLOSED", "OPEN")
+    adaptive_domain: bool = False
+    adaptive_margin: int = 6
+    adaptive_threshold: float = 0.005
     frame_dt: float = 1.0 / 24.0
     substeps: int = 1
     use_cfl: bool = True
@@ -251,6 +254,10 @@ class BakeSnapshot:
         solver = dataclasses.asdict(self.solver)
         for name in RESULT_NEUTRAL_FIELDS:
             solver.pop(name, None)
+        if not solver["adaptive_domain"]:
+            # Off, the adaptive settings change nothing: caches baked before they existed resume.
+            for name in ("adaptive_domain", "adaptive_margin", "adaptive_threshold"):
+                solver.pop(name)
         solver["resolution"] = list(solver["resolution"])
         solver["origin"] = list(solver["origin"])
         solver["boundaries"] = list(solver["boundaries"])

@@ -35,6 +35,20 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         name="Resolution", default=32, soft_min=8, soft_max=512,
         description="Cells along the longest axis of the domain (Δx = longest side / resolution); "
                     f"validated at bake time to {text('resolution')}")
+    adaptive_domain: BoolProperty(
+        name="Adaptive Domain", default=False,
+        description="Simulate only the box around the smoke, heat and fuel, grown and shrunk every "
+                    "step; outside it the air is at rest and at ambient temperature. The cache "
+                    "stays in place (Mantaflow: Adaptive Domain, use_adaptive_domain)")
+    adaptive_margin: IntProperty(
+        name="Margin", default=6, min=RANGES["adaptive_margin"][0], max=RANGES["adaptive_margin"][1],
+        description="Cells of air kept around the smoke in the adaptive box; more follows the "
+                    "air the plume sets moving more closely (Mantaflow: Margin, adapt_margin)")
+    adaptive_threshold: FloatProperty(
+        name="Threshold", default=0.005, min=RANGES["adaptive_threshold"][0],
+        max=RANGES["adaptive_threshold"][1], precision=4,
+        description="Density, heat |T - T_amb|, fuel or soot above which a cell counts as smoke "
+                    "for the adaptive box (Mantaflow: Threshold, adapt_threshold)")
     frame_start: IntProperty(name="Start", default=1, description="First frame of the bake")
     frame_end: IntProperty(name="End", default=50, description="Last frame of the bake")
     time_scale: FloatProperty(

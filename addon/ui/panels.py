@@ -72,6 +72,12 @@ class PHYSICS_PT_plume_settings(PlumeDomainPanel, bpy.types.Panel):
         sub.prop(d, "cfl")
         layout.prop(d, "seed")
         layout.prop(d, "threads")
+        col = layout.column(align=True)
+        col.prop(d, "adaptive_domain")
+        sub = col.column(align=True)
+        sub.active = d.adaptive_domain
+        sub.prop(d, "adaptive_margin")
+        sub.prop(d, "adaptive_threshold")
 
 
 class PHYSICS_PT_plume_forces(PlumeDomainPanel, bpy.types.Panel):

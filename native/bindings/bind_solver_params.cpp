@@ -86,6 +86,12 @@ void bindParams(py::module_& m) {
         std::copy(b.begin(), b.end(), p.boundaries.begin());
       },
       "Sides -x, +x, -y, +y, -z, +z: Boundary.OPEN (p = 0) or Boundary.CLOSED (wall).");
+  field(c, "adaptive_domain", &SmokeParams::adaptiveDomain,
+        "Step only the box around the smoke (Mantaflow's use_adaptive_domain); off by default.");
+  field(c, "adaptive_margin", &SmokeParams::adaptiveMargin,
+        "Cells of air kept around the smoke in the adaptive box (Mantaflow's adapt_margin).");
+  field(c, "adaptive_threshold", &SmokeParams::adaptiveThreshold,
+        "ρ, |T - T_amb|, F or S above which a cell counts as smoke (Mantaflow's adapt_threshold).");
   field(c, "frame_dt", &SmokeParams::frameDt, "Seconds per frame (1/fps × time scale).");
   field(c, "substeps", &SmokeParams::substeps, "Minimum steps per frame.");
   field(c, "use_cfl", &SmokeParams::useCfl, "Add steps so no cell moves more than `cfl` cells.");

@@ -62,6 +62,8 @@ const std::vector<SettingRange>& smokeSettingRanges() {
       {"cooling_rate", 0.0, 1e6},
       {"expansion", 0.0, 1e4},
       {"threads", 0, 1024},  // 0 = all cores
+      {"adaptive_margin", 0, 64},  // cells
+      {"adaptive_threshold", 1e-6, 1.0},
   };
   return ranges;
 }
@@ -106,6 +108,8 @@ void SmokeParams::validate() const {
     fail("max_temperature", "greater than ambient_temperature", maxTemperature);
   checkRange("expansion", expansion);
   checkCount("threads", threads, " (0 = all cores)");
+  checkCount("adaptive_margin", adaptiveMargin, " cells");
+  checkRange("adaptive_threshold", adaptiveThreshold);
 }
 
 }  // namespace plume

@@ -43,6 +43,14 @@ struct SmokeParams {
   std::array<Boundary, 6> boundaries{Boundary::Open, Boundary::Open, Boundary::Open,
                                      Boundary::Open, Boundary::Closed, Boundary::Open};
 
+  // --- Adaptive domain (adaptive_domain.h; Mantaflow's Adaptive Domain) ---
+  /// Step only the box around the smoke (Mantaflow: use_adaptive_domain).
+  bool adaptiveDomain = false;
+  /// Cells of air around the smoke in the box (Mantaflow: adapt_margin).
+  int adaptiveMargin = 6;
+  /// ρ, |T - T_amb|, F or S above which a cell holds smoke (Mantaflow: adapt_threshold).
+  float adaptiveThreshold = 0.005f;
+
   // --- Time ---
   float frameDt = 1.f / 24.f;  ///< seconds per frame (1/fps × time scale)
   int substeps = 1;            ///< minimum steps per frame

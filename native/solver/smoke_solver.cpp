@@ -1,6 +1,7 @@
 #include "solver/smoke_solver.h"
 
 #include "core/parallel.h"
+#include "solver/adaptive_domain.h"
 #include "solver/combustion.h"
 #include "solver/forces.h"
 #include "solver/inflow.h"
@@ -67,6 +68,12 @@ SmokeSolver::SmokeSolver(const SmokeParams& params) : mParams(params) {
   mAdvector.reserve(largest, advected, mParams.advection);
   mPressureSolver.setup(mCellTypes, mParams.boundaries);
   mCellTypesDirty = false;
+}
+
+SmokeSolver::~SmokeSolver() = default;
+
+ActiveBox SmokeSolver::activeBox() const {
+  return mAdaptive ? mAdaptive->box() : ActiveBox{glm::ivec3(0), mParams.resolution};
 }
 
 GridFrame SmokeSolver::gridFrame() const {
@@ -150,7 +157,8 @@ void SmokeSolver::rebuildCellTypes() {
   // obstacle changes them, a still one re-added every frame does not).
   if (mCellTypesNext.values() != mCellTypes.values()) {
     std::swap(mCellTypes.values(), mCellTypesNext.values());
-    mPressureSolver.setup(mCellTypes, mParams.boundaries);
+    // With the adaptive domain the box's solver projects (its own hierarchy).
+    if (!mParams.adaptiveDomain) mPressureSolver.setup(mCellTypes, mParams.boundaries);
   }
 }
 
@@ -168,16 +176,33 @@ bool SmokeSolver::advanceFrame(StepObserver* observer) {
   }
   steps = std::min(steps, 1000);
   const float dt = mParams.frameDt / float(steps);
+  // Adaptive domain (adaptive_domain.h): the steps run on the box around the smoke; the public
+  // grids are copied in at the start of the frame and back at its end (after each step for an
+  // observer, which reads them).
+  AdaptiveDomain* box = nullptr;
+  if (mParams.adaptiveDomain) {
+    rebuildCellTypes();  // the public cell types show this frame's obstacles
+    if (!mAdaptive) mAdaptive = std::make_unique<AdaptiveDomain>();
+    box = mAdaptive.get();
+    box->beginFrame(*this);
+  }
   StepStats stats;
   for (int s = 0; s < steps; ++s) {
     const bool stop = observer && observer->cancelRequested();
     if (mCancel.exchange(false) || stop) return false;
     if (observer) observer->beforeStep(*this);
-    step(dt);
+    if (box) {
+      box->step(*this, dt);
+      mStats = box->lastStats();
+      if (observer) box->syncBack(*this);
+    } else {
+      step(dt);
+    }
     if (observer) observer->afterStep(*this, dt);
     stats.pressureIterations += mStats.pressureIterations;
     stats.pressureResidual = std::max(stats.pressureResidual, mStats.pressureResidual);
   }
+  if (box) box->syncBack(*this);
   stats.substeps = steps;
   stats.maxSpeed = maxSpeed();
   mStats = stats;

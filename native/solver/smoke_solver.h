@@ -5,6 +5,7 @@
 
 #include "core/grid3.h"
 #include "core/mac_grid3.h"
+#include "solver/active_box.h"
 #include "solver/advection.h"
 #include "solver/emitters.h"
 #include "solver/point_emitters.h"
@@ -12,6 +13,7 @@
 #include "solver/smoke_params.h"
 
 #include <atomic>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -39,6 +41,7 @@ struct StepStats {
 };
 
 class SmokeSolver;
+class AdaptiveDomain;
 
 /// Follows a simulation step by step, e.g. the streakline tracers of smoke_surfaces.txt §3.2,
 /// whose particles move with the velocity of every step, not only of every frame.
@@ -59,6 +62,7 @@ class SmokeSolver {
  public:
   /// Validates params (std::invalid_argument) and allocates the grids.
   explicit SmokeSolver(const SmokeParams& params);
+  ~SmokeSolver();
 
   const SmokeParams& params() const { return mParams; }
   GridFrame gridFrame() const;
@@ -78,7 +82,8 @@ class SmokeSolver {
   /// Returns false when cancel() was called; the state is then mid-frame and must be discarded.
   /// `observer`, when given, is called around every step.
   bool advanceFrame(StepObserver* observer = nullptr);
-  /// One fractional step of length dt: the stages below, in order.
+  /// One fractional step of length dt: the stages below, in order, on the whole domain (the
+  /// adaptive domain applies in advanceFrame()).
   void step(float dt);
   /// Thread-safe: makes a running advanceFrame() return false after the current step.
   void cancel() { mCancel.store(true); }
@@ -112,12 +117,17 @@ class SmokeSolver {
   const ScalarGrid& pressure() const { return mPressure; }
   const FlagGrid& cellTypes() const { return mCellTypes; }
 
+  /// The adaptive domain's box (adaptive_domain.h) of the last step, in cells; the whole domain
+  /// when params().adaptiveDomain is off or before the first frame.
+  ActiveBox activeBox() const;
+
   /// Largest |div u - φ| × Δx over fluid cells divided by the largest |u| (tests use it).
   float maxDivergence() const;
   /// Largest face speed, m/s.
   float maxSpeed() const;
 
  private:
+  friend class AdaptiveDomain;  // adaptive_domain.h: runs the steps on the box around the smoke
   struct Source {
     CellSet cells;
     SourceSettings settings;
@@ -155,6 +165,7 @@ class SmokeSolver {
   std::atomic<bool> mCancel{false};
   int mFrame = 0;
   StepStats mStats;
+  std::unique_ptr<AdaptiveDomain> mAdaptive;  ///< params().adaptiveDomain: the box's solver
 };
 
 }  // namespace plume
