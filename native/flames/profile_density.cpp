@@ -165,9 +165,10 @@ double ProfileDensity::density(const glm::dvec3& p) const {
 
 void ProfileDensity::classifyCells() {
   // The radius is piecewise linear in s = z / aspect: its extremes over a cell's z-range are at
-  // the range's ends or at the profile's breakpoints inside it.
+  // the range's ends or at the profile's breakpoints in it (both sides of a jump at one s).
   const double a = mProfile.aspect();
   mCellSide.assign(mCellOrigin.size(), kMixed);
+  mCellRadius.assign(mCellOrigin.size(), glm::dvec2(0.0));
   for (std::size_t c = 0; c < mCellOrigin.size(); ++c) {
     const double r0 = mCellOrigin[c].x, z0 = mCellOrigin[c].y, r1 = r0 + mCell, z1 = z0 + mCell;
     if (z1 < -kSideMargin || z0 > a + kSideMargin) {
@@ -175,9 +176,11 @@ void ProfileDensity::classifyCells() {
       continue;
     }
     const double s0 = std::clamp(z0 / a, 0.0, 1.0), s1 = std::clamp(z1 / a, 0.0, 1.0);
-    double lo = std::min(mProfile.radius(s0), mProfile.radius(s1)), hi = std::max(mProfile.radius(s0), mProfile.radius(s1));
+    const double e0 = mProfile.radius(s0), e1 = mProfile.radius(s1);
+    double lo = std::min(e0, e1), hi = std::max(e0, e1);
     for (const glm::dvec2& q : mProfile.points())
-      if (q.x > s0 && q.x < s1) lo = std::min(lo, q.y), hi = std::max(hi, q.y);
+      if (q.x >= s0 && q.x <= s1) lo = std::min(lo, q.y), hi = std::max(hi, q.y);
+    mCellRadius[c] = {lo, hi};
     if (z0 > kSideMargin && z1 < a - kSideMargin && r1 + kSideMargin < lo)
       mCellSide[c] = kInside;
     else if (r0 > hi + kSideMargin)
@@ -214,7 +217,16 @@ ProfileSample ProfileDensity::sample(double u, Rng& rng) const {
     if (side == kOutside) {
       closestPoint({rho, z}, &dist);
     } else if (side == kMixed) {
-      dist = surfaceDistance({rho, z});
+      // inside() spelled out with the cell's radius bounds: the profile's radius only between them.
+      const glm::dvec2 bounds = mCellRadius[std::size_t(c)];
+      const bool within = z >= 0.0 && z <= mProfile.aspect();
+      if (within && rho + kSideMargin < bounds.x) {
+        dist = 0.0;
+      } else if (!within || rho > bounds.y + kSideMargin) {
+        closestPoint({rho, z}, &dist);
+      } else {
+        dist = surfaceDistance({rho, z});
+      }
     }
     const double d = 1.0 / (1.0 + dist * dist / l2);
     s.position.z = z;

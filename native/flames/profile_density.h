@@ -103,6 +103,7 @@ class ProfileDensity {
   /// Per cell: kInside (every point inside the surface: d = 1, no distance query), kOutside (no
   /// point inside: no inside() test), kMixed.
   std::vector<std::uint8_t> mCellSide;
+  std::vector<glm::dvec2> mCellRadius;  ///< per cell: the profile radius's (min, max) over its z
   double mMass = 0.0, mMeanDensity = 0.0;
 };
 
