@@ -15,6 +15,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kRadialCells = 32;  ///< cells across ρ ∈ [0, rhoMax]
 constexpr int kQuadrature = 4;    ///< midpoint samples per cell side
+constexpr std::uint8_t kMixed = 0, kInside = 1, kOutside = 2;  ///< mCellSide
+/// Margin (widest radii) of the cell classes: far above the rounding of a drawn (ρ, z), which can
+/// pass its cell's far edge by an ulp.
+constexpr double kSideMargin = 1e-9;
 
 }  // namespace
 
@@ -59,6 +63,7 @@ ProfileDensity::ProfileDensity(const FlameProfile& profile, const DensityParams&
     mSegLen2.push_back(glm::dot(b - a, b - a));
   }
   for (int c = 0; c < cells; ++c) mCellOrigin.emplace_back((c % mNr) * mCell, mZMin + (c / mNr) * mCell);
+  classifyCells();
 
   // Candidates: segment j can be closest to a point of a cell (centre c, half-diagonal hd) only
   // if dist(c, j) - hd <= min_k dist(c, k) + hd (the nearest distance in the cell is at most
@@ -158,6 +163,31 @@ double ProfileDensity::density(const glm::dvec3& p) const {
   return 1.0 / (1.0 + dist * dist / (mParams.falloff * mParams.falloff));
 }
 
+void ProfileDensity::classifyCells() {
+  // The radius is piecewise linear in s = z / aspect: its extremes over a cell's z-range are at
+  // the range's ends or at the profile's breakpoints in it (both sides of a jump at one s).
+  const double a = mProfile.aspect();
+  mCellSide.assign(mCellOrigin.size(), kMixed);
+  mCellRadius.assign(mCellOrigin.size(), glm::dvec2(0.0));
+  for (std::size_t c = 0; c < mCellOrigin.size(); ++c) {
+    const double r0 = mCellOrigin[c].x, z0 = mCellOrigin[c].y, r1 = r0 + mCell, z1 = z0 + mCell;
+    if (z1 < -kSideMargin || z0 > a + kSideMargin) {
+      mCellSide[c] = kOutside;
+      continue;
+    }
+    const double s0 = std::clamp(z0 / a, 0.0, 1.0), s1 = std::clamp(z1 / a, 0.0, 1.0);
+    const double e0 = mProfile.radius(s0), e1 = mProfile.radius(s1);
+    double lo = std::min(e0, e1), hi = std::max(e0, e1);
+    for (const glm::dvec2& q : mProfile.points())
+      if (q.x >= s0 && q.x <= s1) lo = std::min(lo, q.y), hi = std::max(hi, q.y);
+    mCellRadius[c] = {lo, hi};
+    if (z0 > kSideMargin && z1 < a - kSideMargin && r1 + kSideMargin < lo)
+      mCellSide[c] = kInside;
+    else if (r0 > hi + kSideMargin)
+      mCellSide[c] = kOutside;
+  }
+}
+
 bool ProfileDensity::inside(glm::dvec2 p) const {
   const double a = mProfile.aspect();
   return p.y >= 0.0 && p.y <= a && p.x <= mProfile.radius(p.y / a);
@@ -177,11 +207,27 @@ ProfileSample ProfileDensity::sample(double u, Rng& rng) const {
   // with mass has a region inside the shell; 256 tries make a miss practically impossible and
   // keep the loop bounded (the last candidate is then kept).
   double rho = 0.0, theta = 0.0;
+  const std::uint8_t side = mCellSide[std::size_t(c)];
   for (int attempt = 0; attempt < 256; ++attempt) {
     rho = std::sqrt(r0 * r0 + rng.uniform() * ((r0 + mCell) * (r0 + mCell) - r0 * r0));
     const double z = z0 + rng.uniform() * mCell;
     theta = 2.0 * kPi * rng.uniform();
-    const double dist = surfaceDistance({rho, z});
+    // The cell's class saves the queries whose answer it knows (the same values as the queries').
+    double dist = 0.0;
+    if (side == kOutside) {
+      closestPoint({rho, z}, &dist);
+    } else if (side == kMixed) {
+      // inside() spelled out with the cell's radius bounds: the profile's radius only between them.
+      const glm::dvec2 bounds = mCellRadius[std::size_t(c)];
+      const bool within = z >= 0.0 && z <= mProfile.aspect();
+      if (within && rho + kSideMargin < bounds.x) {
+        dist = 0.0;
+      } else if (!within || rho > bounds.y + kSideMargin) {
+        closestPoint({rho, z}, &dist);
+      } else {
+        dist = surfaceDistance({rho, z});
+      }
+    }
     const double d = 1.0 / (1.0 + dist * dist / l2);
     s.position.z = z;
     s.density = d;

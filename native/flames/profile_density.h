@@ -27,6 +27,7 @@
 
 #include <glm/glm.hpp>
 
+#include <cstdint>
 #include <vector>
 
 namespace plume {
@@ -82,6 +83,8 @@ class ProfileDensity {
   /// Its square (no square root), the same closest point.
   double distance2ToSegment(int segment, glm::dvec2 p, glm::dvec2* closest) const;
   int cellOf(glm::dvec2 rhoZ) const;
+  /// Fills mCellSide.
+  void classifyCells();
 
   FlameProfile mProfile;
   DensityParams mParams;
@@ -97,6 +100,10 @@ class ProfileDensity {
   std::vector<double> mCumulative;    ///< cumulative cell mass in that order, ending at 1
   std::vector<int> mGuide;            ///< per u bucket of width 1/size: upper_bound of its start
   std::vector<double> mCellMaxDensity;  ///< an upper bound of d in the cell (rejection)
+  /// Per cell: kInside (every point inside the surface: d = 1, no distance query), kOutside (no
+  /// point inside: no inside() test), kMixed.
+  std::vector<std::uint8_t> mCellSide;
+  std::vector<glm::dvec2> mCellRadius;  ///< per cell: the profile radius's (min, max) over its z
   double mMass = 0.0, mMeanDensity = 0.0;
 };
 
