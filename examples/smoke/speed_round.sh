@@ -23,7 +23,7 @@ compare --defaults 128 20
 compare --adaptive 128 60
 for row in 'BM_StepComparable/256' 'BM_Step/256'; do
   echo "== plume_bench $row (own process: peak_rss_MB is this row's)"
-  "$BENCH/plume_bench" --benchmark_filter="^$row\$" --benchmark_min_time=0.1 2>&1 | grep -E "^BM_"
+  "$BENCH/plume_bench" --benchmark_filter="^$row/" --benchmark_min_time=0.1 2>&1 | grep -E "^BM_"
 done
 echo "== plume_bench_adaptive BM_Bake60/64"
 "$BENCH/plume_bench_adaptive" --benchmark_filter='BM_Bake60/64' 2>&1 | grep -E "^BM_|ratio"
