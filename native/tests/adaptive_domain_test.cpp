@@ -2,6 +2,7 @@
 // determinism across thread counts, resume from a state file, and the settings' messages.
 #include "solver/smoke_solver.h"
 #include "solver/state_file.h"
+#include "tests/cell_balls.h"
 
 #include <gtest/gtest.h>
 
@@ -23,16 +24,7 @@ SmokeParams plumeParams(glm::ivec3 res, bool adaptive) {
   return p;
 }
 
-/// All cells whose centre lies within r cells of c.
-CellSet ball(glm::ivec3 res, glm::vec3 c, float r) {
-  CellSet s;
-  for (int k = 0; k < res.z; ++k)
-    for (int j = 0; j < res.y; ++j)
-      for (int i = 0; i < res.x; ++i)
-        if (glm::length(glm::vec3(i, j, k) + 0.5f - c) <= r)
-          s.cells.push_back(std::uint32_t(i + res.x * (j + res.y * k)));
-  return s;
-}
+using test::ball;
 
 /// A hot smoke ball low in the middle of the domain.
 void addPlume(SmokeSolver& solver, glm::vec3 centre, float radius) {

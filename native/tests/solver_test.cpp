@@ -5,6 +5,7 @@
 #include "solver/advection.h"
 #include "solver/mass_conservation.h"
 #include "solver/smoke_solver.h"
+#include "tests/cell_balls.h"
 
 #include <gtest/gtest.h>
 
@@ -26,16 +27,7 @@ SmokeParams smallParams(glm::ivec3 res) {
   return p;
 }
 
-/// All cells whose centre lies within r cells of c.
-CellSet ball(glm::ivec3 res, glm::vec3 c, float r) {
-  CellSet s;
-  for (int k = 0; k < res.z; ++k)
-    for (int j = 0; j < res.y; ++j)
-      for (int i = 0; i < res.x; ++i)
-        if (glm::length(glm::vec3(i, j, k) + 0.5f - c) <= r)
-          s.cells.push_back(std::uint32_t(i + res.x * (j + res.y * k)));
-  return s;
-}
+using test::ball;
 
 double total(const ScalarGrid& g) {
   double t = 0.0;
