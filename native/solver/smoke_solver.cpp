@@ -172,7 +172,11 @@ bool SmokeSolver::advanceFrame(StepObserver* observer) {
   if (mParams.useCfl) {
     // Enough steps that the fastest face moves at most `cfl` cells per step.
     const float cellsPerFrame = maxSpeed() * mParams.frameDt / h;
-    steps = std::max(steps, int(std::ceil(cellsPerFrame / mParams.cfl)));
+    // As a float first: a huge speed must not reach the int cast; a non-finite one (a state
+    // that has blown up) adds no steps.
+    const float needed = std::ceil(cellsPerFrame / mParams.cfl);
+    if (needed < 1000.f) steps = std::max(steps, int(needed));
+    else if (std::isfinite(needed)) steps = 1000;
   }
   steps = std::min(steps, 1000);
   const float dt = mParams.frameDt / float(steps);
@@ -295,7 +299,11 @@ void SmokeSolver::advect(float dt) {
   // kDilation blocks, more for a long step (one step a frame) rather than no mask at all.
   const float reach = 2.f * maxSpeed() * dt / h + 4.f;
   constexpr int kMostBlocks = 6;  // beyond it the dilated mask is about the whole grid
-  const int blocks = std::max(BlockMask::kDilation, int(reach / float(BlockMask::kBlock)) + 1);
+  // Compared as a float first: a huge (or non-finite) speed must not reach the int cast.
+  const float reachBlocks = reach / float(BlockMask::kBlock);
+  const int blocks = reachBlocks < float(kMostBlocks)
+                         ? std::max(BlockMask::kDilation, int(reachBlocks) + 1)
+                         : kMostBlocks + 1;
   const BlockMask* mask = nullptr;
   if (blocks <= kMostBlocks && reach < float(blocks * BlockMask::kBlock)) {
     mMask.build(*scalars[0].grid, scalars[0].background, blocks);
