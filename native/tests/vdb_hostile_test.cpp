@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -28,8 +29,10 @@ namespace {
 
 using Bytes = std::vector<unsigned char>;
 
+/// A file name of this process: ctest runs the tests of this file in parallel processes, which
+/// must not write (and rename onto) the same path.
 std::string tempPath(const std::string& name) {
-  return ::testing::TempDir() + "plume_hostile_" + name;
+  return ::testing::TempDir() + "plume_hostile_" + std::to_string(::getpid()) + "_" + name;
 }
 
 Bytes load(const std::string& path) {
