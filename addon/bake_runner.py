@@ -252,9 +252,9 @@ class BakeRunner:
             # A traced bake needs the tracers' checkpoint of the same frame too.
             state = m.get("state_frame")
             if (isinstance(state, int) and snap.frame_start <= state <= last
-                    and os.path.isfile(cache.state_path(snap.cache_folder))
+                    and any(map(os.path.isfile, cache.state_paths(snap.cache_folder)))
                     and (not snap.streaks.enabled
-                         or os.path.isfile(cache.tracer_state_path(snap.cache_folder)))):
+                         or any(map(os.path.isfile, cache.tracer_state_paths(snap.cache_folder))))):
                 self._mode = "resume"
                 self._resume_last = last
                 self._resume_state = state
@@ -347,6 +347,7 @@ class BakeRunner:
                 now = time.perf_counter()
                 if (frame == snap.frame_end
                         or now - last_checkpoint >= CHECKPOINT_COST_RATIO * checkpoint_cost):
+                    cache.keep_previous_checkpoint(folder)
                     self._solver.save_state(cache.state_path(folder))
                     if tracer is not None:
                         tracer.save_state(cache.tracer_state_path(folder), frame)
@@ -393,18 +394,17 @@ class BakeRunner:
 
     def _load_checkpoints(self, folder):
         """Loads the checkpoints of frame state_frame (the solver's, and the tracers' in a traced
-        bake). False when one is missing, corrupt or of another frame (a bake killed between a
-        checkpoint and its manifest update); the solver and tracer are then rebuilt as prepare()
-        made them, so that the bake can start over."""
+        bake), each from state.bin or, when a bake was killed between writing a checkpoint and
+        the manifest naming it, from the previous one (state.prev.bin), which then becomes the
+        current one again. False when none is of that frame (missing or corrupt); the solver and
+        tracer are then rebuilt as prepare() made them, so that the bake can start over."""
         expected = self._resume_state - self.snapshot.frame_start + 1  # frames advanced
-        try:
-            self._solver.load_state(cache.state_path(folder))
-            ok = self._solver.frame == expected
-            if ok and self._tracer is not None:
-                label = self._tracer.load_state(cache.tracer_state_path(folder))
-                ok = label == self._resume_state
-        except RuntimeError:
-            ok = False
+        ok = self._load_one(cache.state_paths(folder),
+                            lambda path: self._solver.load_state(path) is None
+                            and self._solver.frame == expected)
+        if ok and self._tracer is not None:
+            ok = self._load_one(cache.tracer_state_paths(folder),
+                                lambda path: self._tracer.load_state(path) == self._resume_state)
         if not ok:
             self._solver = self._native.SmokeSolver(self._params)
             self._emitter_inputs = None
@@ -412,6 +412,20 @@ class BakeRunner:
             if self._tracer is not None:
                 self._tracer = self._make_tracer(self._params)
         return ok
+
+    @staticmethod
+    def _load_one(paths, load):
+        """The first of `paths` (newest first) that `load` accepts; an older one accepted is renamed
+        to the newest's name (the newer is of a frame the manifest never named)."""
+        for path in paths:
+            try:
+                if os.path.isfile(path) and load(path):
+                    if path != paths[0]:
+                        os.replace(path, paths[0])
+                    return True
+            except RuntimeError:
+                continue
+        return False
 
     def _new_manifest(self):
         snap = self.snapshot

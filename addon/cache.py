@@ -5,6 +5,8 @@
                                     state.bin            (checkpoint of the last complete frame)
                                     tracer_state.bin     (streak surfaces on: the tracers' checkpoint,
                                                           same frame as state.bin)
+                                    state.prev.bin, tracer_state.prev.bin   (the checkpoint before,
+                                                          kept until the manifest names the new one)
                                     streaks_<frame:04d>.bin   (streak surfaces on: tracers, §3.2)
                                     surface_<n>.npz, sheet_<n>_<frame:04d>.exr  (plume.surfaces_build)
                                     toon_<frame:04d>.bin, stencil_<kind>.png   (plume.toon_build)
@@ -20,6 +22,10 @@ from .files.manifest import FORMAT_VERSION  # noqa: F401
 
 STATE_NAME = "state.bin"
 TRACER_STATE_NAME = "tracer_state.bin"
+#: The checkpoint before the last one: a kill between writing a checkpoint and the manifest naming
+#: its frame leaves the manifest pointing at this one.
+STATE_PREV_NAME = "state.prev.bin"
+TRACER_STATE_PREV_NAME = "tracer_state.prev.bin"
 #: Pathline groups of a fire bake (graph_fire_synthesis.txt §4.2); ".partial" while recording.
 PATHLINES_NAME = "pathlines.bin"
 KIND = "smoke"
@@ -91,6 +97,25 @@ def tracer_state_path(folder):
     return os.path.join(folder, TRACER_STATE_NAME)
 
 
+def state_paths(folder):
+    """The solver checkpoints a resume may load, newest first (state.bin, state.prev.bin)."""
+    return [os.path.join(folder, STATE_NAME), os.path.join(folder, STATE_PREV_NAME)]
+
+
+def tracer_state_paths(folder):
+    """The tracer checkpoints a resume may load, newest first."""
+    return [os.path.join(folder, TRACER_STATE_NAME), os.path.join(folder, TRACER_STATE_PREV_NAME)]
+
+
+def keep_previous_checkpoint(folder):
+    """Before a new checkpoint is written: the current one becomes the previous one (a rename of
+    each existing file), so that whichever instant a kill lands at, a checkpoint of the frame the
+    manifest names is on disk."""
+    for paths in (state_paths(folder), tracer_state_paths(folder)):
+        if os.path.isfile(paths[0]):
+            os.replace(paths[0], paths[1])
+
+
 def read_manifest(folder):
     """The smoke bake's manifest as a dict, or None when missing or unreadable (then the bake
     starts over)."""
@@ -117,7 +142,7 @@ def volume_frames(folder):
 
 def plume_files(folder):
     """Files of the folder that a bake owns: manifest.json, volume_*.vdb, streaks_*.bin, state.bin,
-    tracer_state.bin, pathlines.bin(.partial), the surfaces' and toon files, *.tmp."""
+    tracer_state.bin, their .prev.bin, pathlines.bin(.partial), the surfaces' and toon files, *.tmp."""
     try:
         names = sorted(os.listdir(folder))
     except OSError:
@@ -127,8 +152,8 @@ def plume_files(folder):
         path = os.path.join(folder, name)
         if not os.path.isfile(path):
             continue
-        if (name in (MANIFEST_NAME, STATE_NAME, TRACER_STATE_NAME, PATHLINES_NAME,
-                     PATHLINES_NAME + ".partial") or _frame_of(name) is not None
+        if (name in (MANIFEST_NAME, STATE_NAME, TRACER_STATE_NAME, STATE_PREV_NAME,
+                     TRACER_STATE_PREV_NAME, PATHLINES_NAME, PATHLINES_NAME + ".partial") or _frame_of(name) is not None
                 or _SURFACE_RE.match(name) or _TOON_RE.match(name) or name.endswith(".tmp")):
             own.append(path)
     return own

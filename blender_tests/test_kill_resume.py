@@ -27,8 +27,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
 
-from helpers import (add_domain, add_sphere_source, assert_same_frames, native,  # noqa: E402
-                     reset_scene, rmtree, run, select_only, temp_dir)
+from helpers import (add_domain, add_sphere_source, assert_same_frames,  # noqa: E402
+                     incense_streak_scene, native, reset_scene, rmtree, run, select_only,
+                     temp_dir)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CHILD = os.path.join(HERE, "children", "bake_scene.py")
@@ -162,6 +163,51 @@ class KillResumeTest(unittest.TestCase):
         self.assertFalse(set(left) & set(names), names)
         self.assertIn(".plume_probe_keep.tmp", names)
         self.assertEqual(manifest(cache)["last_complete_frame"], 5)
+
+    def test_kill_between_checkpoint_and_manifest_resumes(self):
+        """A kill after a checkpoint is written but before the manifest names its frame (the
+        window CI's random kills found: the bake started over) leaves the manifest pointing at
+        the checkpoint before, which is kept (state.prev.bin, tracer_state.prev.bin): the next
+        bake resumes from it and ends equal to a straight bake, volumes and streaks. The kill is
+        made exact here: every frame checkpoints, and the manifest write of frame KILL_AT fails
+        as the process would have died."""
+        from plume import bake_runner
+        kill_at, frames = 5, 8
+        killed = os.path.join(self.tmp, "killed")
+        incense_streak_scene(killed, 16, frames, point_sources=3)
+        real_write, ratio = bake_runner.cache.write_manifest, bake_runner.CHECKPOINT_COST_RATIO
+
+        def dies_at_frame(folder, data, durable=True):
+            if data.get("last_complete_frame") == kill_at:
+                raise OSError("killed")
+            real_write(folder, data, durable)
+
+        bake_runner.cache.write_manifest, bake_runner.CHECKPOINT_COST_RATIO = dies_at_frame, 0.0
+        try:
+            with self.assertRaises(RuntimeError):
+                bpy.ops.plume.bake()
+        finally:
+            bake_runner.cache.write_manifest, bake_runner.CHECKPOINT_COST_RATIO = real_write, ratio
+        m = manifest(killed)
+        self.assertEqual((m["last_complete_frame"], m["state_frame"]), (kill_at - 1, kill_at - 1))
+        folder = os.path.join(killed, "Domain")
+        self.assertTrue({"state.bin", "state.prev.bin", "tracer_state.bin",
+                         "tracer_state.prev.bin"} <= set(os.listdir(folder)))
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        m = manifest(killed)
+        self.assertTrue(m["last_run"]["resumed"])
+        self.assertEqual(m["last_run"]["computed_frames"], list(range(kill_at, frames + 1)))
+
+        reset_scene()
+        straight = os.path.join(self.tmp, "straight")
+        incense_streak_scene(straight, 16, frames, point_sources=3)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        assert_same_frames(self, frame_file, killed, straight, range(1, frames + 1), GRIDS)
+        for f in range(1, frames + 1):
+            name = os.path.join("Domain", f"streaks_{f:04d}.bin")
+            with open(os.path.join(killed, name), "rb") as a, \
+                    open(os.path.join(straight, name), "rb") as b:
+                self.assertEqual(a.read(), b.read(), name)
 
 
 if __name__ == "__main__":
