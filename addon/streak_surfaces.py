@@ -172,12 +172,17 @@ def most_surfaces_threshold(native, groups):
     every pair with h < R is held, so h0 just above each held value covers every clustering in
     that range exactly, in one pass over the groups' curves (single linkage, Kruskal). Larger
     h0 are not searched: the pairs that decide them are not held (the peak of Figure 4 lies far
-    below the mean of h in practice, where the mean joins nearly everything)."""
+    below the mean of h in practice, where the mean joins nearly everything).
+
+    The h0 returned lies midway in the step of the curve it picks (every h0 in (v_k, v_k+1]
+    gives the same clustering), as a float32: the domain's streak_threshold is a single-precision
+    property, and a value just above v_k would round to v_k or below it and lose the peak."""
     reach = min(float(g.h.reach) for g in groups.values())
     curves = [g.h.curve() for g in groups.values()]
     values = np.unique(np.concatenate([c[0] for c in curves]))
-    h0s = np.nextafter(values, np.inf)
-    keep = h0s <= reach
+    values = values[values < reach]
+    h0s = step_midpoints(values, reach)
+    keep = np.isfinite(h0s)
     values, h0s = values[keep], h0s[keep]
     surfaces = np.zeros(len(values), dtype=np.int64)
     lines = np.zeros(len(values), dtype=np.int64)
@@ -192,6 +197,18 @@ def most_surfaces_threshold(native, groups):
                         "finite): check the point sources")
     best = np.lexsort((-h0s, lines, surfaces))[-1]  # most surfaces, then lines, then smallest h0
     return float(h0s[best])
+
+
+def step_midpoints(values, reach):
+    """For sorted values v_k < reach: a float32 h0 in each step (v_k, min(v_k+1, reach)] of the
+    curve, near its middle; NaN for a step too narrow to hold a float32 strictly above v_k."""
+    upper = np.append(values[1:], reach)
+    mid = (0.5 * (values + upper)).astype(np.float32).astype(np.float64)
+    above = np.nextafter(values.astype(np.float32), np.float32(np.inf)).astype(np.float64)
+    low = mid <= values
+    mid[low] = above[low]  # float32 rounding fell to v_k or below: the next float32 up
+    mid[(mid <= values) | (mid > upper)] = np.nan
+    return mid
 
 
 def plan_surfaces(native, groups, h0) -> List[SurfacePlan]:

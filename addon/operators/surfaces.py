@@ -227,6 +227,7 @@ class PLUME_OT_surfaces_pick_threshold(bpy.types.Operator):
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
         domain.plume.domain.streak_threshold = h0
+        h0 = domain.plume.domain.streak_threshold  # as stored (float32; the pick is one)
         surfaces, lines = ss.summary(_native, groups, h0)
         self.report({'INFO'}, f"Plume: h0 = {h0:.4g} gives {surfaces} surfaces from {lines} "
                               "streaklines")
