@@ -113,6 +113,11 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         items=(('LINEAR', "Linear", "Trilinear sampling"),
                ('MONOTONIC_CUBIC', "Monotonic Cubic", "Monotonic cubic sampling (Fedkiw 2001 eq. 12-13): "
                                                       "keeps small rolling features, no new extrema")))
+    linear_velocity: BoolProperty(
+        name="Fast Velocity", default=False,
+        description="Carry the velocity with trilinear samples (the smoke, heat and fuel keep the "
+                    "Interpolation above): with BFECC a step about 2x cheaper, nearly as sharp, "
+                    "but other small-scale motion than the cubic default")
     trace: EnumProperty(
         name="Back-trace", default='MIDPOINT',
         description="How far back each cell looks for what the flow brings it (Stam 1999 §3.2)",

@@ -109,6 +109,7 @@ class PHYSICS_PT_plume_advection(PlumeDomainPanel, bpy.types.Panel):
         d = context.object.plume.domain
         layout.prop(d, "advection")
         layout.prop(d, "interpolation")
+        layout.prop(d, "linear_velocity")
         layout.prop(d, "trace")
         layout.prop(d, "conserve_mass")
 

@@ -60,13 +60,17 @@ struct Config {
   Interpolation interpolation;
   Trace trace;
   float tolerance;
+  bool linearVelocity = false;  ///< SmokeParams::linearVelocity (Fast Velocity)
   bool operator<(const Config& o) const {
-    return std::tie(scheme, interpolation, trace, tolerance) <
-           std::tie(o.scheme, o.interpolation, o.trace, o.tolerance);
+    return std::tie(scheme, interpolation, trace, tolerance, linearVelocity) <
+           std::tie(o.scheme, o.interpolation, o.trace, o.tolerance, o.linearVelocity);
   }
 };
 /// Plume's defaults.
 constexpr Config kBfecc{Advection::Bfecc, Interpolation::MonotonicCubic, Trace::Midpoint, 1e-4f};
+/// The defaults with Fast Velocity: the velocity carried with trilinear BFECC.
+constexpr Config kFastVelocity{Advection::Bfecc, Interpolation::MonotonicCubic, Trace::Midpoint,
+                               1e-4f, true};
 constexpr Config kMacCormack{Advection::MacCormack, Interpolation::MonotonicCubic,
                              Trace::Midpoint, 1e-4f};
 /// Mantaflow's gas solver: MacCormack with trilinear sampling and Euler traces (advection.cpp,
@@ -81,6 +85,7 @@ SmokeParams benchParams(int n, bool fire, const Config& config) {
   p.interpolation = config.interpolation;
   p.trace = config.trace;
   p.pressureTolerance = config.tolerance;
+  p.linearVelocity = config.linearVelocity;
   p.vorticity = 0.3f;
   p.alpha = 1.f;
   p.beta = 1.f;
@@ -145,9 +150,12 @@ void stepBenchmark(benchmark::State& state, const Config& config) {
 void BM_Step(benchmark::State& state) { stepBenchmark(state, kBfecc); }
 /// The same step with MacCormack advection (Selle et al. 2008): two interpolation passes a field.
 void BM_StepMacCormack(benchmark::State& state) { stepBenchmark(state, kMacCormack); }
+/// The default step with Fast Velocity (kFastVelocity).
+void BM_StepFastVelocity(benchmark::State& state) { stepBenchmark(state, kFastVelocity); }
 /// The step with Mantaflow's settings (kComparable).
 void BM_StepComparable(benchmark::State& state) { stepBenchmark(state, kComparable); }
 BENCHMARK(BM_Step)->Arg(50)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_StepFastVelocity)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_StepMacCormack)->Arg(50)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 /// With Mantaflow's settings one step is one frame: at 256³ this row is the time per frame (VDB
 /// writing excluded); run it alone for its peak_rss_MB.
@@ -155,8 +163,8 @@ BENCHMARK(BM_StepComparable)->Arg(50)->Arg(64)->Arg(128)->Arg(256)->Unit(benchma
 
 /// A whole frame with Plume's defaults: as many steps as the CFL number 4 asks for
 /// (SmokeParams::useCfl), counted in substeps.
-void BM_FrameDefaults(benchmark::State& state) {
-  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false, kBfecc);
+void frameBenchmark(benchmark::State& state, const Config& config) {
+  SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false, config);
   double substeps = 0.0;
   for (auto _ : state) {
     solver.advanceFrame();
@@ -166,7 +174,10 @@ void BM_FrameDefaults(benchmark::State& state) {
   state.counters["peak_rss_MB"] = peakRssMb();
   state.counters["rss_MB"] = rssMb();
 }
+void BM_FrameDefaults(benchmark::State& state) { frameBenchmark(state, kBfecc); }
+void BM_FrameFastVelocity(benchmark::State& state) { frameBenchmark(state, kFastVelocity); }
 BENCHMARK(BM_FrameDefaults)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FrameFastVelocity)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// Times `stage` alone, each iteration from the state the previous stages of a step leave.
 template <typename Stage>

@@ -272,13 +272,12 @@ void SmokeSolver::addForces(float dt) {
 void SmokeSolver::advect(float dt) {
   const Advection scheme = mParams.advection;
   const Interpolation interp = mParams.interpolation;
-  // With BFECC the velocity is carried with trilinear samples, the scalars with `interp`: the
-  // error correction makes trilinear BFECC second order, and on a smooth field, which the
-  // velocity is next to the smoke's edges, it keeps nearly what cubic BFECC keeps (a Gaussian
-  // carried around a rotation: advection_velocity_test.cpp). The velocity's were 9 of the 15
-  // cubic passes of a step, a quarter of its time at 64³; examples/smoke/README.md
-  // "Performance".
-  const Interpolation velocityInterp = scheme == Advection::Bfecc ? Interpolation::Linear : interp;
+  // linearVelocity: the velocity is carried with trilinear samples, the scalars with `interp`:
+  // the error correction makes trilinear BFECC second order, and on a smooth field it keeps
+  // nearly what cubic BFECC keeps (a Gaussian carried around a rotation:
+  // advection_velocity_test.cpp). The velocity's are 9 of the 15 cubic passes of a BFECC step,
+  // a quarter of its time at 64³; examples/smoke/README.md "Performance".
+  const Interpolation velocityInterp = mParams.linearVelocity ? Interpolation::Linear : interp;
   const float h = mParams.cellSize;
   // Scalars first, all carried by the same (pre-advection) velocity along one shared trace.
   struct Field {

@@ -1,5 +1,5 @@
-// The solver's defaults carry the velocity with trilinear BFECC and the scalars with monotonic
-// cubic BFECC (SmokeSolver::advect()). On a smooth field, which the velocity is, trilinear BFECC
+// SmokeParams::linearVelocity (Fast Velocity) carries the velocity with trilinear BFECC and the
+// scalars with monotonic cubic BFECC (SmokeSolver::advect()). On a smooth field trilinear BFECC
 // must keep nearly what cubic BFECC (the scheme before) keeps, and far more than the trilinear
 // MacCormack Mantaflow carries its velocity with: a Gaussian carried once around a rigid
 // rotation, with no new extrema.
