@@ -45,7 +45,7 @@ class SolverSettings:
     cfl: float = 4.0
     advection: str = "BFECC"
     interpolation: str = "MONOTONIC_CUBIC"
-    linear_velocity: bool = False
+    linear_velocity: bool = True
     trace: str = "MIDPOINT"
     conserve_mass: bool = True
     gravity: Tuple[float, float, float] = (0.0, 0.0, -9.81)

@@ -114,10 +114,11 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                ('MONOTONIC_CUBIC', "Monotonic Cubic", "Monotonic cubic sampling (Fedkiw 2001 eq. 12-13): "
                                                       "keeps small rolling features, no new extrema")))
     linear_velocity: BoolProperty(
-        name="Fast Velocity", default=False,
+        name="Fast Velocity", default=True,
         description="Carry the velocity with trilinear samples (the smoke, heat and fuel keep the "
-                    "Interpolation above): with BFECC a step about 2x cheaper, nearly as sharp, "
-                    "but other small-scale motion than the cubic default")
+                    "Interpolation above): with BFECC a step about 2x cheaper and nearly as "
+                    "sharp; off, the velocity is carried with the Interpolation too (other "
+                    "small-scale motion, not more of it)")
     trace: EnumProperty(
         name="Back-trace", default='MIDPOINT',
         description="How far back each cell looks for what the flow brings it (Stam 1999 §3.2)",

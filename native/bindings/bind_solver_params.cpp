@@ -102,7 +102,7 @@ void bindParams(py::module_& m) {
         "Interpolation.LINEAR or Interpolation.MONOTONIC_CUBIC (Fedkiw 2001 eq. 12-13).");
   field(c, "linear_velocity", &SmokeParams::linearVelocity,
         "Carry the velocity with trilinear samples whatever `interpolation` is (a BFECC step "
-        "about 2x cheaper; other small-scale motion). Off by default.");
+        "about 2x cheaper; other small-scale motion). On by default.");
   field(c, "trace", &SmokeParams::trace,
         "Trace.MIDPOINT (RK2, the default) or Trace.EULER (first order, grid-point velocity).");
   field(c, "conserve_mass", &SmokeParams::conserveMass,
