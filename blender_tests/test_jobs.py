@@ -169,6 +169,48 @@ class JobsTest(unittest.TestCase):
         finally:
             type(self).dom = bpy.data.objects["Domain"]
 
+    def test_12_undo_holds_the_workers(self):
+        """Undo and redo free every datablock with the GIL released, and Blender then reads the
+        GIL holder's thread state without the GIL (jobs/quiet.py: the windowed UI test crashed in
+        about 1 run in 4). The persistent undo_pre/redo_pre handlers stop every worker at its
+        next unit of work, waiting with the GIL released, until undo_post/redo_post: called here
+        as Blender calls them, the worker's progress stands still in between, then the job ends."""
+        from plume.jobs import JobRunner, Worker, handlers, quiet
+        for name in ("undo_pre", "redo_pre", "undo_post", "redo_post"):
+            names = [h.__name__ for h in getattr(bpy.app.handlers, name)]
+            self.assertIn("undo_post" if name.endswith("post") else "undo_pre", names, name)
+
+        class Counter(JobRunner):
+            title = "Count"
+
+            def prepare(self, context):
+                pass
+
+            def run(self):
+                for i in range(400):
+                    self.set_progress(i + 1, 400)
+                    time.sleep(0.002)
+
+            def finish(self, context):
+                return 'INFO', ""
+        job = Counter()
+        Worker(job).start()
+        t0 = time.perf_counter()
+        while job.progress().done < 5 and time.perf_counter() - t0 < 30:
+            time.sleep(0.005)
+        try:
+            handlers.undo_pre(None)
+            held = job.progress().done
+            time.sleep(0.3)
+            self.assertIn(job.worker.thread_id, quiet._parked)
+            self.assertEqual(job.progress().done, held)
+        finally:
+            handlers.undo_post(None)
+        job.worker.thread.join(30)
+        self.assertTrue(job.worker.finished)
+        self.assertEqual(job.progress().done, 400)
+        self.assertGreater(held, 4)
+
     def test_11_exit_with_a_running_worker(self):
         """The process ends while a bake's worker runs, nobody cancelling it (jobs_exit.py):
         Python's shutdown cancels and joins it. Exit code 0, no abort ("terminate called

@@ -10,10 +10,12 @@ fire synthesis, mesh export) as one runner protocol and one operator mixin.
 - registry.py which jobs run, by the keys they hold (one job per domain at a time)
 - folder_lock.py one writer per cache folder (.plume.lock: host, pid, job; flock; stale takeover)
 - staging.py  new files kept in a hidden folder until the job succeeds (atomic renames)
-- handlers.py file load, quit and add-on disable abort the running jobs
+- handlers.py file load, quit and add-on disable abort the running jobs; undo and redo hold them
+- quiet.py    workers stand still at their next unit while Blender undoes or redoes (no Python
+              thread may run then: Blender reads the GIL holder's thread state without the GIL)
 """
 
-from . import handlers, registry
+from . import handlers, quiet, registry
 from .operator import JobOperator
 from .runner import Forecast, JobCancelled, JobProgress, JobRunner
 from .staging import Staging

@@ -9,13 +9,30 @@ import threading
 
 import bpy
 
-from . import registry, worker
+from . import quiet, registry, worker
 
 
 @bpy.app.handlers.persistent
 def load_pre(*_args):
     """Another file is loaded: its objects replace the ones the jobs work on."""
     registry.abort_all()
+
+
+@bpy.app.handlers.persistent
+def undo_pre(*_args):
+    """Undo or redo: the workers hold still until it is done (quiet.py: no Python thread may run
+    while Blender frees the datablocks)."""
+    quiet.hold(worker.running_threads)
+
+
+@bpy.app.handlers.persistent
+def undo_post(*_args):
+    quiet.release()
+
+
+#: (handler list name, handler) of the undo and redo hold.
+_UNDO_HANDLERS = (("undo_pre", undo_pre), ("redo_pre", undo_pre), ("undo_post", undo_post),
+                  ("redo_post", undo_post))
 
 
 def _at_exit():
@@ -47,6 +64,10 @@ def _register_shutdown_hook():
 def register():
     if load_pre not in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.append(load_pre)
+    for name, handler in _UNDO_HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler not in handlers:
+            handlers.append(handler)
     atexit.unregister(_at_exit)
     atexit.register(_at_exit)
     _register_shutdown_hook()
@@ -56,4 +77,9 @@ def unregister():
     registry.abort_all()
     while load_pre in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(load_pre)
+    for name, handler in _UNDO_HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        while handler in handlers:
+            handlers.remove(handler)
+    quiet.release_all()
     atexit.unregister(_at_exit)

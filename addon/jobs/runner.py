@@ -33,7 +33,7 @@ from typing import Optional
 
 from ..files import no_room, sweep_temporaries
 from ..settings import BakeError
-from . import folder_lock, registry
+from . import folder_lock, quiet, registry
 from .staging import Staging
 
 
@@ -249,7 +249,9 @@ class JobRunner(abc.ABC):
 
     # ------------------------------------------------------------------ progress
     def set_progress(self, done, total, label=None, seconds_left=None):
-        """Called by run() (any thread): `done` of `total` units."""
+        """Called by run() (any thread): `done` of `total` units. A worker waits here while
+        Blender undoes or redoes (quiet.py)."""
+        quiet.park()
         last = self._progress
         label = last.label if label is None else label
         same = (label, int(total)) == (last.label, last.total) and last.stage_started

@@ -15,6 +15,7 @@ import traceback
 
 from ..files import no_room
 from ..settings import BakeError
+from . import quiet
 from .runner import JobCancelled
 
 #: Workers whose thread runs now (started, not ended).
@@ -22,6 +23,11 @@ _live = set()
 _live_lock = threading.Lock()
 #: Seconds between two "still waiting" lines while stop_all() waits at quit.
 WAIT_NOTE_S = 5.0
+
+
+def running_threads():
+    """Thread idents of the workers running on threads of their own now (quiet.hold())."""
+    return [w.thread_id for w in live() if w.thread_id is not None and not w.finished]
 
 
 def live():
@@ -35,6 +41,7 @@ def stop_all():
     finalizes; also atexit). A worker stops within one unit of work of its job; it is waited for
     however long that takes, saying so every WAIT_NOTE_S seconds, because ending the process with
     the worker inside native code is what crashes."""
+    quiet.release_all()  # a parked worker must see its cancel
     workers = live()
     for w in workers:
         w.runner.aborted = True

@@ -1,0 +1,74 @@
+"""Workers hold still while Blender undoes or redoes, no ``bpy``.
+
+Blender's undo and redo free and re-read every datablock with the GIL released (the operator
+call releases it), and releasing an ID asks Python for the current thread's state without the
+GIL (PyC_IsInterpreterActive -> PyThreadState_GetDict). When a worker thread holds the GIL at
+that instant, that is the worker's state, and Blender's main thread creates its dict while the
+worker runs Python: the heap breaks. Seen as Blender 3.4.1 crashing while a job ran and the UI
+test pressed Undo (about 1 run in 4 of test_ui_jobs; the core: SIGSEGV on the main thread in
+PyDict_New <- _PyThreadState_GetDict <- PyC_IsInterpreterActive, inside an undo).
+
+So undo_pre/redo_pre (handlers.py) hold the workers: each running worker stops at its next unit
+of work (park(), from JobRunner.set_progress), waiting on a Condition, which releases the GIL,
+and Blender undoes with no Python thread running; undo_post/redo_post let them go on. A worker
+inside a long native call is waited for at most PARK_WAIT_S (a native call that released the GIL
+runs no Python until it returns, then parks)."""
+
+import threading
+import time
+
+#: Longest an undo waits for a worker to reach its next unit (then it goes ahead anyway).
+PARK_WAIT_S = 5.0
+
+_cond = threading.Condition()
+_holds = 0
+_parked = set()  # thread idents of parked workers
+
+
+def park():
+    """A worker between two units of work: blocks while an undo or redo holds the workers (the
+    GIL released). Nothing on the main thread (a blocking job)."""
+    if threading.current_thread() is threading.main_thread():
+        return
+    with _cond:
+        if _holds == 0:
+            return
+        me = threading.get_ident()
+        _parked.add(me)
+        _cond.notify_all()
+        while _holds > 0:
+            _cond.wait()
+        _parked.discard(me)
+
+
+def hold(running, timeout=PARK_WAIT_S):
+    """Main thread, before an undo: workers stop at their next unit; waits until every thread
+    ident that `running()` returns is parked (or has ended), at most `timeout` seconds. True
+    when all are still."""
+    global _holds
+    with _cond:
+        _holds += 1
+        deadline = time.monotonic() + timeout
+        while True:
+            if all(t in _parked for t in running()):
+                return True
+            left = deadline - time.monotonic()
+            if left <= 0.0:
+                return False
+            _cond.wait(min(left, 0.05))
+
+
+def release():
+    """After the undo: the workers go on."""
+    global _holds
+    with _cond:
+        _holds = max(0, _holds - 1)
+        _cond.notify_all()
+
+
+def release_all():
+    """Quit or unregister: no hold may outlive the handlers that would release it."""
+    global _holds
+    with _cond:
+        _holds = 0
+        _cond.notify_all()
