@@ -1,4 +1,5 @@
-"""Workers hold still while Blender undoes or redoes, no ``bpy``.
+"""Workers hold still while Blender undoes or redoes, or a script calls an operator under a
+context override; no ``bpy``.
 
 Blender's undo and redo free and re-read every datablock with the GIL released (the operator
 call releases it), and releasing an ID asks Python for the current thread's state without the
@@ -14,6 +15,7 @@ and Blender undoes with no Python thread running; undo_post/redo_post let them g
 inside a long native call is waited for at most PARK_WAIT_S (a native call that released the GIL
 runs no Python until it returns, then parks)."""
 
+import contextlib
 import threading
 import time
 
@@ -72,3 +74,20 @@ def release_all():
     with _cond:
         _holds = 0
         _cond.notify_all()
+
+
+@contextlib.contextmanager
+def held(timeout=PARK_WAIT_S):
+    """Workers parked for the duration: for a script calling an operator under
+    ``bpy.context.temp_override`` while a Plume job runs in the background. Blender (3.4-5.x)
+    looks the override's members up in Python from the operator with the GIL released, asking
+    whether Python is active by reading the GIL holder's thread state, so a worker running Python
+    then breaks the heap (two cores of the windowed UI test: SIGSEGV in PyDict_New and in
+    PyDict_GetItemString under BPY_context_member_get's PyC_IsInterpreterActive). A worker the
+    call starts (an INVOKE of a Plume operator) parks before its first step."""
+    from . import worker  # worker imports this module
+    hold(worker.running_threads, timeout)
+    try:
+        yield
+    finally:
+        release()

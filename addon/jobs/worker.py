@@ -73,6 +73,7 @@ class Worker:
         self.thread_id = threading.get_ident()
         self.started_at = time.perf_counter()
         try:
+            quiet.park()  # started inside an operator call made under quiet.held()
             self.runner.run()
         except JobCancelled:
             pass

@@ -36,6 +36,7 @@ seconds from the action to its end, the scene's objects and the cache folder's f
 after. RESULT (JSON) is rewritten after every case (and before quitting), so a crash still leaves
 the cases before it."""
 
+import contextlib
 import json
 import os
 import sys
@@ -72,9 +73,14 @@ def window_and_area():
     return win, area
 
 
+@contextlib.contextmanager
 def override():
+    """The window context for an operator call from a timer, with Plume's workers parked for it
+    (plume.jobs.quiet.held(): Blender reads the override from Python without the GIL)."""
+    from plume.jobs import quiet
     win, area = window_and_area()
-    return bpy.context.temp_override(window=win, area=area, screen=win.screen)
+    with quiet.held(), bpy.context.temp_override(window=win, area=area, screen=win.screen):
+        yield
 
 
 #: Seconds the gate below holds a job's worker at most (the action comes within a few polls).
