@@ -142,7 +142,8 @@ def volume_frames(folder):
 
 def plume_files(folder):
     """Files of the folder that a bake owns: manifest.json, volume_*.vdb, streaks_*.bin, state.bin,
-    tracer_state.bin, their .prev.bin, pathlines.bin(.partial), the surfaces' and toon files, *.tmp."""
+    tracer_state.bin, their .prev.bin, pathlines.bin(.partial), the surfaces' and toon files,
+    *.tmp."""
     try:
         names = sorted(os.listdir(folder))
     except OSError:
@@ -153,8 +154,9 @@ def plume_files(folder):
         if not os.path.isfile(path):
             continue
         if (name in (MANIFEST_NAME, STATE_NAME, TRACER_STATE_NAME, STATE_PREV_NAME,
-                     TRACER_STATE_PREV_NAME, PATHLINES_NAME, PATHLINES_NAME + ".partial") or _frame_of(name) is not None
-                or _SURFACE_RE.match(name) or _TOON_RE.match(name) or name.endswith(".tmp")):
+                     TRACER_STATE_PREV_NAME, PATHLINES_NAME, PATHLINES_NAME + ".partial")
+                or _frame_of(name) is not None or _SURFACE_RE.match(name)
+                or _TOON_RE.match(name) or name.endswith(".tmp")):
             own.append(path)
     return own
 

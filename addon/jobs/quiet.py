@@ -1,13 +1,15 @@
 """Workers hold still while Blender undoes or redoes, or a script calls an operator under a
 context override; no ``bpy``.
 
-Blender's undo and redo free and re-read every datablock with the GIL released (the operator
-call releases it), and releasing an ID asks Python for the current thread's state without the
-GIL (PyC_IsInterpreterActive -> PyThreadState_GetDict). When a worker thread holds the GIL at
-that instant, that is the worker's state, and Blender's main thread creates its dict while the
-worker runs Python: the heap breaks. Seen as Blender 3.4.1 crashing while a job ran and the UI
-test pressed Undo (about 1 run in 4 of test_ui_jobs; the core: SIGSEGV on the main thread in
-PyDict_New <- _PyThreadState_GetDict <- PyC_IsInterpreterActive, inside an undo).
+An operator called from Python runs with the GIL released, and Blender then asks whether Python
+is active (PyC_IsInterpreterActive -> PyThreadState_GetDict) without the GIL, e.g. to look a
+context override up: when a worker thread holds the GIL at that instant, the answer is the
+worker's thread state, and Blender's main thread touches Python objects while the worker runs
+Python: the heap breaks. Seen as Blender 3.4.1 crashing while a job ran and the UI test called
+Undo or started a job under a context override (about 1 run in 4 of test_ui_jobs; two cores:
+SIGSEGV on the main thread in PyDict_New <- _PyThreadState_GetDict <- PyC_IsInterpreterActive,
+and in PyDict_GetItemString, both inside an operator call). A third crash, in a redo, is not
+explained by this (the issue's note).
 
 So undo_pre/redo_pre (handlers.py) hold the workers: each running worker stops at its next unit
 of work (park(), from JobRunner.set_progress), waiting on a Condition, which releases the GIL,
@@ -21,6 +23,9 @@ import time
 
 #: Longest an undo waits for a worker to reach its next unit (then it goes ahead anyway).
 PARK_WAIT_S = 5.0
+#: Longest a worker stays parked: a hold whose release never comes (an undo_post Blender skipped)
+#: must not freeze the job for good.
+PARKED_MAX_S = 60.0
 
 _cond = threading.Condition()
 _holds = 0
@@ -38,8 +43,9 @@ def park():
         me = threading.get_ident()
         _parked.add(me)
         _cond.notify_all()
-        while _holds > 0:
-            _cond.wait()
+        end = time.monotonic() + PARKED_MAX_S
+        while _holds > 0 and time.monotonic() < end:
+            _cond.wait(end - time.monotonic())
         _parked.discard(me)
 
 
