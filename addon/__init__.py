@@ -1,9 +1,9 @@
 """Plume: small-scale smoke and fire for Blender, backed by the native module ``_native``.
 
-Installed as the package ``plume`` with ``_native.cpython-311-x86_64-linux-gnu.so`` beside this
-file. Only relative imports, so it also loads as a Blender 4.2+ extension (``bl_ext.*.plume``)."""
-
-import sys
+Installed as the package ``plume`` with one native module per CPython beside this file
+(``_native.cpython-311-x86_64-linux-gnu.so`` for Blender 3.4-5.0, ``…-313-…`` for 5.1+): Python
+picks the one built for itself by its file name, and ``native.py`` explains a Python with none.
+Only relative imports, so it also loads as a Blender 4.2+ extension (``bl_ext.*.plume``)."""
 
 bl_info = {
     "name": "Plume",
@@ -16,17 +16,11 @@ bl_info = {
     "category": "Physics",
 }
 
-if sys.version_info[:2] != (3, 11):
-    raise ImportError(
-        "Plume: the native module is built for Python 3.11, but this Blender runs Python "
-        f"{sys.version_info[0]}.{sys.version_info[1]}; use Blender 3.4 to 5.0 (Python 3.11) "
-        "or rebuild the module against this Python", name=__name__)
-
 import bpy  # noqa: E402
 
 if tuple(bpy.app.version) < (3, 4, 0):
     raise ImportError(f"Plume needs Blender 3.4 or newer (this is {bpy.app.version_string}); "
-                      "tested in 3.4.1, 4.5 LTS and 5.0", name=__name__)
+                      "tested in 3.4.1 and 4.2 LTS to 5.3", name=__name__)
 
 from . import native  # noqa: E402,F401  (fails here, with a clear message)
 from . import cache_state, jobs, operators, properties, ui  # noqa: E402

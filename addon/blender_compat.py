@@ -295,7 +295,8 @@ _MANTA_BASES = {
     "ParticleDataImpl_Real": "ParticleDataBase", "ParticleDataImpl_Vec3": "ParticleDataBase",
     "ParticleDataImpl_int": "ParticleDataBase",
 }
-#: Index of PyTypeObject.tp_mro among its pointer-sized fields (CPython 3.11, 64-bit).
+#: Index of PyTypeObject.tp_mro among its pointer-sized fields (CPython 3.11 to 3.13, 64-bit;
+#: the relinking checks the slot holds the MRO before it writes).
 _TP_MRO_FIELD = 43
 
 

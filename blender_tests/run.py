@@ -3,21 +3,31 @@
 
     blender_tests/run.py --blender 4.5 test_bake.py            # one file in one Blender
     blender_tests/run.py --blender 5.0 test_bake.py -- BakeTest.test_cache_free
-    blender_tests/run.py --blender all                          # every file in every Blender
+    blender_tests/run.py --blender all                          # every Blender, as the policy says
+    blender_tests/run.py --blender all --list                   # which files each Blender runs
     blender_tests/run.py --setup all                            # create the bpy venvs only
     blender_tests/run.py --blender 4.5 --script examples/smoke/compare_mantaflow.py -- 64 48
 
-Blenders: "3.4" is Debian 12's packaged 3.4.1 (``blender -b --factory-startup``); "4.5" and "5.0"
-are the ``bpy`` wheels from the Python package index, pinned below, each in its own CPython 3.11
-venv under $PLUME_VENV_ROOT (default ~/.cache/plume/venvs), created once by --setup and reused.
-A test file under a ``bpy`` module runs in ``<venv>/bin/python`` after ``import bpy``: the same
-script, the same operators, no window. Each Blender's renders go to $PLUME_TEST_OUT/<x.y>/
+Blenders, 4.2 LTS to 5.3: "3.4" is Debian 12's packaged 3.4.1 (``blender -b --factory-startup``);
+"4.2", "4.5", "5.0" and "5.3" are the ``bpy`` wheels from the Python package index, pinned below,
+each in a venv ~/.cache/plume/venvs/bpy-<version> ($PLUME_VENV_ROOT), created once by --setup
+(again when its ``import bpy`` fails) and reused. 4.2 to 5.0 are cp311 wheels, their venvs made
+from Debian's /usr/bin/python3; Blender 5.1+ bundles CPython 3.13, so 5.3's venv is made from a
+CPython 3.13 found by pythons.py ($PLUME_PYTHON313, else pyenv's newest 3.13.x, else python3.13
+on PATH). A test file under a ``bpy`` module runs in ``<venv>/bin/python`` after ``import bpy``:
+the same script, the same operators, no window.
+
+Which files run where (CI has a time budget): "3.4" (with the windowed UI test) and the newest,
+"5.3", run every test_*.py; 4.2, 4.5 and 5.0 run SUBSET below (the zip install and one end-to-end
+file per pipeline). ``--full`` runs every file everywhere; files named on the command line always
+run as asked. WINDOWED files run in 3.4 only. Each Blender's renders go to $PLUME_TEST_OUT/<x.y>/
 (default /tmp/plume_test_out/<x.y>/), to compare them. The add-on must be installed where each
 Blender finds user add-ons ($BLENDER_USER_SCRIPTS/addons/plume, else
 ~/.config/blender/<x.y>/scripts/addons/plume); .ci/common.sh does that.
 
 Each file prints "N passed, N failed" on its last line (helpers.run); this runner adds them up and
-prints them per Blender and in total, and exits 1 when anything failed."""
+prints them per Blender and in total, then a table per Blender (files, passed, failed, the files
+that failed), and exits 1 when anything failed."""
 
 import argparse
 import glob
@@ -27,14 +37,28 @@ import subprocess
 import sys
 import time
 
+import pythons  # this folder is sys.path[0]: run.py runs as a script
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 
-#: Blender label -> exact bpy wheel version (None: the system's `blender` executable).
-BPY_PINS = {"3.4": None, "4.5": "4.5.15", "5.0": "5.0.1"}
+#: Blender label -> exact bpy wheel version (None: the system's `blender` executable), oldest
+#: first. 4.2.23 is the newest 4.2 LTS wheel on the index; 5.3.0 is cp313 (pythons.py).
+BPY_PINS = {"3.4": None, "4.2": "4.2.23", "4.5": "4.5.15", "5.0": "5.0.1", "5.3": "5.3.0"}
+#: Blenders that run every test_*.py: the packaged one (it alone has the windowed UI test) and
+#: the newest.
+FULL = {"3.4", "5.3"}
+#: What the other Blenders run: the zip install and, per pipeline, the one file that takes it end
+#: to end through the operators to a Cycles render whose pixels it checks.
+SUBSET = [
+    "test_install_zip.py",     # the zip installed as an artist does; a 32³ bake renders smoke
+    "test_bake.py",            # solver: bake, Volume sequence, VDB grids, render, free, resume
+    "test_streak_surfaces.py",  # streak surfaces: streak bake, Build Surfaces, render is sheets
+    "test_toon_smoke.py",      # toon smoke: Build Toon Smoke, render's outline = _native's
+    "test_flowgraph_fire.py",  # flow-graph fire: 2 states, Flow Graph, Synthesize Fire, render
+    "test_flames.py",          # structural flames: Bake Flames, grids, spines, lights, render
+]
 #: Files that need a window (Xvfb + the real executable): only the packaged Blender has one.
 WINDOWED = {"test_ui_jobs.py"}
-#: The interpreter the venvs are made from: Debian's CPython 3.11, the _native module's ABI.
-VENV_PYTHON = "/usr/bin/python3"
 TIMEOUT_S = 1800
 
 _SUMMARY = re.compile(r"^(\d+) passed, (\d+) failed\s*$", re.M)
@@ -48,21 +72,58 @@ def venv_python(label):
     return os.path.join(venv_root(), f"bpy-{BPY_PINS[label]}", "bin", "python")
 
 
+def bpy_works(label):
+    """Whether the venv of a bpy Blender imports its pinned bpy (a venv whose interpreter went,
+    or a half-installed wheel, does not)."""
+    py, pin = venv_python(label), BPY_PINS[label]
+    probe = [py, "-c", "import importlib.metadata as m, bpy; "
+             f"assert m.version('bpy') == '{pin}', m.version('bpy')"]
+    try:
+        return os.path.exists(py) and subprocess.run(
+            probe, capture_output=True, timeout=300, env=clean_env()).returncode == 0
+    except subprocess.TimeoutExpired:
+        return False
+
+
+def base_python(label):
+    """The CPython a bpy Blender's venv is made from; exits with pythons.py's reason if none."""
+    try:
+        return pythons.python_for(pythons.cpython_of_blender(label))
+    except pythons.PythonNotFound as e:
+        raise SystemExit(f"run.py: Blender {label}: {e}")
+
+
 def setup(label):
-    """Creates (once) the venv of a bpy Blender and installs the pinned wheel into it."""
+    """Creates the venv of a bpy Blender and installs the pinned wheel into it, unless it is
+    there and imports bpy; a venv that exists but does not is made again from scratch."""
     pin = BPY_PINS[label]
     if pin is None:
         return
     py = venv_python(label)
-    probe = [py, "-c", f"import importlib.metadata as m; assert m.version('bpy') == '{pin}'"]
-    if os.path.exists(py) and subprocess.run(probe, capture_output=True).returncode == 0:
-        print(f"== bpy {pin}: venv ready ({os.path.dirname(os.path.dirname(py))})", flush=True)
-        return
     env_dir = os.path.dirname(os.path.dirname(py))
-    print(f"== bpy {pin}: creating {env_dir}", flush=True)
-    subprocess.run([VENV_PYTHON, "-m", "venv", "--clear", env_dir], check=True)
+    if bpy_works(label):
+        print(f"== bpy {pin}: venv ready ({env_dir})", flush=True)
+        return
+    base = base_python(label)
+    again = "re-creating (import bpy failed)" if os.path.exists(env_dir) else "creating"
+    print(f"== bpy {pin}: {again} {env_dir} from {base}", flush=True)
+    subprocess.run([base, "-m", "venv", "--clear", env_dir], check=True)
     subprocess.run([py, "-m", "pip", "install", "-q", "--disable-pip-version-check",
                     f"bpy=={pin}"], check=True)
+    if not bpy_works(label):
+        raise SystemExit(f"run.py: bpy {pin} is installed in {env_dir} but `import bpy` fails "
+                         f"there; try: {py} -c 'import bpy'")
+
+
+def require_venv(label):
+    """The Python of a bpy Blender's venv; exits saying how to make it when there is none (or,
+    first, that there is no CPython to make it from)."""
+    py = venv_python(label)
+    if not os.path.exists(py):
+        base_python(label)
+        raise SystemExit(f"run.py: no venv for Blender {label} ({py}); create it with "
+                         f"{sys.argv[0]} --setup {label}")
+    return py
 
 
 def command(label, path, names):
@@ -71,10 +132,7 @@ def command(label, path, names):
     if BPY_PINS[label] is None:
         return ["blender", "-b", "--factory-startup", "--python-exit-code", "1",
                 "--python", path, *tail]
-    py = venv_python(label)
-    if not os.path.exists(py):
-        raise SystemExit(f"run.py: no venv for Blender {label} ({py}); create it with "
-                         f"{sys.argv[0]} --setup {label}")
+    py = require_venv(label)
     # bpy first, as inside Blender: it puts Blender's own modules (addon_utils, bl_*) on sys.path.
     boot = ("import runpy, sys, bpy; sys.argv = sys.argv[1:]; "
             "runpy.run_path(sys.argv[0], run_name='__main__')")
@@ -121,6 +179,41 @@ def run_file(label, path, names):
     return passed, failed
 
 
+def blender_name(label):
+    return "3.4.1 (Debian blender)" if BPY_PINS[label] is None else f"{BPY_PINS[label]} (bpy)"
+
+
+def plan(label, named, full):
+    """(the test files one Blender runs, which rule chose them): the files named, else every
+    test_*.py (a FULL Blender, or --full), else SUBSET; never a WINDOWED file under bpy."""
+    if named:
+        files, why = named, "as named"
+    elif full or label in FULL:
+        files, why = sorted(glob.glob(os.path.join(HERE, "test_*.py"))), "every test_*.py"
+    else:
+        why = "SUBSET"
+        files = [os.path.join(HERE, f) for f in SUBSET]
+        missing = [f for f in files if not os.path.exists(f)]
+        if missing:
+            raise SystemExit(f"run.py: SUBSET names {', '.join(map(os.path.basename, missing))}, "
+                             f"not in {HERE}; update SUBSET in {__file__}")
+    if BPY_PINS[label] is not None:  # bpy has no window; the UI test runs in the packaged Blender
+        kept = [f for f in files if os.path.basename(f) not in WINDOWED]
+        if len(kept) < len(files):
+            why += f", not {' '.join(sorted(WINDOWED))} (no window)"
+        files = kept
+    return files, why
+
+
+def print_list(plans):
+    """--list: per Blender, the files it would run (nothing runs)."""
+    for label, (files, why) in plans.items():
+        py = "3.11 (Debian's)" if BPY_PINS[label] is None else pythons.cpython_of_blender(label)
+        print(f"Blender {label}: {blender_name(label)}, CPython {py}: {len(files)} files ({why})")
+        for f in files:
+            print(f"  {os.path.relpath(f)}")
+
+
 def main(argv):
     args_, names = (argv[:argv.index("--")], argv[argv.index("--") + 1:]) if "--" in argv \
         else (argv, [])
@@ -130,7 +223,12 @@ def main(argv):
                     help="create the venv(s) of the bpy Blender(s) and stop")
     ap.add_argument("--script", help="run this script (an example, a benchmark) in the Blender "
                     "given by --blender, passing the arguments after --, and exit with its code")
-    ap.add_argument("files", nargs="*", help="test files (default: every blender_tests/test_*.py)")
+    ap.add_argument("--list", action="store_true",
+                    help="print which test files each Blender would run, and stop")
+    ap.add_argument("--full", action="store_true",
+                    help="every test_*.py in every Blender asked for, not SUBSET in 4.2-5.0")
+    ap.add_argument("files", nargs="*", help="test files (default: every blender_tests/test_*.py "
+                    f"in {' and '.join(sorted(FULL))}, SUBSET in the others)")
     a = ap.parse_args(args_)
     if a.setup:
         for label in (BPY_PINS if a.setup == "all" else [a.setup]):
@@ -140,23 +238,32 @@ def main(argv):
     if a.script:
         return max(subprocess.run(command(label, os.path.abspath(a.script), names),
                                   env=clean_env()).returncode for label in labels)
-    files = [f if os.path.exists(f) else os.path.join(HERE, f) for f in a.files] or \
-        sorted(glob.glob(os.path.join(HERE, "test_*.py")))
+    named = [f if os.path.exists(f) else os.path.join(HERE, f) for f in a.files]
+    plans = {label: plan(label, named, a.full) for label in labels}
+    if a.list:
+        print_list(plans)
+        return 0
+    for label in labels:  # a missing venv (or CPython 3.13) stops the run before it starts
+        if BPY_PINS[label] is not None and plans[label][0]:
+            require_venv(label)
     totals = {}
     for label in labels:
         p = f = 0
-        for path in files:
-            if BPY_PINS[label] is not None and os.path.basename(path) in WINDOWED:
-                continue  # bpy has no window; the UI test runs in the packaged Blender
+        bad = []
+        for path in plans[label][0]:
             dp, df = run_file(label, path, names)
             p, f = p + dp, f + df
-        totals[label] = (p, f)
+            if df:
+                bad.append(os.path.basename(path))
+        totals[label] = (p, f, len(plans[label][0]), bad)
     print("== Blender tests")
-    for label, (p, f) in totals.items():
-        name = "3.4.1 (Debian blender)" if BPY_PINS[label] is None else f"{BPY_PINS[label]} (bpy)"
-        print(f"Blender {name}: {p} passed, {f} failed")
+    for label, (p, f, _, _) in totals.items():
+        print(f"Blender {blender_name(label)}: {p} passed, {f} failed")
     tp, tf = sum(v[0] for v in totals.values()), sum(v[1] for v in totals.values())
     print(f"all Blenders: {tp} passed, {tf} failed")
+    print(f"{'Blender':<24} {'files':>5} {'passed':>6} {'failed':>6}  failing files")
+    for label, (p, f, n, bad) in totals.items():
+        print(f"{blender_name(label):<24} {n:>5} {p:>6} {f:>6}  {' '.join(bad) or '-'}")
     return 0 if tf == 0 and tp > 0 else 1
 
 

@@ -12,9 +12,11 @@ bool hasAvx2();
 
 }  // namespace plume
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PLUME_NO_AVX2)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(PLUME_NO_AVX2) && \
+    (!defined(__clang__) || __clang_major__ >= 16)
 /// A function compiled twice, for AVX2 and for the build's baseline, the loader picking one
-/// (GCC function multi-versioning). For row kernels: a call per row, the loop inside vectorized
+/// (function multi-versioning: GCC, and clang 16+ as in the portable build; the fuzzers' clang
+/// 14 builds the baseline only). For row kernels: a call per row, the loop inside vectorized
 /// twice as wide; "avx2" does not enable FMA, so the results are the same bit for bit.
 #define PLUME_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
 #else

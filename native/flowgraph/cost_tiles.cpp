@@ -46,6 +46,15 @@ typedef float Lanes __attribute__((vector_size(kLanes * sizeof(float))));
 
 inline void load(Lanes& v, const float* p) { std::memcpy(&v, p, sizeof v); }
 
+/// The lanes of v in the order i0..i7 (GCC's __builtin_shuffle, clang's
+/// __builtin_shufflevector: the same permutation, so the same sums in either build).
+#if defined(__clang__)
+#define laneShuffle(v, ...) __builtin_shufflevector(v, v, __VA_ARGS__)
+#else
+typedef int LaneIndex __attribute__((vector_size(kLanes * sizeof(int))));
+#define laneShuffle(v, ...) __builtin_shuffle(v, LaneIndex{__VA_ARGS__})
+#endif
+
 /// out[r] = Σ_k (a_r,k − b_k)² for k < n and the kRows rows a_r against one column b: squares
 /// summed in float in kLanes lanes per row (lane k mod kLanes; the tail is padded with zeros,
 /// which add exactly 0), the lanes then added in a fixed tree. One column load serves kRows
@@ -76,11 +85,10 @@ inline void squaredDistances(const float* const* a, const float* b, std::size_t 
     }
   }
   // Fixed tree ((s0 + s4) + (s2 + s6)) + ((s1 + s5) + (s3 + s7)) per row, as vector halves.
-  typedef int Index __attribute__((vector_size(kLanes * sizeof(int))));
   for (int r = 0; r < kRows; ++r) {
-    Lanes v = s[r] + __builtin_shuffle(s[r], Index{4, 5, 6, 7, 0, 1, 2, 3});
-    v += __builtin_shuffle(v, Index{2, 3, 0, 1, 2, 3, 0, 1});
-    v += __builtin_shuffle(v, Index{1, 0, 1, 0, 1, 0, 1, 0});
+    Lanes v = s[r] + laneShuffle(s[r], 4, 5, 6, 7, 0, 1, 2, 3);
+    v += laneShuffle(v, 2, 3, 0, 1, 2, 3, 0, 1);
+    v += laneShuffle(v, 1, 0, 1, 0, 1, 0, 1, 0);
     out[r] = v[0];
   }
 }

@@ -52,7 +52,8 @@ std::vector<char> reachingCycle(const EdgeLists& g, const std::vector<char>& ali
         ++predecessorBegin[std::size_t(g.edges[std::size_t(k)].to) + 1];
       }
   for (std::size_t m = 0; m < n; ++m) predecessorBegin[m + 1] += predecessorBegin[m];
-  std::vector<int> predecessors(std::size_t(predecessorBegin[n])), fill(predecessorBegin.begin(), predecessorBegin.end() - 1);
+  std::vector<int> predecessors(static_cast<std::size_t>(predecessorBegin[n]));
+  std::vector<int> fill(predecessorBegin.begin(), predecessorBegin.end() - 1);
   for (std::size_t m = 0; m < n; ++m)
     for (int k = g.begin[m]; k < g.begin[m + 1]; ++k)
       if (counted(m, g.edges[std::size_t(k)])) predecessors[std::size_t(fill[std::size_t(g.edges[std::size_t(k)].to)]++)] = int(m);
