@@ -40,10 +40,11 @@ stage_headers() {  # stage_headers PYTHON -> "<tag>=<folder>"
   tag="$("$py" -c 'import sys; print("%d%d" % sys.version_info[:2])')"
   [ -f "$inc/Python.h" ] || { echo "no Python.h in $inc (CPython $tag headers)" >&2; exit 1; }
   out="$BUILD/python-headers/$tag"
-  rm -rf "$out"; mkdir -p "$out"; cp -r "$inc/." "$out/"
+  # cp -a keeps the headers' own times: a rebuild does not recompile the bindings for nothing.
+  rm -rf "$out"; mkdir -p "$out"; cp -a "$inc/." "$out/"
   real="$(dirname "$inc")/x86_64-linux-gnu/$(basename "$inc")/pyconfig.h"
   if grep -q '<x86_64-linux-gnu/' "$out/pyconfig.h" && [ -f "$real" ]; then
-    cp "$real" "$out/pyconfig.h"
+    cp -a "$real" "$out/pyconfig.h"
   fi
   echo "$tag=$out"
 }

@@ -88,9 +88,19 @@ void writeGridsAtomic(const std::string& path, const openvdb::GridPtrVec& grids,
     // descriptors back through the same checks as every read (vdb_guard).
     if (err == ENOSPC || err == EDQUOT || err == EFBIG || err == EIO)
       throw std::runtime_error(writeFailure(err));
-    err = 0;
-    if (CheckedVdbFile(tmp).gridNames().size() != grids.size())
-      throw std::runtime_error("grids missing after writing");
+    std::string damage = "grids missing after writing";
+    bool complete = false;
+    try {
+      complete = CheckedVdbFile(tmp).gridNames().size() == grids.size();
+    } catch (const std::exception& e) {
+      damage = e.what();
+    }
+    if (!complete) {
+      // A short file whose stream left no errno (libc++'s, in the portable build, does not):
+      // a file at the size limit or a full disk still says so, not "damaged".
+      const int cause = writeFailureCause(tmp, 0);
+      throw std::runtime_error(cause != 0 ? writeFailure(cause) : damage);
+    }
   } catch (const std::exception& e) {
     std::remove(tmp.c_str());  // no half file: the previous one, if any, stays
     fail(path, std::string("cannot be written: ") + e.what());
