@@ -25,14 +25,19 @@ def _pythons(names):
     return sorted(found)
 
 
-def _listed_modules(folder):
-    """The module files the zip's PLUME_BUILD.txt lists ("module: …" lines), or None when the
-    add-on was not installed from a zip (a developer checkout has no such file)."""
+def _build_info(folder):
+    """(release, module files) from the zip's PLUME_BUILD.txt (its "plume <version>" and
+    "module: …" lines), or (None, None) when the add-on was not installed from a zip (a
+    developer checkout has no such file)."""
     try:
         with open(os.path.join(folder, "PLUME_BUILD.txt"), encoding="utf-8") as f:
-            return [line.split(":", 1)[1].strip() for line in f if line.startswith("module:")]
+            lines = f.read().splitlines()
     except OSError:
-        return None
+        return None, None
+    release = next((line.split()[1] for line in lines if line.startswith("plume ")
+                    and len(line.split()) == 2), "<version>")
+    return release, [line.split(":", 1)[1].strip() for line in lines
+                     if line.startswith("module:")]
 
 
 def explain_import_failure(folder, error, python=None):
@@ -41,9 +46,9 @@ def explain_import_failure(folder, error, python=None):
     python = tuple(python or sys.version_info[:2])
     mine = f"Python {python[0]}.{python[1]}"
     present = _pythons(glob.glob(os.path.join(folder, "_native*.so")))
-    listed = _listed_modules(folder)
+    release, listed = _build_info(folder)
     shipped = _pythons(listed) if listed is not None else present
-    reinstall = ("install plume-<version>-linux-x64.zip again (Edit > Preferences > Get "
+    reinstall = (f"install plume-{release}-linux-x64.zip again (Edit > Preferences > Get "
                  "Extensions > Install from Disk; in Blender 3.4 Add-ons > Install)")
     if shipped and python not in shipped:
         supported = "; ".join(f"Python {a}.{b} ({BLENDERS_OF_PYTHON.get((a, b), 'Blender ?')})"

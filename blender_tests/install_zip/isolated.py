@@ -1,9 +1,12 @@
 """The isolated Blender of test_install_zip.py: this Blender (``blender -b`` or the bpy venv's
 Python) started again with BLENDER_USER_RESOURCES/SCRIPTS/CONFIG/EXTENSIONS/DATAFILES pointing at
 new empty folders, so the add-on installed by .ci/common.sh is invisible and the zip is installed
-as an artist installs it. The parent starts it (IsolatedRun) and reads back the outcome of each
-test it ran (run_isolated writes them); what the process maps is read from /proc/self/maps."""
+as an artist installs it, from nothing. The parent starts it (IsolatedRun) and reads back the
+outcome of each test it ran (run_isolated writes them); what the process maps is read from
+/proc/self/maps, and what Blender prints while enabling is captured at the file descriptors, since
+some Blenders raise a failed enable as an error and others only print it."""
 
+import ctypes
 import json
 import os
 import shutil
@@ -15,26 +18,16 @@ import unittest
 
 import bpy
 
-import plume_zip
-
 #: Set (to the results file) in the re-launched, isolated Blender.
 ISOLATED_ENV = "PLUME_ZIP_ISOLATED"
 VERSION = "%d.%d.%d" % bpy.app.version[:3]
 OUT_DIR = os.environ.get("PLUME_TEST_OUT", "/tmp/plume_test_out")
-#: Libraries whose Debian system copies must not be the ones _native uses when Blender does not
-#: already hold that soname (the bpy builds).
-KEY_LIBS = ("libopenvdb.so.10.0", "libosdCPU.so.3.5.0", "libblosc.so.1", "liblog4cplus-2.0.so.3")
-#: Removed from a copy of the package to check the error a missing library gives.
-MISSING_LIB = "libblosc.so.1"
+#: Libraries linked statically into each _native: enabling Plume must map no file of theirs
+#: (Blender's own copies, already mapped, stay as they were).
+STATIC_LIB_PREFIXES = ("libopenvdb", "libtbb", "libblosc", "libosd")
 #: The script the isolated Blender runs.
 CASES_SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                             "installed_cases.py")
-
-
-def debian_blender():
-    """Debian's packaged Blender executable (links the system OpenVDB, TBB, OpenSubdiv...)."""
-    return bool(bpy.app.binary_path) and bpy.app.version < (4, 2, 0)
-
 
 
 def mapped_files():
@@ -44,27 +37,41 @@ def mapped_files():
                 if len(parts) == 6 and parts[5].startswith("/")}
 
 
-_soname_cache = {}
+def static_lib_files(files):
+    """The files among `files` that are a copy of a library Plume links statically."""
+    return sorted(p for p in files if os.path.basename(p).startswith(STATIC_LIB_PREFIXES))
 
 
-def soname_of(path):
-    if path not in _soname_cache:
+def call_capturing_output(fn):
+    """Calls fn() with file descriptors 1 and 2 sent to a temporary file, so both Python's and
+    Blender's own (C) prints are caught; echoes them afterwards. Returns (fn's result or None,
+    "ExceptionType: message" or "", the printed text)."""
+    libc = ctypes.CDLL(None)
+    with tempfile.TemporaryFile() as tmp:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        libc.fflush(None)
+        saved = os.dup(1), os.dup(2)
+        os.dup2(tmp.fileno(), 1)
+        os.dup2(tmp.fileno(), 2)
+        result, error = None, ""
         try:
-            _soname_cache[path] = plume_zip.elf_dynamic(path)["soname"]
-        except plume_zip.PackagingError:
-            _soname_cache[path] = None
-    return _soname_cache[path]
-
-
-def mapped_by_soname(files, sonames):
-    """{soname: sorted paths} of the mapped files that carry one of `sonames`."""
-    out = {s: [] for s in sonames}
-    for path in sorted(files):
-        base = os.path.basename(path)
-        for s in sonames:
-            if base.startswith(s.split(".so")[0] + ".so") and soname_of(path) == s:
-                out[s].append(path)
-    return out
+            result = fn()
+        except Exception as e:  # an operator's {'ERROR'} report is a RuntimeError
+            error = f"{type(e).__name__}: {e}"
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            libc.fflush(None)
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            os.close(saved[0])
+            os.close(saved[1])
+        tmp.seek(0)
+        printed = tmp.read().decode(errors="replace")
+    for line in printed.splitlines():
+        print("  > " + line)
+    return result, error, printed
 
 
 class _Recorder(unittest.TextTestResult):
@@ -90,8 +97,10 @@ class _Recorder(unittest.TextTestResult):
             self.outcomes["setUpClass"] = ("error", self.errors[-1][1])
 
 
-def run_isolated(results_file, case):
-    suite = unittest.defaultTestLoader.loadTestsFromTestCase(case)
+def run_isolated(results_file, case, method=None):
+    """Runs the TestCase `case` (only its test `method`, if given) and writes the outcomes."""
+    suite = unittest.TestSuite([case(method)]) if method else \
+        unittest.defaultTestLoader.loadTestsFromTestCase(case)
     runner = unittest.TextTestRunner(stream=sys.stdout, verbosity=2, resultclass=_Recorder)
     result = runner.run(suite)
     with open(results_file, "w") as f:
@@ -114,7 +123,8 @@ def isolated_command(script):
 
 class IsolatedRun:
     """installed_cases.py run in this Blender with new empty user folders under `root`, installing
-    `zip_file` and running the TestCase named `case`: (return code, outcomes by test name)."""
+    `zip_file` and running `case` ("TestCase" or "TestCase.test_method"): the return code and the
+    outcomes by test name."""
 
     def __init__(self, zip_file, case):
         self.root = tempfile.mkdtemp(prefix="plume_zip_install_")
@@ -135,7 +145,9 @@ class IsolatedRun:
                                   timeout=900)
             output, self.rc = proc.stdout, proc.returncode
         except subprocess.TimeoutExpired as e:
-            output, self.rc = str(e.stdout or ""), "timeout"
+            output = e.stdout.decode(errors="replace") if isinstance(e.stdout, bytes) \
+                else str(e.stdout or "")
+            self.rc = "timeout"
         print(f"  ---- isolated Blender {VERSION}, {case} (rc {self.rc}, "
               f"{time.perf_counter() - t0:.1f} s) ----")
         for line in output.splitlines():
@@ -158,5 +170,3 @@ class IsolatedRun:
 
     def cleanup(self):
         shutil.rmtree(self.root, ignore_errors=True)
-
-
