@@ -46,22 +46,25 @@ build_native() {
 # Every Blender the tests run (blender_tests/run.py): Debian's 3.4.1 and the bpy wheels.
 BLENDER_VERSIONS=(3.4 4.2 4.5 5.0 5.3)
 
-# Where each Blender finds user add-ons: one folder when $BLENDER_USER_SCRIPTS is set, else each
-# version's own under ~/.config/blender.
+# The Blenders that run CPython 3.11, the development module's.
+BLENDERS_PY311=(3.4 4.2 4.5 5.0)
+
+# Where the given Blenders find user add-ons: one folder when $BLENDER_USER_SCRIPTS is set, else
+# each version's own under ~/.config/blender.
 addon_dirs() {
   if [ -n "${BLENDER_USER_SCRIPTS:-}" ]; then
     echo "$BLENDER_USER_SCRIPTS/addons/plume"
   else
     local v
-    for v in "${BLENDER_VERSIONS[@]}"; do echo "$HOME/.config/blender/$v/scripts/addons/plume"; done
+    for v in "$@"; do echo "$HOME/.config/blender/$v/scripts/addons/plume"; done
   fi
 }
 
 # The development install: the add-on with the module of build_native (Debian's libraries,
-# CPython 3.11), for `.ci/main` and working on the add-on.
+# CPython 3.11), for `.ci/main` and working on the add-on, in the Blenders it can serve.
 install_addon() {
   local dest
-  for dest in $(addon_dirs); do
+  for dest in $(addon_dirs "${BLENDERS_PY311[@]}"); do
     echo "== installing the add-on into $dest"
     rm -rf "$dest"
     mkdir -p "$dest"
@@ -76,7 +79,7 @@ install_zip_package() {
   local zip="$1" dest stage
   stage="$(mktemp -d)"
   unzip -q "$zip" -d "$stage"
-  for dest in $(addon_dirs); do
+  for dest in $(addon_dirs "${BLENDER_VERSIONS[@]}"); do
     echo "== installing $(basename "$zip") into $dest"
     rm -rf "$dest"
     mkdir -p "$(dirname "$dest")"
