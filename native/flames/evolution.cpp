@@ -51,7 +51,13 @@ void evolvePoints(std::vector<SpinePoint>& points, const FlameParams& params, co
       }
     }
     p.v = (x1 - x0) / dt;
-    if (sigma > 0.0) x1 += sigma * glm::dvec3(rng.normal(), rng.normal(), rng.normal());
+    if (sigma > 0.0) {
+      // Named draws: C++ leaves the order of a call's arguments to the compiler (GCC took
+      // these right to left, clang left to right), so the same seed gave other flames in
+      // another build. z, y, x is GCC's order, which earlier bakes used.
+      const double nz = rng.normal(), ny = rng.normal(), nx = rng.normal();
+      x1 += sigma * glm::dvec3(nx, ny, nz);
+    }
     p.x = x1;
     p.age = a + dt;
   }

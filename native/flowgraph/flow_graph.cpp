@@ -27,7 +27,9 @@ EdgeLists compress(std::vector<std::vector<FlowEdge>>& lists) {
   EdgeLists g;
   g.begin.assign(lists.size() + 1, 0);
   for (std::size_t n = 0; n < lists.size(); ++n) {
-    std::sort(lists[n].begin(), lists[n].end(), [](const FlowEdge& a, const FlowEdge& b) { return a.to < b.to; });
+    // Stable: edges to one target (if any) keep their order with every standard library.
+    std::stable_sort(lists[n].begin(), lists[n].end(),
+                     [](const FlowEdge& a, const FlowEdge& b) { return a.to < b.to; });
     g.begin[n + 1] = g.begin[n] + int(lists[n].size());
     g.edges.insert(g.edges.end(), lists[n].begin(), lists[n].end());
   }

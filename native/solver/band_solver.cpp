@@ -8,7 +8,8 @@ namespace detail {
 
 void BandSolver::build(const Level& L) {
   int ax[3] = {0, 1, 2};  // fastest, middle, slowest = the longest axis
-  std::sort(ax, ax + 3, [&](int a, int b) { return L.n[a] < L.n[b]; });
+  // Equal lengths keep their axis order: the same numbering with every standard library.
+  std::sort(ax, ax + 3, [&](int a, int b) { return L.n[a] != L.n[b] ? L.n[a] < L.n[b] : a < b; });
   std::vector<int> number(L.padded(), -1);
   cells.clear();
   glm::ivec3 c;
