@@ -267,6 +267,30 @@ def compositor_file_output(nt, directory, name, socket):
     return fo
 
 
+# --- Geometry Nodes modifier inputs ----------------------------------------------------------
+
+def _modifier_input(mod, identifier):
+    """5.1+: the input's own struct (mod.properties.inputs.<identifier>), else None."""
+    inputs = getattr(getattr(mod, "properties", None), "inputs", None)
+    return getattr(inputs, identifier, None) if inputs is not None else None
+
+
+def modifier_input(mod, identifier):
+    """The value of a Geometry Nodes modifier's input, by its socket identifier: an ID property
+    of the modifier up to 5.0 (mod["Socket_2"]), mod.properties.inputs.Socket_2.value in 5.1+."""
+    item = _modifier_input(mod, identifier)
+    return item.value if item is not None else mod[identifier]
+
+
+def set_modifier_input(mod, identifier, value):
+    """Sets a Geometry Nodes modifier's input (see modifier_input)."""
+    item = _modifier_input(mod, identifier)
+    if item is not None:
+        item.value = value
+    else:
+        mod[identifier] = value
+
+
 # --- Blender's Mantaflow in the bpy wheels ----------------------------------------------------
 
 #: Mantaflow's Python class hierarchy (its `PYTHON() class X : public Y` declarations), by the

@@ -138,8 +138,8 @@ def build_object(scene, domain, folder, frame_start, last_frame, cell_size, max_
         mod = ob.modifiers.new(GROUP, 'NODES')
     mod.node_group = ng
     ids = compat.group_input_ids(ng)
-    mod[ids["Radius"]] = 0.5 * float(cell_size)
-    mod[ids["Material"]] = points_material(max_temperature)
+    compat.set_modifier_input(mod, ids["Radius"], 0.5 * float(cell_size))
+    compat.set_modifier_input(mod, ids["Material"], points_material(max_temperature))
     # The handler rewrites the points while rendering frames: lock the interface.
     scene.render.use_lock_interface = True
     _files.clear()

@@ -181,10 +181,11 @@ def set_camera(mod, camera):
     """Points the billboards at `camera` (perspective or not). False when nothing changed."""
     ids = compat.group_input_ids(mod.node_group)
     persp = is_perspective(camera)
-    if mod[ids["Camera"]] == camera and bool(mod[ids["Perspective"]]) == persp:
+    if (compat.modifier_input(mod, ids["Camera"]) == camera
+            and bool(compat.modifier_input(mod, ids["Perspective"])) == persp):
         return False
-    mod[ids["Camera"]] = camera
-    mod[ids["Perspective"]] = persp
+    compat.set_modifier_input(mod, ids["Camera"], camera)
+    compat.set_modifier_input(mod, ids["Perspective"], persp)
     return True
 
 
@@ -203,7 +204,7 @@ def apply_billboards(ob, camera, material, stretch_factor):
     mod.node_group = ng
     ids = compat.group_input_ids(ng)
     set_camera(mod, camera)
-    mod[ids["Material"]] = material
+    compat.set_modifier_input(mod, ids["Material"], material)
     set_stretch(mod, stretch_factor)
     ob.data.update()
     return mod
@@ -226,7 +227,7 @@ def set_ramp(mat, settings):
 
 def set_stretch(mod, stretch_factor):
     ids = compat.group_input_ids(mod.node_group)
-    mod[ids["Stretch Factor"]] = float(stretch_factor)
+    compat.set_modifier_input(mod, ids["Stretch Factor"], float(stretch_factor))
 
 
 def toon_material(name, stencil_path, settings):
