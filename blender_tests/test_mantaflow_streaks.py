@@ -24,6 +24,10 @@ from helpers import (add_domain, assert_reports_error, compat, native, reset_sce
                      rmtree, run, select_only, temp_dir, tree_listing)
 
 FRAMES = 20
+#: Mantaflow in the 5.3 wheel (checked there; 5.0 writes 224) writes VDB file version 225, which
+#: Plume's OpenVDB 10 reader does not read yet: there a bake from it must be refused with a
+#: message naming the file and the versions Plume reads, leaving nothing (README, Tested Blenders).
+MANTAFLOW_VDB_TOO_NEW = bpy.app.version >= (5, 1, 0)
 EMITTER_AT = (0.0, 0.0, 0.3)
 
 
@@ -119,8 +123,17 @@ class MantaflowStreaksTest(unittest.TestCase):
         centre0 = matrix[:3, :3] @ (start + 0.5 * cell) + matrix[:3, 3]
         return density, cell_of, centre0
 
+    def refuses_too_new_vdb(self, name):
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.plume.bake()
+        print(f"  Blender {bpy.app.version_string}: {str(e.exception)[:160]}")
+        self.assertIn("has VDB file version 225; Plume reads versions 222-224", str(e.exception))
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, name, "manifest.json")))
+
     def test_traced_particles_rise_with_the_smoke_and_make_surfaces(self):
         dom = plume_domain("Traced", self.tmp, self.manta)
+        if MANTAFLOW_VDB_TOO_NEW:
+            return self.refuses_too_new_vdb("Traced")
         bpy.ops.plume.bake()
         folder = os.path.join(self.tmp, "Traced")
         with open(os.path.join(folder, "manifest.json"), encoding="utf-8") as f:
@@ -227,6 +240,8 @@ class MantaflowStreaksTest(unittest.TestCase):
         scn.collection.objects.link(cam)
         cam.location, cam.rotation_euler = (0.0, -4.0, 1.0), (np.pi / 2, 0.0, 0.0)
         scn.camera = cam
+        if MANTAFLOW_VDB_TOO_NEW:
+            return self.refuses_too_new_vdb("ToonTraced")
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
         folder = os.path.join(self.tmp, "ToonTraced")
         with open(os.path.join(folder, "manifest.json"), encoding="utf-8") as f:
