@@ -60,6 +60,24 @@ def _normalized(data):
     return json.loads(json.dumps(data, sort_keys=True))
 
 
+def check_input(snap, native):
+    """The checks of a bake's input that need no solver (Blender runs them before it starts the
+    bake's child); the validated native SmokeParams. BakeError naming the setting."""
+    validate_python_side(snap.domain_name, snap.resolution, snap.frame_start,
+                         snap.frame_end, snap.solver)
+    try:
+        params = to_native_params(snap.solver, native)
+    except ValueError as e:
+        raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
+    for emitter in snap.emitters:
+        if emitter.role == "SOURCE":
+            validate_source(emitter, snap.frame_start)
+    validate_streaks(snap.domain_name, snap.streaks, snap.emitters)
+    validate_pathlines(snap.domain_name, snap.pathlines, snap.solver, snap.streaks,
+                       snap.emitters, snap.frame_count)
+    return params
+
+
 class BakeRunner:
     """One bake of one domain from a BakeSnapshot."""
 
@@ -88,19 +106,7 @@ class BakeRunner:
         """Checks everything that can be wrong with the input and decides between a fresh bake
         and a resume. Raises BakeError; nothing is written."""
         snap = self.snapshot
-        validate_python_side(snap.domain_name, snap.resolution, snap.frame_start,
-                             snap.frame_end, snap.solver)
-        try:
-            params = to_native_params(snap.solver, self._native)
-        except ValueError as e:
-            raise BakeError(f"Plume: domain '{snap.domain_name}': {e}") from None
-        self._params = params
-        for emitter in snap.emitters:
-            if emitter.role == "SOURCE":
-                validate_source(emitter, snap.frame_start)
-        validate_streaks(snap.domain_name, snap.streaks, snap.emitters)
-        validate_pathlines(snap.domain_name, snap.pathlines, snap.solver, snap.streaks,
-                           snap.emitters, snap.frame_count)
+        params = self._params = check_input(snap, self._native)
         try:
             self._solver = self._native.SmokeSolver(params)
         except ValueError as e:

@@ -12,6 +12,7 @@ import numpy as np
 from .. import cache
 from ..native import _native
 from ..settings import BakeError
+from ..jobs import kinds
 from . import surface_edits
 from .surfaces import CACHE_KEY, cache_of
 
@@ -97,15 +98,8 @@ def inputs(ob, frame):
 
 def refine(name, points, nu, nv, density, level):
     """(vertices, quads, density per vertex in [0, 1]) of the control net refined `level` times
-    (OpenSubdiv), no bpy; BakeError naming the surface on bad input."""
-    try:
-        verts, quads, dens = _native.subdivide_mesh(points, nu, nv, level, density, True)
-    except ValueError as e:
-        raise BakeError(f"Plume: mesh export of '{name}': {e}") from None
-    verts = np.asarray(verts, dtype=np.float32)
-    quads = np.asarray(quads, dtype=np.int32)
-    dens = np.clip(np.asarray(dens, dtype=np.float32), 0.0, 1.0)
-    return verts, quads, dens
+    (OpenSubdiv), no bpy; BakeError naming the surface on bad input (jobs/kinds.py)."""
+    return kinds.refine(name, points, nu, nv, density, level)
 
 
 def mesh_object(ob, verts, quads, dens):

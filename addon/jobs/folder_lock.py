@@ -7,7 +7,10 @@ in another Blender or in this one, is refused with a BakeError naming the holder
 
 The lock file holds a JSON record: host, pid, the process's start time (Linux: /proc, so a
 reused pid is not mistaken for the holder), when the job started and its title. The holder also
-keeps an flock() on the file for the job's life and refreshes the file's time every REFRESH_S.
+keeps an flock() on the file for the job's life and refreshes the file's time every REFRESH_S
+(keep_alive(), called by whoever waits for the job: Blender's poll of the job's child, or the
+job command's main thread; no thread of its own). Blender holds the lock while its job's child
+writes, and the child inherits nothing from it: the one writer is the pair.
 
 - The lock is free when the file is missing. It is created whole: the record is written under
   a temporary name and flocked, then hard-linked to ``.plume.lock``, which fails when another
@@ -31,7 +34,6 @@ import errno
 import json
 import os
 import socket
-import threading
 import time
 import uuid
 
@@ -181,11 +183,7 @@ class FolderLock:
         #: The setting naming the folder in reports ("cache_directory '//x/'"), if any.
         self.setting = None
         self._fd, self._made, self._on_lost = fd, made_dirs, on_lost
-        self._stop = threading.Event()
-        self._fd_lock = threading.Lock()  # refresh() never uses a closed (reused) fd number
-        self._beat = threading.Thread(target=self._refresh_loop, daemon=True,
-                                      name="plume folder lock")
-        self._beat.start()
+        self._refreshed = time.monotonic()
 
     @property
     def held(self):
@@ -194,33 +192,32 @@ class FolderLock:
     def refresh(self):
         """Sign of life: the lock file's time set to now. False (and on_lost called) when the
         path no longer names our file (deleted by hand and taken by another writer)."""
-        with self._fd_lock:
-            fd = self._fd
-            if fd is None:
-                return False
-            ours = _same_file(fd, self.path)
-            if ours:
-                try:
-                    os.utime(fd if os.utime in os.supports_fd else self.path)
-                except OSError:
-                    pass
+        fd = self._fd
+        if fd is None:
+            return False
+        self._refreshed = time.monotonic()
+        ours = _same_file(fd, self.path)
+        if ours:
+            try:
+                os.utime(fd if os.utime in os.supports_fd else self.path)
+            except OSError:
+                pass
         if not ours and not self.lost:
             self.lost = True
             if self._on_lost is not None:
                 self._on_lost()
         return ours
 
-    def _refresh_loop(self):
-        while not self._stop.wait(REFRESH_S):
+    def keep_alive(self):
+        """refresh() when REFRESH_S have passed since the last one (cheap to call often)."""
+        if self._fd is not None and time.monotonic() - self._refreshed >= REFRESH_S:
             self.refresh()
 
     def release(self):
         """Deletes the lock file (when still ours) and drops the flock; safe to call twice."""
-        with self._fd_lock:
-            fd, self._fd = self._fd, None
+        fd, self._fd = self._fd, None
         if fd is None:
             return
-        self._stop.set()
         try:
             if _same_file(fd, self.path):
                 os.remove(self.path)

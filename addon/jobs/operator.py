@@ -5,11 +5,13 @@ Surfaces, Build Toon Smoke, Build Flow Graph, Synthesize Fire and Export Mesh.
         def make_runner(self, context):
             return XJob()
 
-execute() runs the job blocking (``blender -b``, scripts, tests: bad input raises RuntimeError).
-invoke() (a button) runs prepare() at once, then run() on a worker thread while a modal timer
-shows "<label> i of N, ~s left (Esc cancels)" in the status bar and the progress cursor; Esc
-cancels within one unit of work; deleting an object the job works on cancels it; the result is
-built on the main thread when the worker is done. A job whose runner forecasts more than
+Both paths run the job's work in a child process (process.py): execute() waits for it
+(``blender -b``, scripts, tests: bad input raises RuntimeError; a crashed child too), invoke()
+(a button) runs prepare() at once and starts the child while a modal timer shows "<label> i of
+N, ~s left (Esc cancels)" in the status bar and the progress cursor; Esc cancels at the child's
+next unit of work (killing it after a grace period); deleting an object the job works on
+cancels it; the result is built on the main thread when the child is done. No Python thread of
+Plume runs in Blender's process. A job whose runner forecasts more than
 LONG_JOB_S asks first (a dialog saying how long, OK starts it); headless, the forecast is printed
 when the job starts and repeated in its report. Blender calls cancel() when it removes the
 modal handler (quit, window closed, file load): the job is aborted and nothing is built."""
@@ -21,7 +23,7 @@ import bpy
 
 from ..settings import BakeError
 from . import registry
-from .worker import Worker
+from .process import JobProcess
 
 #: Seconds between two polls of the modal timer (progress, cancel, deleted objects).
 POLL_S = 0.1
@@ -65,7 +67,7 @@ class JobOperator:
         if runner is None:
             return {'CANCELLED'}
         runner.forecast_said = forecast
-        error = Worker(runner).run_here().error
+        error = self._run_child(runner)
         if error is None and not runner.cancelled:
             try:
                 for _ in runner.main_steps(context):
@@ -74,6 +76,16 @@ class JobOperator:
             except Exception as e:
                 error = e
         return self._conclude(context, runner, error, None)
+
+    @staticmethod
+    def _run_child(runner):
+        """Starts the job's child and waits for it (blocking); the error it ended with."""
+        try:
+            child = JobProcess(runner).start()
+        except Exception as e:
+            return e
+        child.wait()
+        return child.error
 
     # ------------------------------------------------------------------ in the background
     def invoke(self, context, event):
@@ -100,18 +112,21 @@ class JobOperator:
                 col.prop(self, prop.identifier)
 
     def _start(self, context):
-        """prepare(), then run() on a worker thread with a modal timer (the button's path)."""
+        """prepare(), then the child with a modal timer (the button's path)."""
         self._asked = None
         runner = self._prepare(context)
         if runner is None:
             return {'CANCELLED'}
         runner.forecast_said = getattr(self, "_forecast", None)
         self._runner, self._steps, self._error, self._gone = runner, None, None, None
+        try:
+            JobProcess(runner).start()
+        except Exception as e:
+            return self._conclude(context, runner, e, None)
         wm = context.window_manager
         self._timer = wm.event_timer_add(POLL_S, window=context.window)
         wm.progress_begin(0, 100)
         wm.modal_handler_add(self)
-        Worker(runner).start()
         return {'RUNNING_MODAL'}
 
     def modal(self, context, event):
@@ -126,21 +141,21 @@ class JobOperator:
             registry.release(runner)
             return {'CANCELLED'}
         self._check_objects(runner)
-        if not runner.worker.finished:
+        if not runner.child.poll():
             self._show(context, runner)
             return {'PASS_THROUGH'}
         if not self._main_steps_done(context, runner):
             self._show(context, runner)
             return {'PASS_THROUGH'}
         self._end_ui(context)
-        result = self._conclude(context, runner, self._error or runner.worker.error, self._gone)
+        result = self._conclude(context, runner, self._error or runner.child.error, self._gone)
         for area in context.screen.areas if context.screen else ():
             area.tag_redraw()
         return result
 
     def cancel(self, context):
         """Called by Blender when it drops the modal handler (quit, window closed, file load):
-        stop the worker and remove what it wrote; the scene is not touched."""
+        kill the child and remove what it wrote; the scene is not touched."""
         runner = getattr(self, "_runner", None)
         if runner is None:
             return
@@ -194,7 +209,7 @@ class JobOperator:
     def _main_steps_done(self, context, runner):
         """Runs the runner's main-thread steps for up to STEP_BUDGET_S; True when none are
         left (or the job was cancelled, or failed)."""
-        if runner.worker.error is not None or self._error is not None or runner.cancelled:
+        if runner.child.error is not None or self._error is not None or runner.cancelled:
             return True
         if self._steps is None:
             self._steps = runner.main_steps(context)
@@ -246,7 +261,7 @@ class JobOperator:
                 return self._end_report(runner, 'gone', 'WARNING',
                                         f"Plume: {runner.title} cancelled: object '{gone}' was "
                                         "deleted or renamed; nothing was built")
-            if runner.cancelled and not runner.keeps_partial:
+            if runner.cancelled and (runner.killed or not runner.keeps_partial):
                 runner.discard()
                 return self._end_report(runner, 'cancelled', 'WARNING', runner.cancelled_text())
             try:

@@ -3,7 +3,7 @@
 A key names what one job at a time may work on: ("domain", name) for a domain's bake, surfaces,
 toon smoke, flow graph and synthesis, ("flames",) for the scene's flames bake. A second job on a
 held key is refused with the holder's busy_text(); Free Bake and the panels ask busy().
-abort_all() stops every job for a file load or quit: cancel, wait for the worker, discard."""
+abort_all() stops every job for a file load or quit: its child killed, its temporaries removed."""
 
 import traceback
 
@@ -16,8 +16,8 @@ _held = {}
 #: failed, refused, cancelled or aborted): the panels' cache state is read again from there.
 ended = []
 
-#: Seconds abort_all() waits for a cancelled worker (cancel acts within one unit of work).
-ABORT_WAIT_S = 30.0
+#: Seconds abort() waits for a killed child to be reaped.
+ABORT_WAIT_S = 10.0
 
 
 def claim(runner, keys):
@@ -63,16 +63,16 @@ def running():
 
 
 def abort(runner, wait_s=None):
-    """Stops a job from outside its operator: cancel, wait up to `wait_s` (ABORT_WAIT_S) for its
-    worker thread, remove its temporaries, free its keys. Its operator then ends without touching
-    the scene. A worker still running after the wait removes the temporaries itself when it ends
-    (worker.py; at quit, worker.stop_all() waits for it)."""
+    """Stops a job from outside its operator (file load, quit, add-on disabled): its child is
+    killed at once (a bake's complete frames stay; nothing else it wrote was moved into place),
+    its temporaries are removed and its keys freed. Its operator then ends without touching the
+    scene."""
     runner.aborted = True
     runner.outcome = 'aborted'
-    runner.cancel()
-    worker = getattr(runner, "worker", None)
-    if worker is None or worker.join(ABORT_WAIT_S if wait_s is None else wait_s):
-        runner.discard()
+    child = getattr(runner, "child", None)
+    if child is not None:
+        child.join(ABORT_WAIT_S if wait_s is None else wait_s)
+    runner.discard()
     release(runner)
 
 
@@ -81,7 +81,8 @@ def abort_all(wait_s=None):
     jobs = running()
     for runner in jobs:
         runner.aborted = True
-        runner.cancel()  # all at once, then wait: they stop in parallel
+        if getattr(runner, "child", None) is not None:
+            runner.child.kill()  # all at once, then reap: they end in parallel
     for runner in jobs:
         abort(runner, wait_s)
     return len(jobs)

@@ -1,12 +1,16 @@
 """The runner protocol of every long Plume operation (a *job*), no ``bpy``.
 
-A job is split in four parts, so that one operator mixin (operator.py) can run any of them
-blocking (``blender -b``, scripts) or on a worker thread with progress and Esc (the UI):
+A job is split in parts, so that one operator mixin (operator.py) can run any of them blocking
+(``blender -b``, scripts) or in the background with progress and Esc (the UI), and so that its
+work runs in a child process, never in Blender's (process.py, child.py):
 
     runner.prepare(context)   main thread: settings snapshot + validation; BakeError on bad
                               input, nothing written and nothing changed
-    runner.run()              worker thread: the computation; touches no bpy data; polls
-                              runner.cancelled between units of work; new files go to a Staging
+    runner.job_spec()         main thread, once prepare() succeeded: the plain data the child
+                              needs (written to the job file, jobfile.py); may stage()
+    kinds.<kind>(spec, job)   the child: the computation (no bpy); new files go to the staging
+                              folder (a bake: its cache folder, frame by frame)
+    runner.take_result(v)     main thread: what the child returned (default: self.result)
     runner.main_steps(ctx)    main thread, optional: short bpy steps (saving images into the
                               staging folder), each yielding progress; Esc cancels between them
     runner.finish(context)    main thread: commits the staged files, builds the Blender data,
@@ -14,26 +18,23 @@ blocking (``blender -b``, scripts) or on a worker thread with progress and Esc (
 
 and, when the job is cancelled or fails, ``runner.discard()`` removes whatever it wrote, so the
 scene and the cache folder are left as they were. Bakes (keeps_partial) are the exception: their
-per-frame files are complete and resumable, so a cancelled bake keeps them and finish() builds
-what is there.
+per-frame files are complete and resumable, so a cancelled or crashed bake keeps them (and a
+cancelled one that reported its result still builds what is there).
 
 A job that writes a cache folder takes its lock in prepare() (lock_folder(), folder_lock.py)
-before writing anything: one writer per folder across Blenders and hosts, released however the
-job ends. A write that fails for want of room is reported by no_room_text().
-
-cancel() is thread-safe and may come from the main thread (Esc, file load, a deleted object) at
-any time; native objects that run long register with watch() and are cancelled with it.
+before writing anything: one writer per folder across Blenders and hosts, held by Blender for
+the child's whole life, released however the job ends. A write that fails for want of room is
+reported by no_room_text().
 """
 
 import abc
-import threading
 import time
 from dataclasses import dataclass
 from typing import Optional
 
 from ..files import no_room, sweep_temporaries
 from ..settings import BakeError
-from . import folder_lock, quiet, registry
+from . import folder_lock, registry
 from .staging import Staging
 
 
@@ -91,11 +92,11 @@ class JobRunner(abc.ABC):
     prepare_errors = (BakeError,)
     #: True for bakes: a cancelled run keeps its complete frames and finish() still builds them.
     keeps_partial = False
+    #: The work function of the child (jobs/kinds.py).
+    kind = None
 
     def __init__(self):
-        self._cancel = threading.Event()
-        self._lock = threading.Lock()
-        self._watched = []
+        self._cancelled = False
         self._progress = JobProgress()
         #: Called with each JobProgress from the thread that reports it (tests use it).
         self.on_progress = None
@@ -108,8 +109,14 @@ class JobRunner(abc.ABC):
         #: Set when the job was stopped from outside its operator (file load, quit): the
         #: operator must neither finish() nor touch the scene.
         self.aborted = False
-        #: The Worker running run() (worker.py), once started.
-        self.worker = None
+        #: The JobProcess running the job's child (process.py), once started.
+        self.child = None
+        #: What the child returned (take_result()).
+        self.result = None
+        #: The child reported that it stopped early (SIGTERM from Esc, or from another program).
+        self.cancelled_by_child = False
+        #: The child was killed (Esc past its grace period, or an abort): no result.
+        self.killed = False
         #: The status bar's last line (operator.py), for scripts and tests.
         self.status_text = ""
         #: The Forecast said before a long job started (operator.py), for its report.
@@ -140,8 +147,20 @@ class JobRunner(abc.ABC):
         """Snapshot and checks on the main thread; BakeError on bad input, nothing written."""
 
     @abc.abstractmethod
-    def run(self):
-        """The computation, on the worker thread: no bpy."""
+    def job_spec(self):
+        """The plain data the child's kinds.<kind>() needs (main thread, after prepare())."""
+
+    def job_folder(self):
+        """The cache folder holding the job file and log (default: self.folder)."""
+        return self.folder
+
+    def job_name(self):
+        """The job file's name in the folder's jobs/ (the kind; unique where two may run)."""
+        return self.kind
+
+    def take_result(self, value):
+        """What the child's work returned (main thread)."""
+        self.result = value
 
     def main_steps(self, context):
         """Main-thread steps after run(), each yielding a JobProgress; none by default."""
@@ -152,7 +171,8 @@ class JobRunner(abc.ABC):
         """Commits and builds; returns (report kind, text), e.g. ('INFO', "Plume: ...")."""
 
     def stage(self, folder):
-        """A Staging in the cache folder `folder` for run()'s new files (made now); its path."""
+        """A Staging in the cache folder `folder` for the child's new files (made now); its
+        path."""
         self.staging = Staging(folder)
         return self.staging.create()
 
@@ -167,7 +187,7 @@ class JobRunner(abc.ABC):
         return str(exc)
 
     def error_text(self, exc):
-        """The report of an error in run(), main_steps() or finish()."""
+        """The report of an error in the child, main_steps() or finish()."""
         if isinstance(exc, BakeError):
             return str(exc)
         return f"Plume: {self.title} failed: {exc}"
@@ -188,6 +208,9 @@ class JobRunner(abc.ABC):
                 f"there or choose another cache folder, then run {self.title} again; {kept}")
 
     def cancelled_text(self):
+        if self.keeps_partial:  # killed past its grace period: no result to build
+            return (f"Plume: {self.title} cancelled: the frames it finished are kept, and the "
+                    "next run resumes from them")
         return f"Plume: {self.title} cancelled: nothing was changed"
 
     def busy_text(self):
@@ -216,42 +239,26 @@ class JobRunner(abc.ABC):
             lock.release()
 
     def cancel(self):
-        """Thread-safe: run() stops within one unit of work; watched native objects too."""
+        """Esc, a deleted object, a lost lock: the child stops at its next unit of work (and is
+        killed if it does not within its grace period, process.py)."""
         if self.cancelled_at is None:
             self.cancelled_at = time.perf_counter()
-        self._cancel.set()
-        with self._lock:
-            watched = list(self._watched)
-        for obj in watched:
-            obj.cancel()
+        self._cancelled = True
+        if self.child is not None:
+            self.child.cancel()
 
     @property
     def cancelled(self):
-        return self._cancel.is_set()
+        return self._cancelled or self.cancelled_by_child
 
     def check_cancel(self):
-        """Raises JobCancelled when cancel() was called (for Python loops in run())."""
-        if self._cancel.is_set():
+        """Raises JobCancelled when cancel() was called (main-thread steps)."""
+        if self.cancelled:
             raise JobCancelled()
-
-    def watch(self, native_object):
-        """cancel() also cancels `native_object` (anything with a thread-safe cancel())."""
-        with self._lock:
-            self._watched.append(native_object)
-        if self._cancel.is_set():
-            native_object.cancel()
-        return native_object
-
-    def unwatch(self, native_object):
-        with self._lock:
-            if native_object in self._watched:
-                self._watched.remove(native_object)
 
     # ------------------------------------------------------------------ progress
     def set_progress(self, done, total, label=None, seconds_left=None):
-        """Called by run() (any thread): `done` of `total` units. A worker waits here while
-        Blender undoes or redoes (quiet.py)."""
-        quiet.park()
+        """`done` of `total` units (the child's reports, main-thread steps)."""
         last = self._progress
         label = last.label if label is None else label
         same = (label, int(total)) == (last.label, last.total) and last.stage_started
@@ -262,5 +269,5 @@ class JobRunner(abc.ABC):
             self.on_progress(p)
 
     def progress(self):
-        """The latest JobProgress (polled by the operator's timer on the main thread)."""
+        """The latest JobProgress (the operator's timer shows it)."""
         return self._progress

@@ -1,8 +1,10 @@
 """plume.bake and plume.cache_free on the active domain.
 
-plume.bake is a job (jobs/): blocking in execute() (``blender -b``, scripts), on a worker thread
-with status-bar progress and Esc from a button. A cancelled bake keeps its complete frames (a
-later bake with the same settings resumes from them) and builds the Volume over them."""
+plume.bake is a job (jobs/): its frames are computed in a child process (a crash there costs
+the bake, never Blender), waited for in execute() (``blender -b``, scripts), in the background
+with status-bar progress and Esc from a button. A cancelled or crashed bake keeps its complete
+frames (a later bake with the same settings resumes from them); a cancelled one builds the
+Volume over them."""
 
 import os
 
@@ -11,8 +13,8 @@ import bpy
 from .. import bake_runner, cache, cache_state
 from ..native import _native
 from ..build import volume
-from ..jobs import JobOperator, JobRunner, folder_lock, registry
-from ..mantaflow_trace import MantaflowTraceRunner
+from ..jobs.operator import JobOperator
+from ..jobs import JobRunner, folder_lock, registry
 from ..settings import BakeError
 from ..version import VERSION
 from ..snapshot import NOT_A_DOMAIN, active_domain, cache_folder_of, take_snapshot
@@ -24,39 +26,32 @@ def domain_key(name):
 
 
 class BakeJob(JobRunner):
-    """The smoke bake of one domain (bake_runner.BakeRunner, or MantaflowTraceRunner when the
-    domain traces a Mantaflow cache) as a job."""
+    """The smoke bake of one domain as a job: the child runs bake_runner.BakeRunner (or
+    MantaflowTraceRunner when the domain traces a Mantaflow cache, jobs/kinds.py)."""
 
     title = "Bake"
+    kind = "bake"
     keeps_partial = True  # complete frames stay and resume
 
     def prepare(self, context):
-        """Snapshot + validation; BakeError on bad input, nothing written."""
+        """Snapshot + the checks that need no solver; BakeError on bad input, nothing written
+        (the child checks the rest, the emitters' voxels, before it writes anything)."""
         snap = take_snapshot(context, addon_version=VERSION)
         self.domain_name = snap.domain_name
         self.objects = (snap.domain_name,)
+        if snap.mantaflow is None:
+            bake_runner.check_input(snap, _native)
         self.claim(domain_key(snap.domain_name))
         self.lock_folder(snap.cache_folder, f"cache_directory '{snap.cache_directory}'")
-        # motion_source 'MANTAFLOW': trace the Mantaflow cache's velocity instead of simulating.
-        runner_class = bake_runner.BakeRunner if snap.mantaflow is None else MantaflowTraceRunner
-        self.bake = runner_class(snap, _native, progress=self._frame_done)
-        self.bake.prepare()
+        self.snapshot, self.folder = snap, snap.cache_folder
         self.set_progress(0, snap.frame_count, "frame")
 
-    def _frame_done(self, p):
-        self.set_progress(p.frames_done, p.frames_total, "frame", seconds_left=p.seconds_left)
-
-    def run(self):
-        self.result = self.bake.run()
-
-    def cancel(self):
-        super().cancel()
-        if getattr(self, "bake", None) is not None:
-            self.bake.cancel()  # the solver, tracers and recorder stop within one step
+    def job_spec(self):
+        return {"snapshot": self.snapshot}
 
     def finish(self, context):
         """Builds/updates the Volume object from what the cache holds."""
-        snap, result = self.bake.snapshot, self.result
+        snap, result = self.snapshot, self.result
         domain = bpy.data.objects.get(snap.domain_name)
         if domain is not None:
             volume.build_volume(domain, snap.cache_folder, snap.frame_start, result.frames_done,

@@ -1,10 +1,10 @@
 """plume.flames_bake and plume.flames_free (structural_flames.txt): bake the scene's Flame
 Sources into flames_####.vdb + spines_####.npz, then the "Plume Flames" Volume, the "Plume Flame
 Spines" curve and the flame lights; plume.flames_bake_spines_keyframes turns the cached spines
-into keyed curve objects. plume.flames_bake is a job (jobs/): blocking in execute() (``blender
--b``, scripts), on a worker thread with status-bar progress and Esc from a button. Every input
-is checked before anything is written, so bad input changes nothing; a cancelled bake keeps and
-builds the frames it finished."""
+into keyed curve objects. plume.flames_bake is a job (jobs/): the frames are computed in a
+child process, waited for in execute() (``blender -b``, scripts), in the background with
+status-bar progress and Esc from a button. Every input is checked before anything is written,
+so bad input changes nothing; a cancelled bake keeps and builds the frames it finished."""
 
 import os
 import time
@@ -12,11 +12,11 @@ import time
 import bpy
 
 from .. import flames
-from ..native import _native
 from ..build import flame_spine_keys, flame_spines, flames_volume
 from ..snapshot import flames_cache_folder
 from ..snapshot.flames import flames_snapshot
-from ..jobs import JobOperator, JobRunner, folder_lock, registry
+from ..jobs.operator import JobOperator
+from ..jobs import JobRunner, folder_lock, registry
 from ..settings import BakeError
 
 #: The registry key of the scene's flames bake (one at a time).
@@ -24,31 +24,30 @@ FLAMES_KEY = ("flames",)
 
 
 class FlamesJob(JobRunner):
-    """flames.FlameBakeRunner as a job; the Flame Sources are the objects it works on."""
+    """flames.FlameBakeRunner as a job (its child validates every keyed value before it writes
+    anything); the Flame Sources are the objects it works on."""
 
     title = "Bake Flames"
+    kind = "flames"
     keeps_partial = True
 
     def prepare(self, context):
         self.t0 = time.perf_counter()
         self.claim(FLAMES_KEY)
         snap = flames_snapshot(context)
+        flames.validate_snapshot(snap)
         self.lock_folder(snap.folder, "the flames' cache_directory "
                                       f"'{context.scene.plume_flames.cache_directory}'")
         self.objects = tuple(dict.fromkeys(src.name for src in snap.sources))
-        self.bake = flames.FlameBakeRunner(_native, snap, progress=self._frame_done,
-                                           cancel=lambda: self.cancelled)
+        self.snap, self.folder = snap, snap.folder
         self.set_progress(0, snap.frame_count, "frame")
 
-    def _frame_done(self, done, total):
-        self.set_progress(done, total, "frame")
-
-    def run(self):
-        self.result = self.bake.run()
+    def job_spec(self):
+        return {"snapshot": self.snap}
 
     def finish(self, context):
         """Builds the Blender objects over what was baked; the report."""
-        scene, snap, result = context.scene, self.bake.snap, self.result
+        scene, snap, result = context.scene, self.snap, self.result
         f = scene.plume_flames
         frames = result.frames
         if frames < 1:

@@ -1,9 +1,9 @@
 """plume.flowgraph_build and plume.fire_synthesize (graph_fire_synthesis.txt §4.3-5): the
 selected baked fire domains (Record Pathlines on) become the states of a flow graph stored with
 the active domain; Synthesize walks it for any number of frames into a fire Volume. Both are jobs
-(jobs/): every input is checked on the main thread before anything is written, the work runs on
-the worker thread into a staging folder, and the files move into place and the Blender data is
-built only when it succeeded, so bad input or a cancel changes nothing."""
+(jobs/): every input is checked on the main thread before anything is written, the work runs in
+the job's child process into a staging folder, and the files move into place and the Blender
+data is built only when it succeeded, so bad input, a cancel or a crash changes nothing."""
 
 import os
 import time
@@ -13,7 +13,8 @@ import bpy
 from .. import cache, flowgraph
 from ..native import _native
 from ..build import fire_points, fire_volume
-from ..jobs import JobOperator, JobProgress, JobRunner
+from ..jobs.operator import JobOperator
+from ..jobs import JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
 from ..snapshot.flowgraph import (fire_source, frame_inputs,  # noqa: F401  (scripts)
@@ -40,11 +41,12 @@ def show_cost_image(domain, folder):
 
 
 class FlowGraphJob(JobRunner):
-    """Build Flow Graph as a job: the native cost-matrix job on the worker thread (progress and
-    cancel from it), flowgraph.npz and the cost image staged; finish() commits them and fills
-    the panel's summary."""
+    """Build Flow Graph as a job: the native cost-matrix job in the child (progress from it;
+    Esc kills the child when the job cannot stop inside), flowgraph.npz and the cost image
+    staged; finish() commits them and fills the panel's summary."""
 
     title = "Build Flow Graph"
+    kind = "flowgraph"
 
     def prepare(self, context):
         self.t0 = time.perf_counter()
@@ -63,30 +65,17 @@ class FlowGraphJob(JobRunner):
         error = cache.check_writable(self.folder)
         if error is not None:
             raise BakeError(f"Plume: cache folder {self.folder} is not writable ({error})")
-        self._job = self._job_started = None
         self.set_progress(0, 0, "reading the pathlines")  # until the cost matrix reports
 
-    def _attach(self, job):
-        self._job_started = time.perf_counter()
-        self._job = self.watch(job)
-
-    def progress(self):
-        """The native cost-matrix job's own progress while it runs."""
-        job = self._job
-        if job is None:
-            return super().progress()
-        return JobProgress(int(100 * job.progress), 100, "cost matrix (%)",
-                           stage_started=self._job_started)
-
-    def run(self):
-        self.built = flowgraph.build_graph(_native, self.states, self.settings,
-                                           self.stage(self.folder), on_job=self._attach)
+    def job_spec(self):
+        return {"settings": self.settings, "states": [(st.name, st.folder) for st in self.states],
+                "staging": self.stage(self.folder)}
 
     def finish(self, context):
         domain = bpy.data.objects[self.domain_name]
         g = domain.plume.domain.flowgraph
         self.staging.commit()
-        s, states = self.built["summary"], self.states
+        s, states = self.result["summary"], self.states
         g.state_names = ", ".join(f"{i}: {st.name}" for i, st in enumerate(states))
         g.summary = (f"{sum(s['nodes'])} nodes, {s['kept']} of {s['candidates']} transitions "
                      f"(ε = {s['epsilon']:.3g} in [{s['a']:.3g}, {s['b']:.3g}]), pruned "
@@ -117,11 +106,12 @@ SYNTHESIS_KEY = ("fire synthesis",)
 
 
 class SynthesisJob(JobRunner):
-    """Synthesize Fire as a job: the random walk and the rasterized frames on the worker thread
-    into the staging folder's fire/; finish() commits them and builds the fire Volume (and the
-    point preview)."""
+    """Synthesize Fire as a job: the random walk and the rasterized frames in the child into the
+    staging folder's fire/; finish() commits them and builds the fire Volume (and the point
+    preview)."""
 
     title = "Synthesize Fire"
+    kind = "synthesis"
     prepare_errors = (BakeError, ValueError)
 
     def prepare(self, context):
@@ -146,18 +136,13 @@ class SynthesisJob(JobRunner):
             settings.emitter_transforms = source_transforms(
                 context, source, settings.frame_start, settings.frame_end, steps_per_frame)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)
-        self.synthesis = flowgraph.SynthesisRunner(_native, graph, states, settings, folder,
-                                                   progress=self._frame_done,
-                                                   cancel=lambda: self.cancelled, owner=owner)
-        self.settings, self.states = settings, states
+        flowgraph.SynthesisRunner(_native, graph, states, settings, folder, owner=owner)  # checks
+        self.settings, self.states, self.owner = settings, states, owner
         self.set_progress(0, settings.frame_end - settings.frame_start + 1, "frame")
 
-    def _frame_done(self, done, total):
-        self.set_progress(done, total, "frame")
-
-    def run(self):
-        self.synthesis.out_folder = self.stage(self.folder)
-        self.result = self.synthesis.run()
+    def job_spec(self):
+        return {"settings": self.settings, "folder": self.folder, "owner": self.owner,
+                "staging": self.stage(self.folder)}
 
     def finish(self, context):
         domain = bpy.data.objects[self.domain_name]

@@ -4,12 +4,15 @@ selected ones), or, with the domain active (the panel's buttons), on all of its 
 Mesh is a job (jobs/): the surfaces are read on the main thread, refined on the worker thread,
 and the meshes are built only when every surface succeeded."""
 
+import os
+
 import bpy
 
 from ..build import surface_edits as edits
 from ..build import surface_mesh
 from ..build.surfaces import CACHE_KEY, DOMAIN_KEY, cache_of
-from ..jobs import JobOperator, JobRunner
+from ..jobs.operator import JobOperator
+from ..jobs import JobRunner
 from ..settings import BakeError
 
 
@@ -123,10 +126,11 @@ class PLUME_OT_surfaces_bake_keyframes(PlumeSurfaceOperator, bpy.types.Operator)
 
 class ExportMeshJob(JobRunner):
     """Export Mesh as a job: every target surface's control net and density map read by
-    prepare(), refined (OpenSubdiv) one surface after the other by run(), the MESH objects made
-    by finish()."""
+    prepare(), refined (OpenSubdiv) one surface after the other by the child, the MESH objects
+    made by finish()."""
 
     title = "Export Mesh"
+    kind = "export_mesh"
 
     def __init__(self, level):
         super().__init__()
@@ -141,18 +145,19 @@ class ExportMeshJob(JobRunner):
         self.objects = tuple(ob.name for ob, _s, _c in targets)
         self.claim(*(("surface", name) for name in self.objects))
         self.inputs = [surface_mesh.inputs(ob, frame) for ob, _s, _c in targets]
+        self.folder = os.path.dirname(surface_mesh.sheet_file(targets[0][0], frame))
         self.set_progress(0, len(self.inputs), "surface")
 
-    def run(self):
-        self.meshes = []
-        for i, args in enumerate(self.inputs):
-            self.check_cancel()
-            self.meshes.append(surface_mesh.refine(*args, self.level))
-            self.set_progress(i + 1, len(self.inputs), "surface")
+    def job_name(self):
+        """Two exports of one domain's surfaces may run at once: a name of its own."""
+        return f"export_mesh_{os.getpid()}_{id(self):x}"
+
+    def job_spec(self):
+        return {"inputs": self.inputs, "level": self.level}
 
     def finish(self, context):
         names = [surface_mesh.mesh_object(bpy.data.objects[name], *mesh).name
-                 for name, mesh in zip(self.objects, self.meshes)]
+                 for name, mesh in zip(self.objects, self.result)]
         return 'INFO', f"Plume: exported {', '.join(names)}"
 
     def busy_text(self):

@@ -1,22 +1,23 @@
 """plume.surfaces_build on the active baked domain (smoke_surfaces.txt §3.3-3.4): streak files ->
 h per candidate group -> clusters (h0) -> greedy order -> one SURFACE object per cluster with
 per-frame control points and a density-map material. A job (jobs/): the settings are checked on
-the main thread, everything is computed on the worker thread (no bpy) into a staging folder,
-the density-map images are saved in short main-thread steps, and only then are the files moved
-into place and the objects built, so bad input or a cancel changes nothing."""
+the main thread, everything is computed in the job's child process (no bpy) into a staging
+folder, the density-map images are saved in short main-thread steps, and only then are the
+files moved into place and the objects built, so bad input, a cancel or a crash changes
+nothing."""
 
-import os
 import time
 
 import bpy
 import numpy as np
 
-from .. import cache, files
+from .. import cache
 from ..native import _native
 from .. import streak_surfaces as ss
 from .. import sheet_render, surfaces_forecast
 from ..build import surfaces as build
-from ..jobs import Forecast, JobOperator, JobRunner
+from ..jobs.operator import JobOperator
+from ..jobs import Forecast, JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
 from ..snapshot.streaks import sheet_settings
@@ -71,12 +72,13 @@ def compute_distances(domain):
 
 
 class SurfacesJob(JobRunner):
-    """Build Surfaces as a job: prepare() checks the settings and the bake's manifest, run()
-    computes h, the clusters, the NURBS animations and the density maps and stages the
-    control-point files, main_steps() saves the density maps (bpy images) into the staging
-    folder, finish() commits and builds the objects."""
+    """Build Surfaces as a job: prepare() checks the settings and the bake's manifest, the
+    child computes h, the clusters, the NURBS animations and the density maps and stages the
+    control-point files (jobs/kinds.py), main_steps() saves the density maps (bpy images) into
+    the staging folder, finish() commits and builds the objects."""
 
     title = "Build Surfaces"
+    kind = "surfaces"
     prepare_errors = (BakeError, ValueError, RuntimeError)
 
     def forecast(self, context):
@@ -113,56 +115,14 @@ class SurfacesJob(JobRunner):
         if size is not None:
             surfaces_forecast.check_memory(domain.name, *size)
 
-    def run(self):
-        folder, m = self.folder, self.manifest
-        frame_start, last = int(m["frame_start"]), int(m["last_complete_frame"])
-        self.frame_start = frame_start
-        self.set_progress(0, 0, "reading the streak files")
-        frames = ss.load_frames(_native, folder, frame_start, last)
-        self.check_cancel()
-        self.set_progress(0, 0, "distances h between streaklines")
-        groups = ss.group_distances(_native, frames)
-        _distances[self.domain_name] = (_cache_key(folder, m), groups)
-        self.check_cancel()
-        plans = ss.plan_surfaces(_native, groups, self.h0)
-        if not plans:
-            raise BakeError(f"Plume: threshold h0 = {self.h0} joins no two streaklines: raise "
-                            "streak_threshold (0 = the default mean of h)")
-        self.lines = sum(len(p.sources) for p in plans)
-        anims = []
-        for i, plan in enumerate(plans):
-            self.set_progress(i, len(plans), "surface")
-            self.check_cancel()
-            anims.append(ss.surface_animation(_native, frames, plan, float(m["cell_size"])))
-        self.anims = anims
-        self.maps = self._density_maps(folder, m, anims, self.settings)
-        staged = self.stage(folder)
-        for i, anim in enumerate(anims):
-            self.check_cancel()
-            files.save_npz(cache.surface_path(staged, i), control_points=anim.control_points,
-                           frame_start=frame_start, nu=anim.nu, nv=anim.nv, order_u=anim.order_u,
-                           order_v=anim.order_v)
+    def job_spec(self):
+        return {"folder": self.folder, "manifest": self.manifest, "h0": self.h0,
+                "settings": self.settings, "staging": self.stage(self.folder)}
 
-    def _density_maps(self, folder, m, anims, settings):
-        """§3.4 density map of every surface at every frame (from the VDB density grids)."""
-        res = tuple(m["resolution"])
-        origin, cell = tuple(m["origin"]), float(m["cell_size"])
-        interp = getattr(_native.Interpolation, m["settings"]["solver"]["interpolation"])
-        frame_start = int(m["frame_start"])
-        maps = [[] for _ in anims]
-        count = len(anims[0].surfaces)
-        for n in range(count):
-            self.set_progress(n, count, "density map of frame")
-            self.check_cancel()
-            path = cache.volume_path(folder, frame_start + n)
-            if not os.path.isfile(path):
-                raise BakeError(f"Plume: volume file {path} is missing: bake the domain again")
-            density = ss.dense_density(_native, path, res)
-            for i, anim in enumerate(anims):
-                maps[i].append(ss.density_image(
-                    _native, anim.surfaces[n], density, origin, cell, settings["k_u"],
-                    settings["k_v"], interp, anim.particles, anim.nv))
-        return maps
+    def take_result(self, value):
+        self.result = value
+        self.frame_start, self.lines = value["frame_start"], value["lines"]
+        self.anims, self.maps = value["anims"], value["maps"]
 
     def main_steps(self, context):
         """Saves the density maps as EXR files into the staging folder with Blender's image

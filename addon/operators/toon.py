@@ -1,9 +1,9 @@
 """plume.toon_build on the active baked domain (cartoon_smoke.txt §2): toon particles from the
 bake's volume frames -> toon_####.bin, a point object following them, billboards with a stencil
 cut-out material, and the "Plume Depth Differences" compositor outlines. A job (jobs/): every
-input is checked on the main thread before anything is written or created, the particles run on
-the worker thread into a staging folder, and the files move into place and the objects are built
-only when that succeeded, so bad input or a cancel changes nothing."""
+input is checked on the main thread before anything is written or created, the particles run in
+the job's child process into a staging folder, and the files move into place and the objects
+are built only when that succeeded, so bad input, a cancel or a crash changes nothing."""
 
 import time
 
@@ -12,20 +12,21 @@ import bpy
 from .. import toon
 from ..native import _native
 from ..build import toon_compositor, toon_nodes, toon_points
-from ..jobs import JobOperator, JobRunner
+from ..jobs.operator import JobOperator
+from ..jobs import JobRunner
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of, emitter_snapshots
 from ..snapshot.toon import toon_settings
 from ..toon_sources import ToonSourceCells
-from ..toon_stencils import write_stencil
 from .bake import domain_key
 
 
 class ToonJob(JobRunner):
-    """Build Toon Smoke as a job: toon.ToonRunner on the worker thread writing toon_####.bin
-    (and the generated stencil) into the staging folder; finish() commits and builds."""
+    """Build Toon Smoke as a job: toon.ToonRunner in the child writing toon_####.bin (and the
+    generated stencil) into the staging folder; finish() commits and builds."""
 
     title = "Build Toon Smoke"
+    kind = "toon"
 
     def prepare(self, context):
         self.t0 = time.perf_counter()
@@ -49,26 +50,22 @@ class ToonJob(JobRunner):
         # keyed Density / Emit Particles per frame (§2.1 emission follows both).
         frame_start, last = int(manifest["frame_start"]), int(manifest["last_complete_frame"])
         emitters = emitter_snapshots(context, domain, frame_start, last)
-        sources = ToonSourceCells(_native, toon.toon_grid(manifest), emitters, frame_start)
-        sources.check()
-        self.toon = toon.ToonRunner(_native, folder, manifest, settings, domain.name,
-                                    progress=self._frame_done, cancel=lambda: self.cancelled,
-                                    sources=sources)
+        ToonSourceCells(_native, toon.toon_grid(manifest), emitters, frame_start).check()
+        toon.to_params(_native, settings, domain.name)  # BakeError now, not in the child
+        self.emitters, self.manifest = emitters, manifest
         self.folder, self.settings = folder, settings
-        self.set_progress(0, self.toon.last_frame - self.toon.frame_start + 1, "frame")
+        self.set_progress(0, last - frame_start + 1, "frame")
 
-    def _frame_done(self, done, total):
-        self.set_progress(done, total, "frame")
+    def job_spec(self):
+        return {"folder": self.folder, "manifest": self.manifest, "settings": self.settings,
+                "domain_name": self.domain_name, "emitters": self.emitters,
+                "staging": self.stage(self.folder)}
 
-    def run(self):
-        self.toon.out_folder = self.stage(self.folder)
-        self.result = self.toon.run()
-        if self.cancelled:
-            return
+    def take_result(self, value):
+        self.result = value["result"]
         s = self.settings
-        self.stencil = (s.stencil_image if s.stencil == 'IMAGE'
-                        else self.staging.final_path(write_stencil(self.toon.out_folder,
-                                                                   s.stencil)))
+        self.stencil = (s.stencil_image if s.stencil == 'IMAGE' or value["stencil"] is None
+                        else self.staging.final_path(value["stencil"]))
 
     def finish(self, context):
         domain = bpy.data.objects[self.domain_name]
