@@ -65,6 +65,54 @@ class GroupDistances:
 
 
 @dataclass
+class HeldDistances:
+    """What Blender keeps of one group's h when a job's child computed it (Build Surfaces): the
+    held pairs, the mean, the reach and Figure 4's curve, as plain arrays. Enough for the
+    panel's live count (summary()) and Most Surfaces' pick; clustering needs the native
+    StreakDistances (compute_distances(), or the next build)."""
+
+    size: int
+    mean: float
+    reach: float
+    a: np.ndarray
+    b: np.ndarray
+    h: np.ndarray
+    values: np.ndarray
+    surfaces: np.ndarray
+    lines: np.ndarray
+
+    def pairs(self):
+        return self.a, self.b, self.h
+
+    def curve(self):
+        return self.values, self.surfaces, self.lines
+
+    def summary(self, h0):
+        """(surfaces, streaklines) for threshold h0, as the native cluster_summary (pairs with
+        h < h0 joined); ValueError above the reach or for a bad h0."""
+        if not np.isfinite(h0) or h0 < 0.0:
+            raise ValueError(f"h0 must be a finite number >= 0 (got {h0})")
+        if h0 > self.reach:
+            raise ValueError(f"h0 = {h0} is above the reach {self.reach} of these distances")
+        below = int(np.searchsorted(self.values, h0, side="left"))
+        return (0, 0) if below == 0 else (int(self.surfaces[below - 1]),
+                                          int(self.lines[below - 1]))
+
+
+def held_distances(groups):
+    """{group: GroupDistances with h a HeldDistances}: the plain-data copy a child returns."""
+    out = {}
+    for key, g in groups.items():
+        a, b, h = g.h.pairs()
+        values, surfaces, lines = g.h.curve()
+        out[key] = GroupDistances(group=g.group, ids=np.asarray(g.ids), h=HeldDistances(
+            size=int(g.h.size), mean=float(g.h.mean), reach=float(g.h.reach), a=np.asarray(a),
+            b=np.asarray(b), h=np.asarray(h), values=np.asarray(values),
+            surfaces=np.asarray(surfaces), lines=np.asarray(lines)))
+    return out
+
+
+@dataclass
 class SurfacePlan:
     group: int
     threshold: float
@@ -147,7 +195,9 @@ def check_threshold(h0, domain_name=""):
 
 def group_threshold(native, g, h0):
     """h0 if > 0, else the group's default: the mean of its h values (§3.3)."""
-    return float(h0) if h0 > 0.0 else float(native.default_threshold(g.h))
+    if h0 > 0.0:
+        return float(h0)
+    return g.h.mean if isinstance(g.h, HeldDistances) else float(native.default_threshold(g.h))
 
 
 def summary(native, groups, h0):
@@ -158,7 +208,9 @@ def summary(native, groups, h0):
     would decide are not held; Build Surfaces at that h0 widens them)."""
     surfaces = lines = 0
     for g in groups.values():
-        s, n = native.cluster_summary(g.h, group_threshold(native, g, h0))
+        h0_g = group_threshold(native, g, h0)
+        s, n = (g.h.summary(h0_g) if isinstance(g.h, HeldDistances)
+                else native.cluster_summary(g.h, h0_g))
         surfaces += s
         lines += n
     return surfaces, lines

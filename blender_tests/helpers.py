@@ -322,3 +322,13 @@ def run_cancelled(op_class, job, after=1):
         return getattr(bpy.ops.plume, op_class.bl_idname.split(".")[1])()
     finally:
         op_class.make_runner = saved
+
+
+def pid_alive(pid):
+    """True while process `pid` exists and is not a zombie (a child Blender has not reaped)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            state = f.read().rsplit(b")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return False
+    return state not in (b"Z", b"X")

@@ -148,7 +148,9 @@ class FlamesTest(unittest.TestCase):
 
     def test_cancelled_keeps_finished_frames(self):
         """Bake Flames cancelled after two frames (from its progress report, as Esc does in the
-        UI): like a smoke bake it keeps and builds the frames it finished, and no partial file."""
+        UI): like a smoke bake it keeps and builds the frames it finished, and no partial file.
+        The cancel reaches the child while it computes the next frame, which it finishes (a
+        unit of work): two or three frames."""
         from plume.operators.flames import FlamesJob, PLUME_OT_flames_bake
         folder = os.path.join(self.tmp, "cancelled")
         flame_scene(folder)
@@ -156,10 +158,11 @@ class FlamesTest(unittest.TestCase):
         self.assertEqual(run_cancelled(PLUME_OT_flames_bake, job, after=2), {'FINISHED'})
         self.assertTrue(job.result.cancelled)
         f = bpy.context.scene.plume_flames
-        self.assertEqual(f.frames_baked, 2)
+        self.assertIn(f.frames_baked, (2, 3))
+        done = f.frames_baked
         self.assertEqual([n for n in tree_listing(folder) if not n.endswith(".json")],
-                         ["flames_0001.vdb", "flames_0002.vdb", "spines_0001.npz",
-                          "spines_0002.npz"])
+                         [f"flames_{i:04d}.vdb" for i in range(1, done + 1)]
+                         + [f"spines_{i:04d}.npz" for i in range(1, done + 1)])
         self.assertIsNotNone(bpy.data.objects.get(f.volume_object))
         from plume.operators.flames import is_baking
         self.assertFalse(is_baking())

@@ -335,31 +335,29 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         self.assertEqual(g.points_object, "")
 
     def test_4_cancelled_jobs_leave_nothing(self):
-        """Build Flow Graph cancelled while its native cost-matrix job runs, Synthesize Fire
-        after two frames: CANCELLED, and the scene, the panel's summary and every cache file
-        are as before (the staged graph and frames are removed)."""
+        """Build Flow Graph cancelled at the child's first report (reading the pathlines, then
+        the native cost-matrix job, which cancels with it or is killed after the grace period),
+        Synthesize Fire after two frames: CANCELLED, and the scene, the panel's summary and
+        every cache file are as before (the staged graph and frames are removed)."""
         from plume.operators.flowgraph import (FlowGraphJob, PLUME_OT_fire_synthesize,
                                                PLUME_OT_flowgraph_build, SynthesisJob)
-
-        class CancelledInCostMatrix(FlowGraphJob):
-            def _attach(self, job):
-                super()._attach(job)
-                self.cancel()  # watch(): the native job is cancelled with the runner
         g = self.windy.plume.domain.flowgraph
         if not g.summary:
             self.skipTest("needs the graph of test_1")
         select([self.calm, self.windy], self.windy)
         before = self.state()
-        job = CancelledInCostMatrix()
-        self.assertEqual(run_cancelled(PLUME_OT_flowgraph_build, job, after=10 ** 9),
-                         {'CANCELLED'})
+        job = FlowGraphJob()
+        self.assertEqual(run_cancelled(PLUME_OT_flowgraph_build, job,
+                                       after=lambda p: job.child is not None), {'CANCELLED'})
         self.assertTrue(job.cancelled)
         self.assertEqual(self.state(), before)
         select_only(self.windy)
         g.frame_start, g.frame_end, g.point_preview = 1, 20, True
         job = SynthesisJob()
         self.assertEqual(run_cancelled(PLUME_OT_fire_synthesize, job, after=2), {'CANCELLED'})
-        self.assertEqual(job.progress().done, 2)
+        # The child reports every 0.1 s and stops at its next frame once told: frames of ~25 ms
+        # pass meanwhile (measured 8), never the whole synthesis.
+        self.assertTrue(2 <= job.progress().done < 20, job.progress())
         self.assertEqual(self.state(), before)
 
     def test_7_fire_material_upgrade(self):

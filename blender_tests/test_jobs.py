@@ -1,6 +1,7 @@
 """The job mechanism headless (addon/jobs/): a cancelled job leaves nothing behind, one job per
 domain at a time, loading a file aborts a running job, the staging folder commits atomically,
-and the process exits cleanly with a worker still running (jobs_exit.py).
+and the process exits cleanly with a job's child still running (jobs_exit.py); no Plume thread
+runs in Blender's process.
 
 A 24³ streak bake of 20 frames with a camera is built once; Build Surfaces, Build Toon Smoke and
 Export Mesh then run through their operators (blocking, as scripts call them) with a runner
@@ -23,8 +24,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
 
-from helpers import (assert_reports_error, incense_streak_scene, reset_scene, rmtree, run,  # noqa: E402
-                     run_cancelled, select_only, temp_dir, tree_listing)
+from helpers import (assert_reports_error, incense_streak_scene, pid_alive, reset_scene,  # noqa: E402
+                     rmtree, run, run_cancelled, select_only, temp_dir, tree_listing)
 
 RESOLUTION = 24
 FRAMES = 20
@@ -125,8 +126,8 @@ class JobsTest(unittest.TestCase):
             def prepare(self, context):
                 pass
 
-            def run(self):
-                pass
+            def job_spec(self):
+                return {}
 
             def finish(self, context):
                 return 'INFO', ""
@@ -144,24 +145,26 @@ class JobsTest(unittest.TestCase):
 
     # ------------------------------------------------------------------ file load
     def test_7_loading_a_file_aborts_a_running_job(self):
-        """A job on its worker thread when another file is loaded: the persistent load_pre
-        handler cancels it, waits for the worker and removes its staging folder."""
-        from plume.jobs import Worker, registry
+        """A job's child running when another file is loaded: the persistent load_pre handler
+        kills it, reaps it and removes its staging folder and job files."""
+        from plume.jobs import registry
+        from plume.jobs.process import JobProcess
         from plume.operators.toon import ToonJob
         before = tree_listing(self.tmp)
         job = ToonJob()
-        started = []
-        job.on_progress = lambda p: started.append(p.done) or time.sleep(0.05)
         job.prepare(bpy.context)
-        Worker(job).start()
+        JobProcess(job).start()
         t0 = time.perf_counter()
-        while len(started) < 3 and time.perf_counter() - t0 < 30:
+        while job.progress().done < 3 and time.perf_counter() - t0 < 30:
+            job.child.poll()
             time.sleep(0.01)
+        self.assertFalse(job.child.finished, "the toon build ended before the file load")
         path = os.path.join(self.tmp, "other.blend")
         bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
         bpy.ops.wm.open_mainfile(filepath=path)
         try:
-            self.assertTrue(job.aborted and job.cancelled and job.worker.finished)
+            self.assertTrue(job.aborted and job.child.finished and job.child.killed)
+            self.assertFalse(pid_alive(job.child.pid), "the job's child outlived the file load")
             self.assertIsNone(job.staging.path)
             self.assertEqual(registry.running(), [])
             os.remove(path)
@@ -169,56 +172,37 @@ class JobsTest(unittest.TestCase):
         finally:
             type(self).dom = bpy.data.objects["Domain"]
 
-    def test_12_undo_holds_the_workers(self):
-        """Undo and redo free every datablock with the GIL released, and Blender then reads the
-        GIL holder's thread state without the GIL (jobs/quiet.py: the windowed UI test crashed in
-        about 1 run in 4). The persistent undo_pre/redo_pre handlers stop every worker at its
-        next unit of work, waiting with the GIL released, until undo_post/redo_post: called here
-        as Blender calls them, the worker's progress stands still in between, then the job ends."""
-        from plume.jobs import JobRunner, Worker, handlers, quiet
+    def test_12_no_plume_thread_in_blender(self):
+        """A job's work runs in its child: while one runs, Blender's process has no Python
+        thread of Plume (Blender reads the GIL holder's thread state without the GIL, so one
+        broke its heap: the windowed UI test crashed in about 1 run in 4 before), and Plume
+        registers no undo/redo handler to park one."""
+        import threading
+        from plume.jobs.process import JobProcess
+        from plume.operators.toon import ToonJob
         for name in ("undo_pre", "redo_pre", "undo_post", "redo_post"):
-            names = [h.__name__ for h in getattr(bpy.app.handlers, name)]
-            self.assertIn("undo_post" if name.endswith("post") else "undo_pre", names, name)
-
-        class Counter(JobRunner):
-            title = "Count"
-
-            def prepare(self, context):
-                pass
-
-            def run(self):
-                for i in range(400):
-                    self.set_progress(i + 1, 400)
-                    time.sleep(0.002)
-
-            def finish(self, context):
-                return 'INFO', ""
-        job = Counter()
-        Worker(job).start()
-        t0 = time.perf_counter()
-        while job.progress().done < 5 and time.perf_counter() - t0 < 30:
-            time.sleep(0.005)
+            self.assertEqual([h for h in getattr(bpy.app.handlers, name)
+                              if "plume" in (h.__module__ or "")], [], name)
+        job = ToonJob()
+        job.prepare(bpy.context)
+        JobProcess(job).start()
         try:
-            handlers.undo_pre(None)
-            held = job.progress().done
-            time.sleep(0.3)
-            self.assertIn(job.worker.thread_id, quiet._parked)
-            self.assertEqual(job.progress().done, held)
+            job.child.poll()
+            self.assertNotEqual(job.child.pid, os.getpid())
+            self.assertTrue(pid_alive(job.child.pid))
+            self.assertEqual([t.name for t in threading.enumerate()
+                              if t is not threading.main_thread()], [])
         finally:
-            handlers.undo_post(None)
-        job.worker.thread.join(30)
-        self.assertTrue(job.worker.finished)
-        self.assertEqual(job.progress().done, 400)
-        self.assertGreater(held, 4)
+            from plume.jobs import registry
+            registry.abort(job)
+        self.assertFalse(pid_alive(job.child.pid))
 
-    def test_11_exit_with_a_running_worker(self):
-        """The process ends while a bake's worker runs, nobody cancelling it (jobs_exit.py):
-        Python's shutdown cancels and joins it. Exit code 0, no abort ("terminate called
-        without an active exception" came from a worker still in native code when Python
-        finalized), and the bake stopped with whole frames, not run to its end (in the bpy
-        module nothing else stops it: without worker.py's shutdown hook its non-daemon thread
-        ran all 200 frames; Blender itself disables the add-ons as it quits)."""
+    def test_11_exit_with_a_running_child(self):
+        """The process ends while a bake's child runs, nobody cancelling it (jobs_exit.py): the
+        child is killed with it. Exit code 0, no abort, the child gone, and the bake stopped
+        with whole frames, not run to its end."""
         import json
+        import re
         cache = temp_dir("plume_exit_")
         script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "jobs_exit.py")
         if os.path.basename(bpy.app.binary_path or "").startswith("blender"):
@@ -229,8 +213,13 @@ class JobsTest(unittest.TestCase):
         out = proc.stdout + proc.stderr
         print("  " + next((line for line in out.splitlines() if "exiting" in line), "?"))
         self.assertEqual(proc.returncode, 0, out[-3000:])
-        self.assertIn("exiting with the worker at frame", out)
+        m = re.search(r"exiting with the child \(pid (\d+)\) at frame", out)
+        self.assertIsNotNone(m, out[-3000:])
         self.assertNotRegex(out, r"terminate called|Traceback")
+        t0 = time.perf_counter()  # the kernel's death signal may take a moment to be reaped
+        while pid_alive(int(m.group(1))) and time.perf_counter() - t0 < 5:
+            time.sleep(0.05)
+        self.assertFalse(pid_alive(int(m.group(1))), "the bake's child outlived Blender")
         folder = os.path.join(cache, "Domain")
         with open(os.path.join(folder, "manifest.json")) as f:
             last = json.load(f)["last_complete_frame"]

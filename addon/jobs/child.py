@@ -203,7 +203,10 @@ def run_job(job_file, report_fd=None, parent=None):
             out["result"] = work(spec, job)
         except JobCancelled:
             out["result"] = None
-        except BaseException as e:  # reported below
+        except BaseException as e:  # reported below (after a cancel: the way it stopped)
+            if job.cancelled:
+                out["result"] = None
+                return
             out["error"] = e
             if not isinstance(e, BakeError) and no_room(e) is None:
                 traceback.print_exc()

@@ -120,7 +120,7 @@ def surfaces(spec, job):
                        order_v=anim.order_v)
         anim.surfaces = []  # per-frame fit data: the operator builds from the control points
     return {"frame_start": frame_start, "lines": sum(len(p.sources) for p in plans),
-            "anims": anims, "maps": maps}
+            "anims": anims, "maps": maps, "distances": ss.held_distances(groups)}
 
 
 def _density_maps(native, job, folder, m, anims, settings):

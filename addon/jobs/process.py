@@ -118,6 +118,8 @@ class JobProcess:
             jobfile.remove_job(self.folder, self.name)
             raise
         _live.add(self)
+        if r.cancelled:  # cancelled while it was starting (prepare()'s progress, a script)
+            self.cancel()
         return self
 
     def _spawn(self, job_file):
@@ -212,7 +214,8 @@ class JobProcess:
                                          self.folder)
             if m.get("cancelled"):
                 r.cancelled_by_child = True
-            r.take_result(value)
+            if value is not None or not m.get("cancelled"):  # None: stopped before a result
+                r.take_result(value)
             jobfile.remove_job(self.folder, self.name)
         elif code == 1 and m is not None and "error" in m:
             self.error = _exception_of(m)
@@ -220,7 +223,9 @@ class JobProcess:
                 jobfile.remove_job(self.folder, self.name)
             else:  # a bug: the traceback is in the log
                 self.error = RuntimeError(f"{m['error']} (its log: {self.paths['log']})")
-        elif self.killed:  # Esc past its grace, or an abort (quit, file load): nothing to build
+        elif self.killed or (self._term_at is not None and code == -signal.SIGTERM):
+            # Esc past its grace (or before the child could hear it), or an abort (quit, file
+            # load): nothing to build
             r.killed = True
             jobfile.remove_job(self.folder, self.name)
         else:

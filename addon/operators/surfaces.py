@@ -123,6 +123,8 @@ class SurfacesJob(JobRunner):
         self.result = value
         self.frame_start, self.lines = value["frame_start"], value["lines"]
         self.anims, self.maps = value["anims"], value["maps"]
+        # The panel's live count as h0 changes (never computed in draw()).
+        _distances[self.domain_name] = (_cache_key(self.folder, self.manifest), value["distances"])
 
     def main_steps(self, context):
         """Saves the density maps as EXR files into the staging folder with Blender's image
