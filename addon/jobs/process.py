@@ -73,7 +73,16 @@ def signal_name(number):
     return f"{name} ({meaning})" if meaning else name
 
 
+def _stack_line(line):
+    """A line of a Python stack dump (faulthandler's, a traceback's): left out of the tail."""
+    s = line.strip()
+    return (s.startswith(("File ", "Extension modules:", "Current thread", "Thread 0x",
+                          "Stack (most recent", "Traceback (most recent"))
+            or line.startswith("    "))
+
+
 def log_tail(path, lines=LOG_TAIL_LINES):
+    """The last `lines` lines of the child's log that say something (stack dumps left out)."""
     try:
         with open(path, "rb") as f:
             f.seek(0, os.SEEK_END)
@@ -81,7 +90,8 @@ def log_tail(path, lines=LOG_TAIL_LINES):
             text = f.read().decode("utf-8", "replace")
     except OSError:
         return []
-    return [line.rstrip() for line in text.splitlines() if line.strip()][-lines:]
+    return [line.strip() for line in text.splitlines()
+            if line.strip() and not _stack_line(line)][-lines:]
 
 
 class JobProcess:
