@@ -56,6 +56,7 @@ SUBSET = [
     "test_toon_smoke.py",      # toon smoke: Build Toon Smoke, render's outline = _native's
     "test_flowgraph_fire.py",  # flow-graph fire: 2 states, Flow Graph, Synthesize Fire, render
     "test_flames.py",          # structural flames: Bake Flames, grids, spines, lights, render
+    "test_job_child.py",       # jobs in a child: injected crashes cost the job, resume, CLI
 ]
 #: bpy wheels whose process teardown crashes after the tests: the 4.2 module frees registered
 #: classes in C++ static destructors after Python has ended (SIGSEGV in bpy_class_free under
