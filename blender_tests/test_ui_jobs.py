@@ -1,6 +1,6 @@
 """The UI path of Plume's jobs, and what an artist may do while one runs. Invoked from a button,
 every long operator (Bake, Bake Flames, Build Toon Smoke, Build Surfaces, Synthesize Fire, Build
-Flow Graph) runs modal on a worker thread with status-bar progress; while it runs the artist
+Flow Graph) runs modal, its work in a child process, with status-bar progress; while it runs the artist
 presses Esc, opens another file, undoes and redoes, deletes or renames the object it works on,
 changes its settings, presses its pipeline's Free, saves the file, or quits Blender. Blender
 never crashes or hangs, and:
@@ -40,7 +40,7 @@ sys.path[:0] = [HERE, os.path.join(HERE, "ui")]
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import native, reset_scene, run, select_only, tree_listing  # noqa: E402
+from helpers import native, pid_alive, reset_scene, run, select_only, tree_listing  # noqa: E402
 import job_cases  # noqa: E402
 
 OPERATORS = ("bake", "flames", "toon", "surfaces", "synth", "graph")
@@ -50,9 +50,8 @@ STOPPING = ("esc", "load", "delete", "rename")
 GOING_ON = ("undo", "redo", "settings", "free", "save")
 CASES = [f"{o}:{a}" for o in OPERATORS for a in STOPPING + GOING_ON] + \
     ["surfaces:decline", "surfaces:ask"]
-#: One process each. quit0: the operator's wait for its worker cut to 0 s, so the worker is
-#: still inside native code when Blender tears down (what aborted with "terminate called
-#: without an active exception" before the workers were joined at Python's shutdown).
+#: One process each. quit0: the operator's wait for its child cut to 0 s, so the child is
+#: killed and not reaped before Blender tears down (it must not outlive Blender all the same).
 QUITS = [f"{o}:quit" for o in OPERATORS] + ["bake:undo+quit", "bake:free+quit", "bake:quit0"]
 #: Esc, a deleted or renamed object or a file load stops a job within one unit of work (a
 #: frame, a surface, a density map, a slice of the cost matrix) plus a poll of the modal timer
@@ -137,11 +136,11 @@ class UiJobsTest(unittest.TestCase):
 
     def assert_ran_modal_with_progress(self, c):
         """Invoked from the Properties editor: the operator returned RUNNING_MODAL at once, the
-        job ran on a thread of its own while Blender kept handling timers, and the status bar
+        job ran in a child process while Blender kept handling timers, and the status bar
         said "<label> i of N, ~s left (Esc cancels)"."""
         self.assertEqual(c["job_title"], TITLES[c["operator"]])
         self.assertEqual(c["invoke"], ["RUNNING_MODAL"])
-        self.assertFalse(c["worker_is_main_thread"])
+        self.assertTrue(c["ran_in_child"])
         statuses = [s[4] for s in c["seen"] if s[4]]
         self.assertTrue(statuses, c["seen"])
         for text in statuses:
@@ -149,10 +148,10 @@ class UiJobsTest(unittest.TestCase):
         self.assertTrue(any("s left" in t for t in statuses), statuses)
 
     def assert_consistent(self, c):
-        """No staging folder or unfinished write left, the worker ended; a bake's frames are
-        the manifest's; a flames bake's frames are whole (a VDB and its spines each)."""
+        """No staging folder, job file or unfinished write left, the child gone; a bake's frames
+        are the manifest's; a flames bake's frames are whole (a VDB and its spines each)."""
         self.assertEqual(c["leftovers"], [])
-        self.assertFalse(c.get("worker_alive"))
+        self.assertFalse(c.get("child_alive"))
         if c["operator"] == "bake":
             self.assertEqual(len(c["vdb_files"]), c["done_after"])
         if c["operator"] == "flames":
@@ -263,7 +262,7 @@ class UiJobsTest(unittest.TestCase):
         self.assertEqual(c["invoke"], ["RUNNING_MODAL"])
         self.assertFalse(c["job_before_answer"])  # nothing ran before the answer
         self.assertEqual(c["job_title"], "Build Surfaces")
-        self.assertFalse(c["worker_is_main_thread"])
+        self.assertTrue(c["ran_in_child"])
         new = sorted(set(c["objects_after"]) - set(c["objects_before"]))
         self.assertTrue(new and all("_surface_" in n for n in new), new)
 
@@ -283,6 +282,8 @@ class UiJobsTest(unittest.TestCase):
                 c = res["cases"][-1]
                 files = tree_listing(c["cache"])
                 self.assertEqual(job_cases.leftovers(c["cache"]), [])
+                self.assertIsNotNone(c.get("child_pid"), c)
+                self.assertFalse(pid_alive(c["child_pid"]), "the job's child outlived Blender")
                 if c["operator"] == "flames":
                     self.assert_flames_whole(c["cache"])
                 elif c["operator"] != "bake":

@@ -12,8 +12,11 @@ farm: it takes the lock itself and prints its progress.
 
 Exit status: 0 the job ran (its result file written; cancelled or not), 1 it failed (the error
 reported and printed), 2 the job file cannot be run (usage, damaged, from a newer Plume).
-PLUME_JOB_FAULT="<what>@<n>" makes the child fail when its progress reaches n units, for the
-tests: segv, abort, kill (as the out-of-memory killer does), exit (status 7), raise, hang."""
+Two variables are read by the child only, for the tests: PLUME_JOB_FAULT="<what>@<n>" makes it
+fail when its progress reaches n units (segv, abort, kill as the out-of-memory killer does, exit
+with status 7, raise, hang); PLUME_JOB_GATE="<file>@<n>" holds it at n units until <file>
+exists (at most GATE_S; a cancel goes through), so that a windowed test can act on a job of a
+small scene before it ends."""
 
 import argparse
 import ctypes
@@ -34,6 +37,8 @@ from .runner import JobCancelled
 #: Seconds between two progress reports (and lock refreshes) of the main thread.
 REPORT_S = 0.1
 FAULT_ENV = "PLUME_JOB_FAULT"
+GATE_ENV = "PLUME_JOB_GATE"
+GATE_S = 10.0
 _PR_SET_PDEATHSIG = 1
 
 
@@ -42,7 +47,8 @@ class ChildJob:
     objects that cancel(), on_cancel() hooks, follow() a progress source polled by the main
     thread (a native job's own progress)."""
 
-    def __init__(self, fault=None):
+    def __init__(self, fault=None, gate=None):
+        self._gate = gate
         self._cancel = threading.Event()
         self._lock = threading.Lock()
         self._hooks = []
@@ -56,6 +62,11 @@ class ChildJob:
         self._source = None
         if self._fault is not None and total > 0 and done >= self._fault[1]:
             _inject(self._fault[0])
+        if self._gate is not None and total > 0 and done >= self._gate[1]:
+            path, self._gate = self._gate[0], None
+            end = time.monotonic() + GATE_S
+            while not os.path.exists(path) and not self.cancelled and time.monotonic() < end:
+                time.sleep(0.01)
 
     def follow(self, source):
         """source() -> (done, total, label) is polled instead of set_progress' values."""
@@ -97,10 +108,9 @@ class ChildJob:
             raise JobCancelled()
 
 
-def _fault():
-    """(what, n) of PLUME_JOB_FAULT, or None."""
-    text = os.environ.get(FAULT_ENV, "")
-    what, _, n = text.partition("@")
+def _at_units(name):
+    """(what, n) of a "<what>@<n>" variable, or None."""
+    what, _, n = os.environ.get(name, "").rpartition("@")
     if not what:
         return None
     return what, int(n or 1)
@@ -186,7 +196,7 @@ def run_job(job_file, report_fd=None, parent=None):
         return 2
     title, kind = header.get("title", header["kind"]), header["kind"]
     reporter = _Reporter(report_fd, title)
-    job = ChildJob(_fault())
+    job = ChildJob(_at_units(FAULT_ENV), _at_units(GATE_ENV))
     lock = None
     if parent is None:  # by hand or on a farm: one writer per folder, as in Blender
         try:

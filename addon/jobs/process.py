@@ -276,11 +276,14 @@ class JobProcess:
             pass
 
     def join(self, timeout=None):
-        """Kills the child and reaps it (abort): True when it is gone."""
+        """Kills the child and reaps it (abort): True when it is gone. Its job files go either
+        way (a killed child writes nothing more)."""
         self.kill()
         try:
             self.proc.wait(timeout)
         except subprocess.TimeoutExpired:
+            self.runner.killed = True
+            jobfile.remove_job(self.folder, self.name)
             return False
         self.poll()
         return True

@@ -23,9 +23,8 @@ OPERATORS = {"bake": ("bake", "cache_free"), "flames": ("flames_bake", "flames_f
 #: report before the action: it is well under way, and not near its end.
 TRIGGER = {"bake": 3, "flames": 3, "surfaces": 2, "toon": 2, "graph": 5, "synth": 5}
 #: The bake of the bake cases: 40³ over BAKE_FRAMES frames (a few seconds; the quit case's
-#: resume and the straight bake it is compared with take as long each). 20, not 10: an undo
-#: waits for the worker's next frame (jobs/quiet.py), and with 10 frames of ~0.04 s the
-#: undo+quit case's quit once came after the last frame.
+#: resume and the straight bake it is compared with take as long each). 20, not 10: with 10
+#: frames of ~0.04 s the undo+quit case's quit once came after the last frame.
 BAKE_RESOLUTION, BAKE_FRAMES = 40, 20
 FLAME_FRAMES = 6
 SYNTH_FRAMES = 30
@@ -142,10 +141,10 @@ def change_settings(operator, ob):
 
 
 def leftovers(cache):
-    """Files that must never stay in a cache folder once a job has ended: staging folders and
-    unfinished writes."""
+    """Files that must never stay in a cache folder once a job has ended (and did not crash):
+    staging folders, job files (jobs/) and unfinished writes."""
     out = []
     for root, dirs, files in os.walk(cache):
-        out += [os.path.join(root, n) for n in dirs if n.startswith(".plume_job_")]
+        out += [os.path.join(root, n) for n in dirs if n.startswith(".plume_job_") or n == "jobs"]
         out += [os.path.join(root, n) for n in files if n.endswith(".tmp")]
     return out

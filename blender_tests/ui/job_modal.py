@@ -20,18 +20,19 @@ operators and their scenes):
               free     the pipeline's Free (plume.cache_free, plume.flames_free)
               save     save the .blend file under a new name
               quit     quit Blender (the last case: it ends the process)
-              quit0    the same with the operator's wait for its worker cut to 0 s
-                       (registry.ABORT_WAIT_S): the worker is still in native code when
-                       Blender tears down, and Python's shutdown must stop it
+              quit0    the same with the operator's wait for its child cut to 0 s
+                       (registry.ABORT_WAIT_S): the child is killed and not waited for;
+                       it must still not outlive Blender
               A+quit   action A, then quit Blender at the next poll while the job still runs
               ask      the job is made "long" (LONG_JOB_S = 0): the button opens a dialog saying
                        how long; Return starts the job, which then runs to its end
               decline  the same dialog answered with Esc: nothing starts
 
 A case sets its scene up, invokes the operator from the Properties editor's context
-('INVOKE_DEFAULT': worker thread + modal timer), polls the job until it has done a few units and
-the status bar shows them with the time left, acts, waits for the job to end, and records what it
-saw: the job's progress over time, the thread it ran on, how the job ended and its report, the
+('INVOKE_DEFAULT': the job's child process + modal timer), polls the job until it has done a few
+units and the status bar shows them with the time left, acts, waits for the job to end, and
+records what it saw: the job's progress over time, its child's pid, how the job ended and its
+report, the
 seconds from the action to its end, the scene's objects and the cache folder's files before and
 after. RESULT (JSON) is rewritten after every case (and before quitting), so a crash still leaves
 the cases before it."""
@@ -40,7 +41,6 @@ import contextlib
 import json
 import os
 import sys
-import threading
 import time
 import traceback
 
@@ -48,7 +48,7 @@ import bpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]
-from helpers import enable_addon, tree_listing  # noqa: E402
+from helpers import enable_addon, pid_alive, tree_listing  # noqa: E402
 import job_cases  # noqa: E402
 
 ARGS = sys.argv[sys.argv.index("--") + 1:]
@@ -75,44 +75,29 @@ def window_and_area():
 
 @contextlib.contextmanager
 def override():
-    """The window context for an operator call from a timer, with Plume's workers parked for it
-    (plume.jobs.quiet.held(): Blender reads the override from Python without the GIL)."""
-    from plume.jobs import quiet
+    """The window context for an operator call from a timer (as a script calls one)."""
     win, area = window_and_area()
-    with quiet.held(), bpy.context.temp_override(window=win, area=area, screen=win.screen):
+    with bpy.context.temp_override(window=win, area=area, screen=win.screen):
         yield
 
 
-#: Seconds the gate below holds a job's worker at most (the action comes within a few polls).
-GATE_S = 10.0
-
-
-def install_gate():
-    """Holds each job's worker once it has reported TRIGGER units, until the case has acted
-    (or the job was cancelled, or GATE_S passed): on a fast, quiet machine the small scenes'
-    jobs (a 0.3 s flow graph) would otherwise end before the status bar has shown their
+def close_gate(operator):
+    """The job's child will hold once it has reported TRIGGER units, until open_gate() (or a
+    cancel, or 10 s: PLUME_JOB_GATE, jobs/child.py): on a fast, quiet machine the small
+    scenes' jobs (a 0.3 s flow graph) would otherwise end before the status bar has shown their
     progress and the action could come. Only the wait is added; the job's work is unchanged,
-    and once released the worker goes straight back into its next (native) unit, where the
-    action finds it. Wraps JobRunner.set_progress, which run() calls on the worker thread."""
-    from plume.jobs import runner as job_runner
-    cls = job_runner.JobRunner
-    if getattr(cls, "_plume_test_gate", False):
-        return
-    report = cls.set_progress
+    and once released the child goes straight back into its next (native) unit, where the
+    action finds it."""
+    state["gate_file"] = os.path.join(TMP, f"gate_{state['case']}")
+    os.environ["PLUME_JOB_GATE"] = f"{state['gate_file']}@{job_cases.TRIGGER[operator]}"
+    state["gate_open"] = False
 
-    def gated(self, done, total, *args, **kwargs):
-        report(self, done, total, *args, **kwargs)
-        if threading.current_thread() is threading.main_thread() or state["gate_open"]:
-            return
-        operator = CASES[state["case"]][0] if 0 <= state["case"] < len(CASES) else None
-        if operator is None or not (total > 0 and done >= job_cases.TRIGGER[operator]):
-            return
-        end = time.perf_counter() + GATE_S
-        while not state["gate_open"] and not self.cancelled and time.perf_counter() < end:
-            time.sleep(0.01)
 
-    cls.set_progress = gated
-    cls._plume_test_gate = True
+def open_gate():
+    state["gate_open"] = True
+    path = state.get("gate_file")
+    if path and not os.path.exists(path):
+        open(path, "w").close()
 
 
 def job():
@@ -124,7 +109,6 @@ def job():
 def start_case():
     operator, action = CASES[state["case"]]
     enable_addon()
-    install_gate()
     os.makedirs(SHARED, exist_ok=True)
     t0 = time.perf_counter()
     ob, cache = job_cases.set_up(operator, TMP, SHARED)
@@ -145,7 +129,7 @@ def start_case():
     long_job_s = job_operator.LONG_JOB_S
     if action in ("ask", "decline"):
         job_operator.LONG_JOB_S = 0.0  # every forecast is "long": the dialog opens
-    state["gate_open"] = False
+    close_gate(operator)
     try:
         with override():
             op = getattr(bpy.ops.plume, job_cases.OPERATORS[operator][0])
@@ -174,9 +158,10 @@ def act(rec, j):
     if "+" in rec["action"]:
         state["then"] = rec["action"].split("+")[1]
     rec["done_at_action"] = j.progress().done
-    rec["worker_is_main_thread"] = j.worker.thread_id == threading.main_thread().ident
+    rec["ran_in_child"] = j.child is not None and j.child.pid != os.getpid()
+    rec["child_pid"] = j.child.pid if j.child is not None else None
     state["acted_at"] = time.perf_counter()
-    state["gate_open"] = True
+    open_gate()
     ob = bpy.data.objects[rec["object"]]
     if action == "esc":
         win = bpy.context.window_manager.windows[0]
@@ -220,7 +205,7 @@ def answer_dialog(rec):
     win.event_simulate(type=key, value='PRESS')
     win.event_simulate(type=key, value='RELEASE')
     state["acted_at"] = time.perf_counter()
-    state["gate_open"] = True
+    open_gate()
 
 
 def end_case(rec):
@@ -229,10 +214,11 @@ def end_case(rec):
     rec["seconds_to_stop"] = time.perf_counter() - state["acted_at"]
     if j is not None:
         rec["seconds_to_cancel"] = (j.cancelled_at - state["acted_at"]) if j.cancelled_at else None
-        rec["seconds_worker_ran_on"] = (j.worker.ended_at - state["acted_at"]
-                                        if j.worker.ended_at else None)
+        child = j.child
+        rec["seconds_child_ran_on"] = (child.ended_at - state["acted_at"]
+                                       if child is not None and child.ended_at else None)
         rec["outcome"], rec["report"] = j.outcome, j.report_text
-        rec["worker_alive"] = j.worker.alive
+        rec["child_alive"] = child is not None and pid_alive(child.pid)
     rec["objects_after"] = sorted(o.name for o in bpy.data.objects)
     rec["files_after"] = tree_listing(rec["cache"])
     rec["leftovers"] = job_cases.leftovers(rec["cache"])
@@ -289,7 +275,8 @@ def step():
         if j is not None:
             state["job"] = j
             rec["job_title"] = j.title
-            rec["worker_is_main_thread"] = j.worker.thread_id == threading.main_thread().ident
+            rec["ran_in_child"] = j.child is not None and j.child.pid != os.getpid()
+            rec["child_pid"] = j.child.pid if j.child is not None else None
         elif state["job"] is None and rec["action"] == "ask" and \
                 time.perf_counter() - state["acted_at"] < 5.0:
             return POLL_S  # Return not handled yet
