@@ -52,12 +52,13 @@ class ChildJob:
         self._cancel = threading.Event()
         self._lock = threading.Lock()
         self._hooks = []
-        self._progress = (0, 0, "", None)
+        self._progress = None  # nothing reported yet: Blender keeps what prepare() said
         self._source = None
         self._fault = fault
 
     def set_progress(self, done, total, label=None, seconds_left=None):
-        label = self._progress[2] if label is None else label
+        if label is None:
+            label = self._progress[2] if self._progress is not None else ""
         self._progress = (int(done), int(total), label, seconds_left)
         self._source = None
         if self._fault is not None and total > 0 and done >= self._fault[1]:
@@ -162,7 +163,7 @@ class _Reporter:
             pass
 
     def progress(self, p):
-        if p == self._last:
+        if p is None or p == self._last:
             return
         self._last = p
         if self.fd is not None:

@@ -207,7 +207,8 @@ class JobProcess:
             return
         if "progress" in m:
             done, total, label, left = m["progress"]
-            self.runner.set_progress(done, total, label, seconds_left=left)
+            # An empty label: the unit prepare() named ("frame") goes on.
+            self.runner.set_progress(done, total, label or None, seconds_left=left)
         elif "done" in m or "error" in m:
             self._message = m
 

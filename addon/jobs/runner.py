@@ -97,7 +97,7 @@ class JobRunner(abc.ABC):
 
     def __init__(self):
         self._cancelled = False
-        self._progress = JobProgress()
+        self._progress = JobProgress(label="starting")  # until prepare() or the child says more
         #: Called with each JobProgress from the thread that reports it (tests use it).
         self.on_progress = None
         #: Registry keys this job holds ("domain", name): one job per key at a time.
@@ -177,9 +177,13 @@ class JobRunner(abc.ABC):
         return self.staging.create()
 
     def discard(self):
-        """Removes the job's temporaries (cancelled or failed); safe to call twice."""
+        """Removes the job's temporaries (cancelled, failed, killed): its staging folder and
+        the unfinished writes a killed child left in the folders it holds; safe twice."""
         if self.staging is not None:
             self.staging.discard()
+        for lock in self.folder_locks:
+            if lock.held:
+                sweep_temporaries(lock.folder)
 
     # ------------------------------------------------------------------ messages
     def refusal_text(self, exc):

@@ -114,6 +114,7 @@ class SurfacesJob(JobRunner):
         size = surfaces_forecast.shot_size(_native, self.folder, self.manifest)
         if size is not None:
             surfaces_forecast.check_memory(domain.name, *size)
+        self.set_progress(0, 0, "reading the streak files")
 
     def job_spec(self):
         return {"folder": self.folder, "manifest": self.manifest, "h0": self.h0,
