@@ -49,8 +49,11 @@ def bake(cache, wait_after_first_frame):
     scene(cache)
     job = BakeJob()
 
-    def first_frame(p):
-        if p.done == 1:
+    said = []
+
+    def first_frame(p):  # the first report Blender reads from the bake's child (1 frame or more)
+        if p.done >= 1 and not said:
+            said.append(p.done)
             say(f"BAKING {os.getpid()}")
             sys.stdin.read()
 

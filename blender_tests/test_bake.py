@@ -158,8 +158,8 @@ class BakeTest(unittest.TestCase):
         assert_same_frames(self, frame_file, resumed, straight, (5, 6, FRAMES))
 
     def test_cancel_from_another_thread_then_resume(self):
-        # What the UI does (invoke: worker thread, Esc -> cancel), without the modal handler,
-        # which never runs in -b.
+        # What a job's child does (jobs/child.py: the bake on a thread of its own, SIGTERM from
+        # Esc -> cancel from its main thread), here in this process.
         import threading
         from plume import _native, bake_runner, snapshot
         cache = os.path.join(self.tmp, "cache")

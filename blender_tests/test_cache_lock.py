@@ -290,30 +290,30 @@ class CacheLockTest(unittest.TestCase):
         self.assert_baked()
 
     def test_lock_released_when_a_file_load_aborts_the_bake(self):
-        # The bake on its worker thread (as from a button), held after frame 1 until it is
-        # cancelled; loading a file aborts it (quit takes the same path: registry.abort_all).
-        from plume.jobs import Worker, registry
+        # The bake's child running (as from a button) past frame 1; loading a file aborts it
+        # (quit takes the same path: registry.abort_all). The lock is Blender's for the child's
+        # whole life: a second writer is refused while the child writes.
+        from plume.jobs import registry
+        from plume.jobs.process import JobProcess
         from plume.operators.bake import BakeJob
-        job, at_frame, gate = BakeJob(), threading.Event(), threading.Event()
-
-        def progress(p):
-            if p.done >= 1:
-                at_frame.set()
-                gate.wait()
-        cancel = job.cancel
-
-        def cancel_and_go_on():
-            cancel()
-            gate.set()
-        job.on_progress, job.cancel = progress, cancel_and_go_on
+        job = BakeJob()
         job.prepare(bpy.context)
-        Worker(job).start()
-        self.assertTrue(at_frame.wait(CHILD_TIMEOUT_S))
+        os.environ["PLUME_JOB_GATE"] = os.path.join(self.tmp, "never") + "@1"  # held at frame 1
+        try:
+            JobProcess(job).start()
+        finally:
+            del os.environ["PLUME_JOB_GATE"]
+        t0 = time.perf_counter()
+        while job.progress().done < 1 and time.perf_counter() - t0 < CHILD_TIMEOUT_S:
+            job.child.wait(0.05)
+        self.assertFalse(job.child.finished, "the bake ended before the file load")
         self.assertTrue(os.path.exists(self.lock_file()))
+        with self.assertRaises(folder_lock().LockHeld):
+            folder_lock().acquire(self.folder, "Bake")
         path = os.path.join(self.tmp, "other.blend")
         bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
         bpy.ops.wm.open_mainfile(filepath=path)
-        self.assertTrue(job.aborted and job.worker.finished)
+        self.assertTrue(job.aborted and job.child.finished)
         self.assertEqual(registry.running(), [])
         self.assertFalse(os.path.exists(self.lock_file()), "the aborted bake kept its lock")
 

@@ -8,8 +8,9 @@ Two ways to run out of room, both right after frame K - 1 is complete (from the 
 progress report, so the next write is frame K's VDB file):
 - a real full disk: a 64 MB tmpfs mounted for the test and filled up by a filler file (skipped
   where mounting is not allowed, e.g. an unprivileged CI container);
-- the file size limit: RLIMIT_FSIZE lowered in this process with SIGXFSZ ignored, so writes
-  past the limit fail with EFBIG (runs everywhere).
+- the file size limit: RLIMIT_FSIZE lowered for the bake's child process (prlimit), whose
+  writes past it fail with EFBIG (the child ignores SIGXFSZ; runs everywhere).
+The bake's child waits after frame K - 1 (PLUME_JOB_GATE) until the room has run out.
 
 Run: blender_tests/run.py --blender 3.4 blender_tests/test_disk_full.py
 """
@@ -63,22 +64,28 @@ def fill_up(folder):
     return path
 
 
-def bake_running_out_at(frame_done, run_out):
-    """plume.bake with run_out() called once when `frame_done` frames are complete."""
+def bake_running_out_at(frame_done, run_out, gate_dir):
+    """plume.bake with run_out(job) called once when `frame_done` frames are complete, while
+    the bake's child waits at that frame (PLUME_JOB_GATE, a file in `gate_dir`)."""
     from plume.operators.bake import BakeJob, PLUME_OT_bake
     job, fired = BakeJob(), []
+    gate = os.path.join(gate_dir, "gate")
 
     def hook(p):
         if p.done == frame_done and not fired:
             fired.append(p.done)
-            run_out()
+            run_out(job)
+            open(gate, "w").close()
     job.on_progress = hook
     saved = PLUME_OT_bake.make_runner
     PLUME_OT_bake.make_runner = lambda self, context: job
+    os.environ["PLUME_JOB_GATE"] = f"{gate}@{frame_done}"
     try:
         return bpy.ops.plume.bake()
     finally:
         PLUME_OT_bake.make_runner = saved
+        del os.environ["PLUME_JOB_GATE"]
+        os.remove(gate) if os.path.exists(gate) else None
 
 
 class DiskFullTest(unittest.TestCase):
@@ -118,7 +125,7 @@ class DiskFullTest(unittest.TestCase):
         straight = self.straight()
         folder = self.bake_into(cache)
         with self.assertRaises(RuntimeError) as cm:
-            bake_running_out_at(K - 1, run_out)
+            bake_running_out_at(K - 1, run_out, self.tmp)
         make_room()
         msg = str(cm.exception)
         print("  report:", msg.strip())
@@ -157,24 +164,14 @@ class DiskFullTest(unittest.TestCase):
         self.mount = mount
         cache = os.path.join(mount, "cache")
         filler = []
-        self.run_out_and_resume(cache, lambda: filler.append(fill_up(mount)),
+        self.run_out_and_resume(cache, lambda job: filler.append(fill_up(mount)),
                                 lambda: [os.remove(p) for p in filler], "the disk is full")
 
     def test_file_size_limit(self):
-        soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
-        handler = signal.getsignal(signal.SIGXFSZ)
-
-        def restore():
-            resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
-            signal.signal(signal.SIGXFSZ, handler)
-            self.restore = None
-
-        def limit():
-            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # writes past it fail with EFBIG
-            resource.setrlimit(resource.RLIMIT_FSIZE, (FILE_LIMIT, hard))
-            self.restore = restore
-        self.run_out_and_resume(os.path.join(self.tmp, "cache"), limit,
-                                lambda: self.restore and self.restore(),
+        def limit(job):  # the bake's child: it ignores SIGXFSZ, so its writes get EFBIG
+            _soft, hard = resource.prlimit(job.child.pid, resource.RLIMIT_FSIZE)
+            resource.prlimit(job.child.pid, resource.RLIMIT_FSIZE, (FILE_LIMIT, hard))
+        self.run_out_and_resume(os.path.join(self.tmp, "cache"), limit, lambda: None,
                                 "the file size limit is reached")
 
     def test_python_writer_leaves_no_half_file(self):

@@ -170,8 +170,9 @@ class KillResumeTest(unittest.TestCase):
         the checkpoint before, which is kept (state.prev.bin, tracer_state.prev.bin): the next
         bake resumes from it and ends equal to a straight bake, volumes and streaks. The kill is
         made exact here: every frame checkpoints, and the manifest write of frame KILL_AT fails
-        as the process would have died."""
-        from plume import bake_runner
+        as the process would have died (the bake runner runs in this process for that, as the
+        job's child runs it)."""
+        from plume import bake_runner, snapshot
         kill_at, frames = 5, 8
         killed = os.path.join(self.tmp, "killed")
         incense_streak_scene(killed, 16, frames, point_sources=3)
@@ -184,8 +185,10 @@ class KillResumeTest(unittest.TestCase):
 
         bake_runner.cache.write_manifest, bake_runner.CHECKPOINT_COST_RATIO = dies_at_frame, 0.0
         try:
-            with self.assertRaises(RuntimeError):
-                bpy.ops.plume.bake()
+            runner = bake_runner.BakeRunner(snapshot.take_snapshot(bpy.context), native())
+            runner.prepare()
+            with self.assertRaises(OSError):
+                runner.run()
         finally:
             bake_runner.cache.write_manifest, bake_runner.CHECKPOINT_COST_RATIO = real_write, ratio
         m = manifest(killed)

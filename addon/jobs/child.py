@@ -207,6 +207,9 @@ def run_job(job_file, report_fd=None, parent=None):
             return 1
     for sig in (signal.SIGTERM, signal.SIGINT):
         signal.signal(sig, lambda *_: job.cancel())
+    # A write past the file size limit (ulimit -f, a farm's quota) fails with EFBIG and is
+    # reported as such, instead of SIGXFSZ ending the job without a word.
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     out = {}
 
     def work_thread():
