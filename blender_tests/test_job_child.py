@@ -192,6 +192,47 @@ class JobChildTest(unittest.TestCase):
         self.assertEqual(done.returncode, 2)
         self.assertIn("expected one job file", done.stderr)
 
+    def test_job_file_round_trip_and_refusals(self):
+        """The job file keeps what a spec holds exactly (tuples, dicts with int keys, NaN,
+        arrays, the add-on's dataclasses), stores paths inside the cache folder relative to it,
+        and a job file from a newer Plume or a damaged one is refused by name."""
+        import numpy as np
+        from plume.jobs import jobfile
+        from plume.settings import SolverSettings
+        folder = os.path.join(self.tmp, "jobfolder")
+        solver = SolverSettings()
+        spec = {"t": (1, 2.5, "x"), "pairs": {3: [1, 2]}, "nan": float("nan"),
+                "a": np.arange(6, dtype=np.float32).reshape(2, 3), "solver": solver,
+                "inside": os.path.join(folder, "sub", "f.vdb"), "outside": "/elsewhere/f.vdb"}
+        path = jobfile.write_job(folder, "bake", "Bake", spec)
+        with open(path) as f:
+            text = f.read()
+        self.assertIn('"__path__": "sub/f.vdb"', text)
+        self.assertNotIn(folder, text)
+        moved = os.path.join(self.tmp, "moved")
+        shutil.copytree(folder, moved)
+        header, back, root = jobfile.read_job(os.path.join(moved, "jobs", "bake.json"))
+        self.assertEqual((header["kind"], root), ("bake", moved))
+        self.assertEqual(back["t"], (1, 2.5, "x"))
+        self.assertEqual(back["pairs"], {3: [1, 2]})
+        self.assertNotEqual(back["nan"], back["nan"])
+        self.assertEqual(back["a"].dtype, np.float32)
+        self.assertEqual(back["a"].tolist(), spec["a"].tolist())
+        self.assertEqual(back["solver"], solver)
+        self.assertEqual(back["inside"], os.path.join(moved, "sub", "f.vdb"))
+        self.assertEqual(back["outside"], "/elsewhere/f.vdb")
+        with open(path) as f:
+            body = json.load(f)
+        body["version"] = jobfile.FORMAT_VERSION + 1
+        with open(path, "w") as f:
+            json.dump(body, f)
+        with self.assertRaisesRegex(jobfile.JobFileError, "written by a newer Plume"):
+            jobfile.read_job(path)
+        with open(path, "w") as f:
+            f.write("{not json")
+        with self.assertRaisesRegex(jobfile.JobFileError, "cannot be read"):
+            jobfile.read_job(path)
+
     # ------------------------------------------------------------------ Esc
     def test_a_child_that_cannot_stop_is_killed_within_a_second(self):
         """Esc on a job whose child is inside a call that cannot be cancelled (the fault

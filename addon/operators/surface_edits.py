@@ -1,7 +1,7 @@
 """Operators on built streak surfaces: store / clear hand edits (smoke_surfaces.txt §5, Figure 13),
 bake to keyframes, export as an OpenSubdiv mesh. They act on the active Plume surface (plus the
 selected ones), or, with the domain active (the panel's buttons), on all of its surfaces. Export
-Mesh is a job (jobs/): the surfaces are read on the main thread, refined on the worker thread,
+Mesh is a job (jobs/): the surfaces are read on the main thread, refined in the job's child process,
 and the meshes are built only when every surface succeeded."""
 
 import os

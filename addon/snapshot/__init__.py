@@ -1,6 +1,6 @@
 """Scene -> plain settings (bpy side, main thread, before a job starts): one module per pipeline
 (smoke: a domain's grid bake; streaks; toon; flowgraph; flames) and the scene reading they share
-(scene). What a job's worker thread gets from here holds no bpy data."""
+(scene). What a job's child process gets from here (its job file) holds no bpy data."""
 
 from .scene import (NOT_A_DOMAIN, EMITTER_ROLES, absolute_folder, active_domain,
                     blend_relative, cache_folder_of, domain_bbox, emitter_snapshots,
