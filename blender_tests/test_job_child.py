@@ -164,6 +164,33 @@ class JobChildTest(unittest.TestCase):
                          files)
         self.assertEqual(bpy.ops.plume.toon_build(), {'FINISHED'})
 
+    def test_disabling_the_addon_ends_the_job(self):
+        """Disabling the add-on while a job's child runs kills it and removes what it staged;
+        enabled again, the next build works."""
+        from helpers import ADDON, enable_addon
+        from plume.jobs.process import JobProcess
+        from plume.operators.toon import ToonJob
+        bpy.ops.object.camera_add(location=(0.0, -6.0, 1.0), rotation=(1.5708, 0.0, 0.0))
+        bpy.context.scene.camera = bpy.context.active_object
+        select_only(self.dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        files = tree_listing(self.cache)
+        job = ToonJob()
+        job.prepare(bpy.context)
+        with Fault("hang@1"):  # still running when the add-on goes
+            JobProcess(job).start()
+        while job.progress().done < 1:
+            job.child.wait(0.05)
+        bpy.ops.preferences.addon_disable(module=ADDON)
+        try:
+            self.assertTrue(job.aborted and job.child.finished)
+            self.assertFalse(pid_alive(job.child.pid))
+            self.assertEqual(tree_listing(self.cache), files)
+        finally:
+            enable_addon()
+        select_only(bpy.data.objects["Domain"])
+        self.assertEqual(bpy.ops.plume.toon_build(), {'FINISHED'})
+
     # ------------------------------------------------------------------ headless
     def test_job_command_runs_the_job_file_anywhere(self):
         """The job file a crashed bake left runs with ``python -m plume.job run <folder>`` (the
