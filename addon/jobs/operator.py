@@ -79,12 +79,17 @@ class JobOperator:
 
     @staticmethod
     def _run_child(runner):
-        """Starts the job's child and waits for it (blocking); the error it ended with."""
+        """Starts the job's child and waits for it (blocking); the error it ended with. Ctrl+C
+        in the terminal of a ``blender -b`` script is the job's Esc."""
         try:
             child = JobProcess(runner).start()
         except Exception as e:
             return e
-        child.wait()
+        try:
+            child.wait()
+        except KeyboardInterrupt:
+            runner.cancel()
+            child.wait()
         return child.error
 
     # ------------------------------------------------------------------ in the background
