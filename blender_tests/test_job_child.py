@@ -97,6 +97,29 @@ class JobChildTest(unittest.TestCase):
             self.assertFalse(pid_alive(int(pid.group(1))), "the crashed child is still alive")
         return text
 
+    def baked_with_camera(self):
+        """The domain baked, with a camera (what Build Toon Smoke needs); the cache's files."""
+        bpy.ops.object.camera_add(location=(0.0, -6.0, 1.0), rotation=(1.5708, 0.0, 0.0))
+        bpy.context.scene.camera = bpy.context.active_object
+        select_only(self.dom)
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        return tree_listing(self.cache)
+
+    def hanging_toon_job(self):
+        """A Build Toon Smoke whose child hangs after its first frame (as in a native call
+        that cannot be cancelled), started as a button starts it; (job, the cache's files)."""
+        from plume.jobs.process import JobProcess
+        from plume.operators.toon import ToonJob
+        files = self.baked_with_camera()
+        job = ToonJob()
+        job.prepare(bpy.context)
+        with Fault("hang@1"):
+            JobProcess(job).start()
+        t0 = time.perf_counter()
+        while job.progress().done < 1 and time.perf_counter() - t0 < 60:
+            job.child.wait(0.05)
+        return job, files
+
     def straight_bake(self):
         """The same scene baked straight into another folder; that folder."""
         straight = os.path.join(self.tmp, "straight")
@@ -148,10 +171,7 @@ class JobChildTest(unittest.TestCase):
     def test_crashed_build_changes_nothing(self):
         """A job that stages its files (Build Toon Smoke) crashes half way: nothing of it is
         left in the cache folder, and no object was made."""
-        bpy.ops.object.camera_add(location=(0.0, -6.0, 1.0), rotation=(1.5708, 0.0, 0.0))
-        bpy.context.scene.camera = bpy.context.active_object
-        select_only(self.dom)
-        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        self.baked_with_camera()
         # The job file and log a crash keeps (jobs/) are left out: they are the report.
         files = [n for n in tree_listing(self.cache) if "jobs" not in n.split(os.sep)]
         before = self.scene_state()
@@ -168,19 +188,7 @@ class JobChildTest(unittest.TestCase):
         """Disabling the add-on while a job's child runs kills it and removes what it staged;
         enabled again, the next build works."""
         from helpers import ADDON, enable_addon
-        from plume.jobs.process import JobProcess
-        from plume.operators.toon import ToonJob
-        bpy.ops.object.camera_add(location=(0.0, -6.0, 1.0), rotation=(1.5708, 0.0, 0.0))
-        bpy.context.scene.camera = bpy.context.active_object
-        select_only(self.dom)
-        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        files = tree_listing(self.cache)
-        job = ToonJob()
-        job.prepare(bpy.context)
-        with Fault("hang@1"):  # still running when the add-on goes
-            JobProcess(job).start()
-        while job.progress().done < 1:
-            job.child.wait(0.05)
+        job, files = self.hanging_toon_job()
         bpy.ops.preferences.addon_disable(module=ADDON)
         try:
             self.assertTrue(job.aborted and job.child.finished)
@@ -266,21 +274,8 @@ class JobChildTest(unittest.TestCase):
         "hang": the shot fit, reading streak files or the graph's weights would be the same):
         killed after the grace period, within 1 s of the cancel; nothing changed."""
         from plume.jobs import registry
-        from plume.jobs.process import JobProcess
-        from plume.operators.toon import ToonJob
-        bpy.ops.object.camera_add(location=(0.0, -6.0, 1.0), rotation=(1.5708, 0.0, 0.0))
-        bpy.context.scene.camera = bpy.context.active_object
-        select_only(self.dom)
-        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        files = tree_listing(self.cache)
-        job = ToonJob()
-        job.prepare(bpy.context)
-        with Fault("hang@1"):
-            JobProcess(job).start()
+        job, files = self.hanging_toon_job()
         try:
-            t0 = time.perf_counter()
-            while job.progress().done < 1 and time.perf_counter() - t0 < 60:
-                job.child.wait(0.05)
             time.sleep(0.3)  # inside the hang
             t_cancel = time.perf_counter()
             job.cancel()
