@@ -333,9 +333,10 @@ def load_graph(native, folder, owner):
     return graph, states
 
 
-#: The prepared-group cache of the last synthesized graph, kept for the Blender session:
-#: (key, PreparedGroupCache). Synthesizing the same graph again (another seed, other keys, a
-#: longer range) reads no group twice.
+#: The prepared-group cache of the last synthesized graph, kept for the process: (key,
+#: PreparedGroupCache). Each synthesis from Blender is a process of its own (jobs/), so it lives
+#: for one synthesis there; a script synthesizing the same graph again in one process (another
+#: seed, other keys, a longer range) reads no group twice.
 _SESSION_CACHE = [None, None]
 
 
@@ -354,7 +355,7 @@ def _states_key(states: List[State], budget_mb):
 
 
 def session_cache(native, states: List[State], budget_mb):
-    """The PreparedGroupCache of this graph's states for the session (a new one, and the old one
+    """The PreparedGroupCache of this graph's states for the process (a new one, and the old one
     dropped, when the states, their files or the budget changed)."""
     key = _states_key(states, budget_mb)
     if _SESSION_CACHE[0] != key:

@@ -92,9 +92,8 @@ class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
         name="Group Cache (MB)", default=2048, min=RANGES["flowgraph.group_cache"][0],
         max=RANGES["flowgraph.group_cache"][1],
         description="Memory kept for prepared pathline groups between visits of the random "
-                    "walk and, for the Blender session, between syntheses of the same graph: a "
-                    "revisited node is not read from its pathlines.bin again (0: read every "
-                    "visit); 0 to 65,536 MB")
+                    "walk during one synthesis: a revisited node is not read from its "
+                    "pathlines.bin again (0: read every visit); 0 to 65,536 MB")
     # --- Built data ---
     summary: StringProperty(name="Graph", default="", description="Summary of the last build")
     state_names: StringProperty(name="States", default="",
