@@ -20,6 +20,20 @@ def clear_folder(folder):
             os.remove(os.path.join(folder, name))
 
 
+def remove_frames_above(folder, last):
+    """Removes the frame files after frame `last` (what a bake killed between a frame's files
+    and its manifest leaves)."""
+    for name in os.listdir(folder):
+        if ((name.startswith("flames_") and name.endswith(".vdb"))
+                or (name.startswith("spines_") and name.endswith(".npz"))):
+            try:
+                frame = int(name[7:-4])
+            except ValueError:
+                continue
+            if frame > last:
+                os.remove(os.path.join(folder, name))
+
+
 def write_manifest(snap, result):
     data = {"format_version": FORMAT_VERSION, "kind": "flames",
             "frame_start": snap.frame_start, "frame_end": snap.frame_end,

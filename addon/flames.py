@@ -25,7 +25,8 @@ from . import flame_palettes
 from .settings import BakeError
 # The settings, validation and files of a flames bake, also reachable as flames.<name>.
 from .flame_files import (SMOKE_ARRAYS, SPINE_ARRAYS, buoyancy_lift, clear_folder,
-                          read_manifest, read_spines, write_manifest, write_spines)
+                          read_manifest, read_spines, remove_frames_above, write_manifest,
+                          write_spines)
 from .flame_settings import (FIXED_PARTICLES, FLAMES_PER_SOURCE_RANGE, FORMAT_VERSION,
                              MANIFEST_NAME, NO_SOURCE, OBSTACLE_PADDING, OBSTACLE_VOXEL,
                              POINTS_RANGE, PROFILES, SUBSTEPS_RANGE, CameraInput,
@@ -34,6 +35,7 @@ from .flame_settings import (FIXED_PARTICLES, FLAMES_PER_SOURCE_RANGE, FORMAT_VE
                              validate_source_values, volume_path)
 
 __all__ = ["SMOKE_ARRAYS", "SPINE_ARRAYS", "buoyancy_lift", "clear_folder", "read_manifest",
+           "remove_frames_above",
            "read_spines", "write_manifest", "write_spines", "FIXED_PARTICLES",
            "FLAMES_PER_SOURCE_RANGE", "FORMAT_VERSION", "MANIFEST_NAME", "NO_SOURCE",
            "OBSTACLE_PADDING", "OBSTACLE_VOXEL", "POINTS_RANGE", "PROFILES", "SUBSTEPS_RANGE",

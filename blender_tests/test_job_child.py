@@ -154,6 +154,34 @@ class JobChildTest(unittest.TestCase):
         assert_same_frames(self, frame_file, self.folder, self.straight_bake(),
                            range(1, FRAMES + 1), GRIDS)
 
+    def test_a_kill_between_a_frame_and_its_manifest_is_tidied(self):
+        """A child killed after a frame's file is renamed into place but before the manifest
+        names it leaves one frame too many; the job that still holds the folder removes it, so
+        the folder holds exactly the manifest's complete frames (bake and flames)."""
+        from plume.operators.bake import BakeJob
+        from plume.operators.flames import FlamesJob
+        self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
+        with open(os.path.join(self.folder, "manifest.json")) as f:
+            m = json.load(f)
+        m["last_complete_frame"] = 6
+        with open(os.path.join(self.folder, "manifest.json"), "w") as f:
+            json.dump(m, f)
+        BakeJob().tidy_partial(self.folder)
+        self.assertEqual(sorted(n for n in os.listdir(self.folder) if n.endswith(".vdb")),
+                         [f"volume_{i:04d}.vdb" for i in range(1, 7)])
+        flames = os.path.join(self.tmp, "flames")
+        os.makedirs(flames)
+        for i in range(1, 5):
+            for name in (f"flames_{i:04d}.vdb", f"spines_{i:04d}.npz"):
+                open(os.path.join(flames, name), "w").close()
+        with open(os.path.join(flames, "flames_manifest.json"), "w") as f:
+            json.dump({"format_version": 1, "kind": "flames", "last_complete_frame": 3}, f)
+        FlamesJob().tidy_partial(flames)
+        self.assertEqual(sorted(os.listdir(flames)),
+                         ["flames_0001.vdb", "flames_0002.vdb", "flames_0003.vdb",
+                          "flames_manifest.json", "spines_0001.npz", "spines_0002.npz",
+                          "spines_0003.npz"])
+
     def test_every_way_a_child_ends_is_reported(self):
         """SIGKILL (what the out-of-memory killer sends), an abort in a library, another exit
         status and an exception: each named, the scene unchanged, no child left."""

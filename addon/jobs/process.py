@@ -246,8 +246,7 @@ class JobProcess:
         r = self.runner
         how = (f"was ended by {signal_name(-code)}" if code < 0
                else f"exited with status {code}")
-        kept = ("the frames it finished are kept, and the next run resumes from them"
-                if r.keeps_partial else "nothing was changed")
+        kept = r.kept_text if r.keeps_partial else "nothing was changed"
         text = (f"its process (pid {self.pid}) {how}, in cache folder '{self.folder}'; {kept}. "
                 f"Blender and the scene are unharmed. Job file: {self.paths['json']}")
         tail = log_tail(self.paths["log"])

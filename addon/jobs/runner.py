@@ -92,6 +92,8 @@ class JobRunner(abc.ABC):
     prepare_errors = (BakeError,)
     #: True for bakes: a cancelled run keeps its complete frames and finish() still builds them.
     keeps_partial = False
+    #: What a stopped or crashed run of a keeps_partial job leaves, in the reports.
+    kept_text = "the frames it finished are kept, and the next run resumes from them"
     #: The work function of the child (jobs/kinds.py).
     kind = None
 
@@ -184,6 +186,13 @@ class JobRunner(abc.ABC):
         for lock in self.folder_locks:
             if lock.held:
                 sweep_temporaries(lock.folder)
+                if self.keeps_partial:
+                    self.tidy_partial(lock.folder)
+
+    def tidy_partial(self, folder):
+        """A keeps_partial job stopped anywhere (killed, crashed): removes the frames written
+        after the last one its manifest calls complete (a kill between a frame's file and the
+        manifest), so the folder holds exactly the complete frames. Default: nothing."""
 
     # ------------------------------------------------------------------ messages
     def refusal_text(self, exc):
@@ -213,8 +222,7 @@ class JobRunner(abc.ABC):
 
     def cancelled_text(self):
         if self.keeps_partial:  # killed past its grace period: no result to build
-            return (f"Plume: {self.title} cancelled: the frames it finished are kept, and the "
-                    "next run resumes from them")
+            return f"Plume: {self.title} cancelled: {self.kept_text}"
         return f"Plume: {self.title} cancelled: nothing was changed"
 
     def busy_text(self):

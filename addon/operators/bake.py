@@ -49,6 +49,11 @@ class BakeJob(JobRunner):
     def job_spec(self):
         return {"snapshot": self.snapshot}
 
+    def tidy_partial(self, folder):
+        m = cache.read_manifest(folder)
+        if m is not None and isinstance(m.get("last_complete_frame"), int):
+            cache.delete_plume_files(folder, frames_above=m["last_complete_frame"])
+
     def finish(self, context):
         """Builds/updates the Volume object from what the cache holds."""
         snap, result = self.snapshot, self.result

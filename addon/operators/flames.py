@@ -30,6 +30,7 @@ class FlamesJob(JobRunner):
     title = "Bake Flames"
     kind = "flames"
     keeps_partial = True
+    kept_text = "the frames it finished are kept (the next Bake Flames starts over)"
 
     def prepare(self, context):
         self.t0 = time.perf_counter()
@@ -44,6 +45,11 @@ class FlamesJob(JobRunner):
 
     def job_spec(self):
         return {"snapshot": self.snap}
+
+    def tidy_partial(self, folder):
+        m = flames.read_manifest(folder)
+        if m is not None and isinstance(m.get("last_complete_frame"), int):
+            flames.remove_frames_above(folder, m["last_complete_frame"])
 
     def finish(self, context):
         """Builds the Blender objects over what was baked; the report."""
