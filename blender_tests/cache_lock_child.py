@@ -50,15 +50,18 @@ def bake(cache, wait_after_first_frame):
     job = BakeJob()
 
     said = []
+    gate = os.path.join(cache, "gate")
 
-    def first_frame(p):  # the first report Blender reads from the bake's child (1 frame or more)
+    def first_frame(p):  # the bake's child waits at frame 1 (PLUME_JOB_GATE) until stdin closes
         if p.done >= 1 and not said:
             said.append(p.done)
             say(f"BAKING {os.getpid()}")
             sys.stdin.read()
+            open(gate, "w").close()
 
     if wait_after_first_frame:
         job.on_progress = first_frame
+        os.environ["PLUME_JOB_GATE"] = f"{gate}@1"
     PLUME_OT_bake.make_runner = lambda self, context: job
     try:
         say(f"RESULT {sorted(bpy.ops.plume.bake())}")
