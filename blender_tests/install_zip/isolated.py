@@ -108,7 +108,15 @@ def run_isolated(results_file, case, method=None):
     failed = len(result.failures) + len(result.errors)
     print(f"[isolated Blender {VERSION}] {result.testsRun - failed} of {result.testsRun} "
           "passed", flush=True)
-    sys.exit(0 if failed == 0 else 1)
+    code = 0 if failed == 0 else 1
+    if bpy.app.version[:2] == (4, 2):
+        # The bpy 4.2 wheel segfaults in its own teardown once an add-on registered classes
+        # (run.py EXIT_WITHOUT_TEARDOWN): the verdict above is kept, the teardown skipped.
+        # Plume before its jobs moved to a child process happened to escape it here (a plain
+        # enable-and-exit crashed with it too); since then this run crashed after its 4 of 4.
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
 
 
 def isolated_command(script):
