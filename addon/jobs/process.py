@@ -12,6 +12,7 @@ folder, how it ended and the last lines of its log. Cancel sends SIGTERM (the ch
 next unit of work) and SIGKILL after a grace period; abort (quit, file load, add-on disabled)
 kills at once. The child also dies with Blender (PR_SET_PDEATHSIG), so none outlives it."""
 
+import json
 import os
 import select
 import signal
@@ -156,7 +157,7 @@ class JobProcess:
     def poll(self):
         """Reads what the child reported; True once it has ended (then `error` is set or the
         runner has its result)."""
-        if self.finished:
+        if self.finished or self.proc is None:  # ended, or never started
             return True
         self._read()
         for lock in self.runner.folder_locks:
@@ -200,7 +201,6 @@ class JobProcess:
             self._message_of(line)
 
     def _message_of(self, line):
-        import json
         try:
             m = json.loads(line.decode("utf-8"))
         except ValueError:
@@ -257,14 +257,14 @@ class JobProcess:
     # ------------------------------------------------------------------ stopping
     def cancel(self):
         """Esc: SIGTERM now (the child stops at its next unit), SIGKILL after the grace."""
-        if self.finished or self._term_at is not None:
+        if self.finished or self.proc is None or self._term_at is not None:
             return
         self._term_at = time.perf_counter()
         self._signal(signal.SIGTERM)
 
     def kill(self):
         """SIGKILL at once (abort: quit, file load; or a cancel past its grace)."""
-        if self.finished:
+        if self.finished or self.proc is None:
             return
         self.killed = True
         self._signal(signal.SIGKILL)
@@ -278,6 +278,8 @@ class JobProcess:
     def join(self, timeout=None):
         """Kills the child and reaps it (abort): True when it is gone. Its job files go either
         way (a killed child writes nothing more)."""
+        if self.proc is None:
+            return True
         self.kill()
         try:
             self.proc.wait(timeout)
