@@ -277,18 +277,19 @@ class JobProcess:
 
     def join(self, timeout=None):
         """Kills the child and reaps it (abort): True when it is gone. Its job files go either
-        way (a killed child writes nothing more)."""
+        way (a killed child writes nothing more; an aborted job is not rerun from them)."""
         if self.proc is None:
             return True
         self.kill()
         try:
             self.proc.wait(timeout)
+            gone = True
         except subprocess.TimeoutExpired:
-            self.runner.killed = True
-            jobfile.remove_job(self.folder, self.name)
-            return False
-        self.poll()
-        return True
+            self.runner.killed, gone = True, False
+        if gone:
+            self.poll()
+        jobfile.remove_job(self.folder, self.name)
+        return gone
 
     @property
     def alive(self):

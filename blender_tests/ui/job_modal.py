@@ -88,7 +88,8 @@ def close_gate(operator):
     progress and the action could come. Only the wait is added; the job's work is unchanged,
     and once released the child goes straight back into its next (native) unit, where the
     action finds it."""
-    state["gate_file"] = os.path.join(TMP, f"gate_{state['case']}")
+    # One name per process and case: TMP is shared by the matrix process and the quit ones.
+    state["gate_file"] = os.path.join(TMP, f"gate_{os.getpid()}_{state['case']}")
     os.environ["PLUME_JOB_GATE"] = f"{state['gate_file']}@{job_cases.TRIGGER[operator]}"
     state["gate_open"] = False
 
