@@ -17,7 +17,7 @@ class SynthesisCases:
         frames 1..frames, no force fields and no point preview."""
         g = self.windy.plume.domain.flowgraph
         if not g.summary:
-            self.skipTest("needs the graph of test_1")
+            self.fail("needs the graph of test_1, which did not build it")
         select_only(self.windy)
         g.frame_start, g.frame_end = 1, frames
         g.use_force_fields, g.point_preview = False, False

@@ -287,8 +287,20 @@ def assert_same_frames(test, path_of, a, b, frames, grids=("density", "velocity"
                           f"{np.abs(x['values'] - y['values']).max()})")
 
 
+#: The start of the reason of every skip a file may make: what this machine lacks (a skip for
+#: any other reason, e.g. "needs the graph of test_1", hides a failure and counts as one).
+MACHINE_LACKS = "this machine lacks "
+
+
+def skip_machine_lacks(test, what):
+    """Skips `test` because the machine lacks `what` (a mount permission, /proc...)."""
+    test.skipTest(MACHINE_LACKS + what)
+
+
 def run(*cases):
-    """Runs the TestCases (or the names given after "--"), prints "N passed, N failed" alone on the last line, exits 1 on failure."""
+    """Runs the TestCases (or the names given after "--"), prints "N passed, N failed, N
+    skipped" alone on the last line, exits 1 on failure. Every skip is listed with its reason;
+    one whose reason is not what the machine lacks (skip_machine_lacks) counts as a failure."""
     loader = unittest.defaultTestLoader
     names = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     if names:  # e.g. -- BakeTest.test_cache_free
@@ -299,11 +311,18 @@ def run(*cases):
     result = unittest.TextTestRunner(stream=sys.stdout, verbosity=2).run(suite)
     failed = len(result.failures) + len(result.errors) + len(result.unexpectedSuccesses)
     passed = result.testsRun - failed - len(result.skipped)
+    skipped = 0
+    for test, reason in result.skipped:
+        ok = reason.startswith(MACHINE_LACKS)
+        skipped += ok
+        failed += not ok
+        print(f"skipped {test.id()}: {reason}" + ("" if ok else
+              " -- FAILED: a skip must say what this machine lacks (skip_machine_lacks)"))
     sys.stdout.flush()
     # Free the scene's simulation data while Python still runs: the bpy module's exit frees a
     # Mantaflow domain after Python let go of its grids, and Mantaflow then aborts the process.
     bpy.ops.wm.read_homefile(use_factory_startup=True)
-    print(f"{passed} passed, {failed} failed", flush=True)
+    print(f"{passed} passed, {failed} failed, {skipped} skipped", flush=True)
     sys.exit(0 if failed == 0 and result.testsRun > 0 else 1)
 
 

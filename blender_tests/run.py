@@ -25,9 +25,10 @@ run as asked. WINDOWED files run in 3.4 only. Each Blender's renders go to $PLUM
 Blender finds user add-ons ($BLENDER_USER_SCRIPTS/addons/plume, else
 ~/.config/blender/<x.y>/scripts/addons/plume); .ci/common.sh does that.
 
-Each file prints "N passed, N failed" on its last line (helpers.run); this runner adds them up and
-prints them per Blender and in total, then a table per Blender (files, passed, failed, the files
-that failed), and exits 1 when anything failed."""
+Each file prints "N passed, N failed, N skipped" on its last line (helpers.run: a skip must say
+what the machine lacks, else it counts as failed); this runner adds them up and prints them per
+Blender and in total, then a table per Blender (files, passed, failed, skipped, the files that
+failed), and exits 1 when anything failed."""
 
 import argparse
 import glob
@@ -69,7 +70,7 @@ EXIT_WITHOUT_TEARDOWN = {"4.2"}
 WINDOWED = {"test_ui_jobs.py"}
 TIMEOUT_S = 1800
 
-_SUMMARY = re.compile(r"^(\d+) passed, (\d+) failed\s*$", re.M)
+_SUMMARY = re.compile(r"^(\d+) passed, (\d+) failed(?:, (\d+) skipped)?\s*$", re.M)
 
 
 def venv_root():
@@ -169,8 +170,8 @@ def clean_env():
 
 
 def run_file(label, path, names):
-    """(passed, failed) test counts of one file; a file that crashes or prints no summary counts
-    as one failure."""
+    """(passed, failed, skipped) test counts of one file; a file that crashes or prints no
+    summary counts as one failure."""
     start = time.monotonic()
     print(f"-- [{label}] {os.path.basename(path)}", flush=True)
     try:
@@ -185,13 +186,14 @@ def run_file(label, path, names):
             else (e.stdout or ""), "timeout"
     sys.stdout.write(out)
     found = _SUMMARY.findall(out)
-    passed, failed = (int(found[-1][0]), int(found[-1][1])) if found else (0, 0)
+    passed, failed, skipped = ((int(found[-1][0]), int(found[-1][1]), int(found[-1][2] or 0))
+                               if found else (0, 0, 0))
     if rc != 0 and failed == 0:
         failed = 1  # crashed, or failed outside a test case
     status = "ok" if rc == 0 else f"FAILED (rc {rc})"
-    print(f"-- [{label}] {os.path.basename(path)}: {passed} passed, {failed} failed, {status}, "
-          f"{time.monotonic() - start:.0f} s", flush=True)
-    return passed, failed
+    print(f"-- [{label}] {os.path.basename(path)}: {passed} passed, {failed} failed, "
+          f"{skipped} skipped, {status}, {time.monotonic() - start:.0f} s", flush=True)
+    return passed, failed, skipped
 
 
 def blender_name(label):
@@ -263,22 +265,22 @@ def main(argv):
             require_venv(label)
     totals = {}
     for label in labels:
-        p = f = 0
+        p = f = k = 0
         bad = []
         for path in plans[label][0]:
-            dp, df = run_file(label, path, names)
-            p, f = p + dp, f + df
+            dp, df, dk = run_file(label, path, names)
+            p, f, k = p + dp, f + df, k + dk
             if df:
                 bad.append(os.path.basename(path))
-        totals[label] = (p, f, len(plans[label][0]), bad)
+        totals[label] = (p, f, k, len(plans[label][0]), bad)
     print("== Blender tests")
-    for label, (p, f, _, _) in totals.items():
-        print(f"Blender {blender_name(label)}: {p} passed, {f} failed")
-    tp, tf = sum(v[0] for v in totals.values()), sum(v[1] for v in totals.values())
-    print(f"all Blenders: {tp} passed, {tf} failed")
-    print(f"{'Blender':<24} {'files':>5} {'passed':>6} {'failed':>6}  failing files")
-    for label, (p, f, n, bad) in totals.items():
-        print(f"{blender_name(label):<24} {n:>5} {p:>6} {f:>6}  {' '.join(bad) or '-'}")
+    for label, (p, f, k, _, _) in totals.items():
+        print(f"Blender {blender_name(label)}: {p} passed, {f} failed, {k} skipped")
+    tp, tf, tk = (sum(v[i] for v in totals.values()) for i in range(3))
+    print(f"all Blenders: {tp} passed, {tf} failed, {tk} skipped")
+    print(f"{'Blender':<24} {'files':>5} {'passed':>6} {'failed':>6} {'skipped':>7}  failing files")
+    for label, (p, f, k, n, bad) in totals.items():
+        print(f"{blender_name(label):<24} {n:>5} {p:>6} {f:>6} {k:>7}  {' '.join(bad) or '-'}")
     return 0 if tf == 0 and tp > 0 else 1
 
 

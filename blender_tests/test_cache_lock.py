@@ -25,7 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 
 from helpers import (add_domain, add_sphere_source, reset_scene, rmtree, run,  # noqa: E402
-                     select_only, temp_dir, tree_listing)
+                     select_only, skip_machine_lacks, temp_dir, tree_listing)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CHILD = os.path.join(HERE, "cache_lock_child.py")
@@ -214,7 +214,7 @@ class CacheLockTest(unittest.TestCase):
         os.makedirs(self.folder)  # our own pid with another start time: a reused pid
         record = dict(folder_lock().own_record("Bake"), pid_start=1)
         if record.get("pid_start") is None:
-            self.skipTest("no /proc: process start times unknown")
+            skip_machine_lacks(self, "/proc (process start times are unknown)")
         with open(self.lock_file(), "w") as f:
             json.dump(record, f)
         self.assert_baked()

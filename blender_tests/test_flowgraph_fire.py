@@ -245,7 +245,7 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         select_only(self.windy)
         g = self.windy.plume.domain.flowgraph
         if not g.summary:
-            self.skipTest("needs the graph of test_1")
+            self.fail("needs the graph of test_1, which did not build it")
         folder = self.folder(self.windy)
         scn = bpy.context.scene
         frames = range(1, 41)
@@ -343,7 +343,7 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
                                                PLUME_OT_flowgraph_build, SynthesisJob)
         g = self.windy.plume.domain.flowgraph
         if not g.summary:
-            self.skipTest("needs the graph of test_1")
+            self.fail("needs the graph of test_1, which did not build it")
         select([self.calm, self.windy], self.windy)
         before = self.state()
         job = FlowGraphJob()
@@ -367,7 +367,7 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         from plume.build import fire_volume, volume
         g = self.windy.plume.domain.flowgraph
         if not g.fire_object:
-            self.skipTest("needs the synthesized fire of test_1")
+            self.fail("needs the synthesized fire of test_1, which did not make it")
         old = bpy.data.materials.get(volume.FIRE_MATERIAL)
         if old is not None:
             bpy.data.materials.remove(old)
