@@ -165,7 +165,8 @@ class FlameLookTest(unittest.TestCase):
               f"{int(lit.sum())}")
         self.assertGreater(b, 0.0)
         self.assertGreaterEqual(r / b, 1.5)
-        self.assertGreater(int(blue.sum()), 3)
+        # Measured 29 (5.3.0) and 30 (3.4.1) blue-dominant pixels: 20 leaves a third for noise.
+        self.assertGreater(int(blue.sum()), 20)
 
     def test_light_unit_gives_a_candle_one_candela(self):
         """The calibration of Light Unit's default (flame_settings.LIGHT_UNIT): the candle

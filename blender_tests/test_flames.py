@@ -126,7 +126,9 @@ class FlamesTest(unittest.TestCase):
         px = image_pixels(scn.render.filepath)[..., :3]
         lit = float((px.max(axis=2) > 0.05).mean())
         print(f"  {name} render: max {px.max():.3f}, lit pixels {lit * 100:.1f}%")
-        self.assertGreater(lit, 0.005)
+        # Measured in 3.4.1-5.3: candle 8.5-9.3%, torch 15.3-18.6%; the floors leave a third
+        # for the Blenders' differences and say the flame fills its part of the frame.
+        self.assertGreater(lit, {"candle": 0.06, "torch": 0.10}[name])
         return sp
 
     def test_candle(self):

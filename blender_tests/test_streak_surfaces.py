@@ -268,7 +268,8 @@ class StreakSurfacesTest(unittest.TestCase):
         covered = diff > 4 / 255
         share = covered.mean()
         print(f"  pixels changed by the sheets: {share:.3%}")
-        self.assertGreater(share, 0.005, "the sheets do not show")
+        # Measured 1.73% (3.4.1) and 1.66% (5.3.0): the sheets are thin, 1% says they show.
+        self.assertGreater(share, 0.01, "the sheets do not show")
         # Semi-transparent: the checker backdrop still shows through covered pixels, so their
         # red/blue contrast survives partly; and the changes span a range of strengths.
         vals = diff[covered]
@@ -278,8 +279,12 @@ class StreakSurfacesTest(unittest.TestCase):
         bg_contrast = np.abs(empty[..., 0] - empty[..., 2])
         fg_contrast = np.abs(with_sheets[..., 0] - with_sheets[..., 2])
         see_through = covered & (bg_contrast > 0.05) & (fg_contrast > 0.2 * bg_contrast)
-        self.assertGreater(see_through.sum(), 0.5 * covered.sum() * 0.1,
-                           "nothing of the backdrop shows through the sheets")
+        print(f"  covered pixels where the backdrop shows through: "
+              f"{see_through.sum() / max(covered.sum(), 1):.1%}")
+        # Measured 75.7% (3.4.1) and 67.1% (5.3.0) of the covered pixels: at least half, the
+        # margin covering the Blenders' own differences in transparency sampling.
+        self.assertGreater(see_through.sum(), 0.5 * covered.sum(),
+                           "too little of the backdrop shows through the sheets")
         self.assertLess(vals.min(), 0.5 * vals.max())
 
     # ------------------------------------------------------------------- bad input

@@ -131,7 +131,9 @@ TEST(FlameSpine, SplitKeepsPieceCountsAndEnds) {
   EXPECT_EQ(lower.size(), 6u);  // 5 points below 0.3 L plus the break point: not refilled
 }
 
-TEST(FlameBreakaway, DrawsFollowTheirDistributions) {
+TEST(FlameBreakaway, DrawsKeepTheirBoundsAndMeans) {
+  // What is checked: every split height inside [H_p, H_i] and the three means (not the shapes
+  // of the distributions).
   Rng rng(3);
   const FlameHeights h{0.1, 0.3, 1.0};
   const int n = 200000;

@@ -172,7 +172,9 @@ def test_rasterized_frame_vdb(tmp_path):
         _native.FireRasterParams(voxel_size=0.1, ignition_temperature=5.0, max_temperature=4.0)
 
 
-def test_recorder_releases_the_gil_and_cancels(tmp_path):
+def test_recorder_cancelled_before_a_frame_records_nothing(tmp_path):
+    """A cancelled recorder's frame (advanced from another thread) returns False, and discard()
+    leaves no partial file."""
     params = fire_params()
     solver = _native.SmokeSolver(params)
     cells = np.arange(16 * 16 + 100, 16 * 16 + 104)
