@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 #include <vector>
+#include "tests/temp_path.h"
 
 namespace plume {
 namespace {
@@ -186,7 +187,7 @@ TEST(AdaptiveDomain, SameResultWithOneAndTwoThreads) {
 // blown away from the -x side): the same frames as the straight run, bit for bit.
 TEST(AdaptiveDomain, ResumedBakeEqualsTheStraightOne) {
   const std::string path =
-      (std::filesystem::temp_directory_path() / "plume_adaptive_resume.state").string();
+      plume::test::tempPath("adaptive_resume.state");
   const int puff = 3;
   std::vector<ActiveBox> boxes;
   auto straight = growingRun(0, 16, &boxes, puff);

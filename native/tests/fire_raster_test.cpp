@@ -23,13 +23,14 @@
 #include <fstream>
 #include <iostream>
 #include <stdexcept>
+#include "tests/temp_path.h"
 
 namespace fs = std::filesystem;
 
 namespace plume {
 namespace {
 
-std::string tempPath(const std::string& name) { return ::testing::TempDir() + "plume_fire_raster_" + name; }
+std::string tempPath(const std::string& name) { return plume::test::tempPath("fire_raster_" + name); }
 
 struct Cloud {
   std::vector<glm::vec3> x;

@@ -17,6 +17,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include "tests/temp_path.h"
 
 namespace plume {
 namespace {
@@ -32,7 +33,7 @@ using testing::writeOscillatingFiles;
 const std::vector<int> kCounts = {45, 38, 30};
 constexpr int kParticles = 37, kSamples = 19;
 
-std::string prefix(const std::string& name) { return ::testing::TempDir() + "plume_cost_stream_" + name + "_"; }
+std::string prefix(const std::string& name) { return plume::test::tempPath("cost_stream_" + name + "_"); }
 
 FlowGraphParams params(int threads) {
   FlowGraphParams p;

@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 #include <vector>
+#include "tests/temp_path.h"
 
 namespace plume {
 namespace {
@@ -32,8 +33,9 @@ class PreparedGroups : public ::testing::Test {
  protected:
   static constexpr int kNodes = 10;
   void SetUp() override {
-    mPath = ::testing::TempDir() + "plume_prepared_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".bin";
+    mPath = plume::test::tempPath(std::string("prepared_") +
+                                  ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+                                  ".bin");
     const std::vector<PathlineGroup> groups = testing::oscillatingGroups({kNodes}, 700, 6, 5);
     PathlineFileInfo info;
     info.layout = groups[0].layout;

@@ -24,6 +24,7 @@
 #include <iostream>
 #include <limits>
 #include <stdexcept>
+#include "tests/temp_path.h"
 
 namespace fs = std::filesystem;
 
@@ -63,7 +64,7 @@ PathlineFileInfo fileInfo(const PathlineLayout& layout, bool half) {
   return info;
 }
 
-std::string tempPath(const std::string& name) { return ::testing::TempDir() + "plume_pathlines_" + name; }
+std::string tempPath(const std::string& name) { return plume::test::tempPath("pathlines_" + name); }
 
 /// Writes `count` random groups; returns them.
 std::vector<PathlineGroup> writeGroups(const std::string& path, const PathlineFileInfo& info, int count) {

@@ -14,6 +14,7 @@
 #include <iterator>
 #include <limits>
 #include <stdexcept>
+#include "tests/temp_path.h"
 
 namespace fs = std::filesystem;
 
@@ -22,7 +23,7 @@ namespace {
 
 /// A fresh, empty directory per test.
 fs::path scratchDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("plume_io_test_" + name);
+  const fs::path dir = fs::path(plume::test::tempPath("io_test_" + name));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

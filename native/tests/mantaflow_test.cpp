@@ -20,6 +20,7 @@
 #include "core/parallel.h"
 #include "io/mantaflow_cache.h"
 #include "tracers/mantaflow_driver.h"
+#include "tests/temp_path.h"
 
 namespace plume {
 namespace {
@@ -89,7 +90,7 @@ void writeFrame(const std::string& path, const MantaflowGrid& g,
 }
 
 std::string tempPath(const std::string& name) {
-  return ::testing::TempDir() + "plume_mantaflow_" + name;
+  return plume::test::tempPath("mantaflow_" + name);
 }
 
 /// Smoke in the box [1,3] x [2,5] x [1,2] of cells.

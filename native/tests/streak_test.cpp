@@ -25,6 +25,7 @@
 #include <numeric>
 #include <set>
 #include <stdexcept>
+#include "tests/temp_path.h"
 
 namespace fs = std::filesystem;
 
@@ -330,7 +331,7 @@ TEST(BuildSurfaces, TwentySourcesThreeHundredFramesTiming) {
 // --- streak files -------------------------------------------------------------------------------
 
 fs::path scratchDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("plume_streak_test_" + name);
+  const fs::path dir = fs::path(plume::test::tempPath("streak_test_" + name));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <random>
 #include <stdexcept>
+#include "tests/temp_path.h"
 
 namespace plume {
 namespace {
@@ -176,7 +177,7 @@ TEST(ToonVolume, ReadsAPlumeVolumeFrameOntoTheGrid) {
       for (int i = 1; i < 6; ++i) frame.density(i, j, k) = 0.1f * float(i + j + k);
   frame.velocity.u().fill(0.5f);  // uniform: every face velocity inside the smoke is 0.5
   frame.velocity.w().fill(-0.25f);
-  const std::string path = (std::filesystem::temp_directory_path() / "plume_toon_volume.vdb").string();
+  const std::string path = plume::test::tempPath("toon_volume.vdb");
   writeMantaflowVolume(path, frame, mg, 3);
   const GridFrame g{mg.resolution, 0.2f, mg.origin, 1.f / 24.f};
   const ToonFields f = readToonFields(path, g);
@@ -211,7 +212,7 @@ TEST(ToonVolume, ResamplesNonCubicMantaflowCellsOntoACubicGrid) {
       for (int i = 0; i < 8; ++i) frame.density(i, j, k) = linear(mg.indexToWorld(glm::vec3(i, j, k) + 0.5f));
   frame.velocity.u().fill(0.5f);
   frame.velocity.w().fill(-0.25f);
-  const std::string path = (std::filesystem::temp_directory_path() / "plume_toon_resample.vdb").string();
+  const std::string path = plume::test::tempPath("toon_resample.vdb");
   writeMantaflowVolume(path, frame, mg, 1);
   const GridFrame g{glm::ivec3(8), 0.1f, mg.origin, 1.f / 24.f};
   EXPECT_THROW(readToonFields(path, g), std::runtime_error);  // the exact reader refuses them

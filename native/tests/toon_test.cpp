@@ -15,6 +15,7 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include "tests/temp_path.h"
 
 namespace fs = std::filesystem;
 
@@ -307,7 +308,7 @@ TEST(ToonParams, RampsAreLinearAndClamped) {
 }
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("plume_toon_test_" + name);
+  const fs::path dir = fs::path(plume::test::tempPath("toon_test_" + name));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
+#include "tests/temp_path.h"
 
 namespace fs = std::filesystem;
 
@@ -98,7 +99,7 @@ void expectSameSnapshot(const StreakTracer& a, const StreakTracer& b) {
 }
 
 fs::path scratchDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("plume_tracer_state_test_" + name);
+  const fs::path dir = fs::path(plume::test::tempPath("tracer_state_test_" + name));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
