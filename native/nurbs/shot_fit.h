@@ -45,8 +45,10 @@ struct NetSize {
 /// change): along u the smallest nu in [min(order_u, P), P] (P = particles, at least 2) for
 /// which every frame's streakline curves pass within ε of their particles and have their
 /// control points within δ of the curve and within ν of a particle (curveFitQuality()), by
-/// bisection; then, with that nu, the smallest nv in [min(order_v, L), L] (L = lines, at least
-/// 2) for which every frame's surface does (fitSurface(), netToParticles()). Where the lines
+/// bisection on ε and δ, then the first of that count and the 8 above it that meets ν too (ν
+/// is not monotone in the count: a control point may land mid-gap between sparse particles at
+/// one count and beside one at the next), else P; then, with that nu, the smallest nv in
+/// [min(order_v, L), L] (L = lines, at least 2) for which every frame's surface does (fitSurface(), netToParticles()). Where the lines
 /// scatter along u (the top of a plume late in its shot: consecutive particles many cells apart,
 /// zig-zagging) even P control points at order_u miss, and the order along them drops (3, then
 /// 2): at nu = P those interpolate every particle at its slot's Greville abscissa
