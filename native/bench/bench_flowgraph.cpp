@@ -19,6 +19,7 @@
 #include "tests/flowgraph_fire.h"
 
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -83,7 +84,8 @@ void BM_SynthesisGather(benchmark::State& state) {
 class BenchFile {
  public:
   explicit BenchFile(bool half)
-      : mPath(std::string("/tmp/plume_bench_pathlines") + (half ? "16" : "32") + ".bin") {
+      : mPath(std::string("/tmp/plume_bench_pathlines") + (half ? "16" : "32") + "_" +
+              std::to_string(::getpid()) + ".bin") {
     PathlineFileInfo info;
     info.layout = groups()[0].layout;
     info.resolution = glm::ivec3(128, 64, 64);

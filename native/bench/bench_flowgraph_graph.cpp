@@ -29,6 +29,7 @@
 #include "tests/flowgraph_groups.h"
 
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -81,6 +82,7 @@ class GraphFiles {
   explicit GraphFiles(int n) {
     const char* dir = std::getenv("TMPDIR");
     mPaths = testing::writeOscillatingFiles(std::string(dir && *dir ? dir : "/tmp") + "/plume_bench_graph_" +
+                                                std::to_string(::getpid()) + "_" +
                                                 std::to_string(n) + "_",
                                             counts(n), kParticles, kSamples, 1);
     mFiles = testing::openFiles(mPaths);

@@ -253,7 +253,9 @@ BENCHMARK(BM_Stage_projectComparable)->Arg(64)->Arg(128)->Unit(benchmark::kMilli
 void BM_WriteVdb(benchmark::State& state) {
   SmokeSolver& solver = warmSolver(int(state.range(0)), /*fire=*/false);
   const std::string path =
-      (std::filesystem::temp_directory_path() / "plume_bench_frame.vdb").string();
+      (std::filesystem::temp_directory_path() /
+       ("plume_bench_frame_" + std::to_string(::getpid()) + ".vdb"))
+          .string();
   for (auto _ : state) writeVdbFrame(path, solver);
   std::error_code ec;
   state.counters["file_MB"] = double(std::filesystem::file_size(path, ec)) / (1024.0 * 1024.0);

@@ -27,6 +27,8 @@
 #include "tests/flowgraph_fire.h"
 #include "tests/flowgraph_group_files.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -130,7 +132,8 @@ std::pair<int, int> matchingFire(int pathlines) {
 /// One synthesized frame: kNodesPerFrame node steps, gather, rasterize (mean of o.frames).
 void synthesis(const Options& o, int pathlines) {
   const std::vector<PathlineGroup> groups = fireGroups(8, pathlines, o.samples, kNodeDt);
-  const std::string path = o.dir + "/plume_sweep_fire_" + std::to_string(pathlines) + ".bin";
+  const std::string path = o.dir + "/plume_sweep_fire_" + std::to_string(::getpid()) + "_" +
+                           std::to_string(pathlines) + ".bin";
   {
     PathlineFileInfo info;
     info.layout = groups[0].layout;
@@ -199,7 +202,7 @@ int runFlowgraphSweep(int argc, char** argv) {
     }
     for (int pathlines : o.pathlines) {
       const std::vector<std::string> paths = testing::writeOscillatingFiles(
-          o.dir + "/plume_sweep_" + std::to_string(pathlines) + "_",
+          o.dir + "/plume_sweep_" + std::to_string(::getpid()) + "_" + std::to_string(pathlines) + "_",
           std::vector<int>(std::size_t(maxNodes / kStateNodes), kStateNodes), pathlines, o.samples, 1);
       {
         const std::vector<PathlineFile> files = testing::openFiles(paths);
