@@ -361,8 +361,8 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         self.assertEqual(self.state(), before)
 
     def test_7_fire_material_upgrade(self):
-        """"Plume Fire" made by an older Plume (no plume_version) is rebuilt with the blackbody
-        emission; a current one the artist edited is kept; a material the artist put in the fire
+        """"Plume Fire" made by an older Plume (no plume_version) is rebuilt with the fire colour
+        ramp (fire_colors.FIRE_RAMP of T / T_max, as measured under AgX and Filmic); a current one the artist edited is kept; a material the artist put in the fire
         Volume's slot stays there when the fire is rebuilt."""
         from plume.build import fire_volume, volume
         g = self.windy.plume.domain.flowgraph
@@ -380,8 +380,11 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         self.assertIs(mat, old)
         self.assertEqual(mat["plume_version"], volume.FIRE_MATERIAL_VERSION)
         types = {n.bl_idname for n in mat.node_tree.nodes}
-        self.assertTrue({"ShaderNodeBlackbody", "ShaderNodeMapRange", "ShaderNodeOutputMaterial"}
-                        <= types, types)
+        self.assertTrue({"ShaderNodeValToRGB", "ShaderNodeOutputMaterial"} <= types, types)
+        self.assertNotIn("ShaderNodeBlackbody", types)
+        from plume.fire_colors import FIRE_RAMP
+        ramp = mat.node_tree.nodes["Fire Colour"].color_ramp.elements
+        self.assertEqual([round(e.position, 4) for e in ramp], [p for p, _ in FIRE_RAMP])
         pv = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeVolumePrincipled")
         self.assertTrue(pv.inputs["Emission Strength"].is_linked)
         self.assertTrue(pv.inputs["Emission Color"].is_linked)

@@ -2,14 +2,14 @@
 preview"): a MESH object "<domain>_fire_points" whose vertices and point attributes (temperature,
 density) follow fire/points_####.npz through a persistent frame_change_pre handler, drawn as
 spheres of half a cell by a geometry-nodes "Mesh to Points" modifier with an emission material
-coloured by the blackbody of the temperature (the fire Volume's mapping: T_max -> FIRE_KELVIN).
+coloured by the fire Volume's colour ramp of the temperature (fire_colors.FIRE_RAMP of T / T_max).
 Like the fire Volume's sequence (CLIP), frames outside the synthesized range show no points."""
 
 import bpy
 import numpy as np
 
 from . import datablocks, frame_handlers, point_frames
-from .volume import FIRE_KELVIN, _scaled_attribute
+from .volume import _scaled_attribute, fire_ramp_node
 from .. import blender_compat as compat
 from .. import flowgraph
 
@@ -104,8 +104,7 @@ def points_group():
 
 
 def points_material(max_temperature):
-    """Emission coloured by the blackbody of the point's temperature (T_max -> FIRE_KELVIN, as
-    the fire Volume) of strength POINT_EMISSION · T / T_max; created once, then left to the
+    """Emission coloured by the fire Volume's colour ramp of the point's T / T_max, of strength POINT_EMISSION · T / T_max; created once, then left to the
     artist."""
     mat = bpy.data.materials.get(MATERIAL)
     if mat is not None:
@@ -113,12 +112,10 @@ def points_material(max_temperature):
     mat, nt, out = datablocks.node_material(MATERIAL)
     N, L = nt.nodes.new, nt.links.new
     emission = N("ShaderNodeEmission")
-    blackbody = N("ShaderNodeBlackbody")
-    blackbody.location = (-200, 0)
+    ramp = fire_ramp_node(nt, (-200, 0))
     t_max = max(max_temperature, 1e-3)
-    L(_scaled_attribute(nt, TEMPERATURE_ATTRIBUTE, FIRE_KELVIN / t_max, 0).outputs[0],
-      blackbody.inputs["Temperature"])
-    L(blackbody.outputs["Color"], emission.inputs["Color"])
+    L(_scaled_attribute(nt, TEMPERATURE_ATTRIBUTE, 1.0 / t_max, 0).outputs[0], ramp.inputs["Fac"])
+    L(ramp.outputs["Color"], emission.inputs["Color"])
     L(_scaled_attribute(nt, TEMPERATURE_ATTRIBUTE, POINT_EMISSION / t_max, -200).outputs[0],
       emission.inputs["Strength"])
     L(emission.outputs["Emission"], out.inputs["Surface"])

@@ -1,5 +1,5 @@
 """The synthesized fire (flow-graph fire, §5.3) as a Volume object over fire/fire_####.vdb with
-the fire material (blackbody from temperature, emission from flame): renders without the add-on."""
+the fire material (colour ramp of temperature, emission from flame): renders without the add-on."""
 
 import bpy
 

@@ -5,6 +5,7 @@ import bpy
 
 from . import datablocks
 from .. import cache
+from ..fire_colors import FIRE_RAMP
 from ..snapshot import blend_relative
 
 SMOKE_MATERIAL = "Plume Smoke"
@@ -12,26 +13,22 @@ FIRE_MATERIAL = "Plume Fire"
 #: Principled Volume density multiplier of the smoke material (the solver's ρ is ~1 in sources).
 SMOKE_DENSITY = 5.0
 #: Fire material (a fire a compositor would take: bright orange-yellow flames, cooling to dark
-#: red and soot at the top, on black): T_max shows as a blackbody of FIRE_KELVIN (yellow under
-#: Filmic), ambient (T = 0) as one of FIRE_KELVIN_COLD (Blender's deepest red: it clamps below
-#: 965 K), a quarter of T_max (the default ignition) 1200 K red, 60% (the flames' usual heat)
-#: 2300 K orange: the emission colour is the blackbody of a linear map between them
-#: (fire_points.py uses T_max -> FIRE_KELVIN too); the flame grid (0..1) scaled by
-#: FIRE_EMISSION is the emission strength; the soot density is the density grid times
+#: red and soot at the top, on black): the emission colour is fire_colors.FIRE_RAMP of T / T_max
+#: (a Color Ramp the artist can edit; measured to read orange-yellow under both AgX and Filmic,
+#: where a blackbody reads salmon under AgX); the flame grid (0..1) scaled by FIRE_EMISSION is
+#: the emission strength; the soot density is the density grid times
 #: FIRE_DENSITY · clamp(1 - FIRE_SOOT_FADE flame, 0, 1): none where the flame burns (real flames
 #: are nearly transparent, so the hot core is not dimmed by its own fuel), all of it where the
 #: flame has gone out, scattering little (FIRE_SOOT_COLOR) and absorbing the rest, so cooled
 #: smoke above the flames reads dark. The Principled Volume's own blackbody is off: the emission
 #: is the flame grid's alone.
-FIRE_KELVIN = 3600.0
-FIRE_KELVIN_COLD = 400.0
-FIRE_EMISSION = 16.0
+FIRE_EMISSION = 40.0
 FIRE_DENSITY = 4.0
 FIRE_SOOT_FADE = 4.0
 FIRE_SOOT_COLOR = (0.05, 0.04, 0.035, 1.0)
 #: Layout version of "Plume Fire" (custom property "plume_version"): a Plume Fire made by an
 #: older Plume is rebuilt; a material the artist put in its place is left alone.
-FIRE_MATERIAL_VERSION = 2
+FIRE_MATERIAL_VERSION = 3
 
 
 def volume_name(domain):
@@ -52,7 +49,7 @@ def _setup_material(nt, out, combustion, max_temperature):
 
 
 def _setup_fire(nt, pv, max_temperature):
-    """The fire's emission and soot on Principled Volume `pv` (see FIRE_KELVIN)."""
+    """The fire's emission and soot on Principled Volume `pv` (see FIRE_EMISSION)."""
     pv.inputs["Color"].default_value = FIRE_SOOT_COLOR
     flame = _scaled_attribute(nt, "flame", FIRE_EMISSION, -300)
     nt.links.new(flame.outputs[0], pv.inputs["Emission Strength"])
@@ -72,18 +69,29 @@ def _setup_fire(nt, pv, max_temperature):
     temperature = nt.nodes.new("ShaderNodeAttribute")
     temperature.location = (-800, -100)
     temperature.attribute_name = "temperature"
-    kelvin = nt.nodes.new("ShaderNodeMapRange")  # T in [0, T_max] -> kelvin, clamped
-    kelvin.location = (-400, -100)
-    kelvin.inputs["From Min"].default_value = 0.0
-    kelvin.inputs["From Max"].default_value = max(max_temperature, 1e-3)
-    kelvin.inputs["To Min"].default_value = FIRE_KELVIN_COLD
-    kelvin.inputs["To Max"].default_value = FIRE_KELVIN
-    kelvin.clamp = True
-    nt.links.new(temperature.outputs["Fac"], kelvin.inputs["Value"])
-    blackbody = nt.nodes.new("ShaderNodeBlackbody")
-    blackbody.location = (-200, -100)
-    nt.links.new(kelvin.outputs["Result"], blackbody.inputs["Temperature"])
-    nt.links.new(blackbody.outputs["Color"], pv.inputs["Emission Color"])
+    heat = nt.nodes.new("ShaderNodeMath")  # T / T_max
+    heat.location = (-600, -100)
+    heat.operation = 'DIVIDE'
+    nt.links.new(temperature.outputs["Fac"], heat.inputs[0])
+    heat.inputs[1].default_value = max(max_temperature, 1e-3)
+    ramp = fire_ramp_node(nt, (-400, -100))
+    nt.links.new(heat.outputs[0], ramp.inputs["Fac"])
+    nt.links.new(ramp.outputs["Color"], pv.inputs["Emission Color"])
+
+
+def fire_ramp_node(nt, location):
+    """A Color Ramp node "Fire Colour" holding fire_colors.FIRE_RAMP (input: T / T_max)."""
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    ramp.location = location
+    ramp.name = ramp.label = "Fire Colour"
+    elements = ramp.color_ramp.elements
+    while len(elements) > 1:
+        elements.remove(elements[-1])
+    for i, (position, rgb) in enumerate(FIRE_RAMP):
+        element = elements[0] if i == 0 else elements.new(position)
+        element.position = position
+        element.color = (*rgb, 1.0)
+    return ramp
 
 
 def _scaled_attribute(nt, name, factor, y):
