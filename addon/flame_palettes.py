@@ -1,7 +1,13 @@
 """The default colour image of each library profile (structural_flames.txt §5.1: "we find a
 reference photograph and map the picture onto the two-dimensional profile"), no ``bpy``.
 
-Each palette is painted from what photographs of such flames show, on the profile's side view:
+Each palette is painted from what photographs of such flames show, on the profile's side view,
+and checked through today's view transforms: AgX (Blender 4.x/5.x) desaturates a colour with
+much blue in it to cream, and any colour between linear brightness 1 and 4 loses half its
+saturation there, so the palettes keep blue low (b/r <= 0.2) and spread the brightness: a
+yellow core about twice the flame's mean (linear green/red 0.6: yellow-white where it is
+hottest), an orange body, dim saturated red-orange edges and tip (green/red 0.2-0.35: hue 15-25
+degrees under AgX, 20-35 under Filmic) at a third to a tenth of the core.
 u across the widest diameter (x from -1 to 1, in widest radii), v from the base (s = 0) to the tip
 (s = 1). Values are scene-linear RGB whose brightness is relative: the bake scales every flame so
 that its power-weighted mean luminance is 1 (eq. 5-6 give the flame's brightness; the image
@@ -32,10 +38,10 @@ def _smoothstep(edge0, edge1, x):
 
 
 def _candle(x, s):
-    core = _ramp(s, [(0.0, (1.0, 0.78, 0.42)), (0.55, (1.0, 0.8, 0.48)),
-                     (0.8, (1.0, 0.55, 0.18)), (1.0, (0.75, 0.22, 0.05))])
-    mantle = _ramp(s, [(0.0, (0.8, 0.38, 0.08)), (0.6, (0.9, 0.4, 0.08)),
-                       (1.0, (0.55, 0.13, 0.03))])
+    core = _ramp(s, [(0.0, (1.5, 1.0, 0.3)), (0.55, (1.5, 0.95, 0.28)),
+                     (0.8, (1.2, 0.6, 0.12)), (1.0, (0.6, 0.17, 0.03))])
+    mantle = _ramp(s, [(0.0, (0.8, 0.32, 0.05)), (0.6, (0.7, 0.26, 0.04)),
+                       (1.0, (0.35, 0.07, 0.01))])
     rgb = core + (mantle - core) * _smoothstep(0.35, 1.0, np.abs(x))[..., None]
     # The blue base: strongest at the bottom and outside, gone by a fifth of the height.
     blue = np.array([0.12, 0.3, 1.0]) * 0.45
@@ -44,18 +50,18 @@ def _candle(x, s):
 
 
 def _torch(x, s):
-    core = _ramp(s, [(0.0, (1.0, 0.72, 0.3)), (0.3, (1.0, 0.6, 0.18)),
-                     (0.65, (1.0, 0.38, 0.07)), (1.0, (0.45, 0.08, 0.02))])
-    edge = _ramp(s, [(0.0, (0.9, 0.4, 0.08)), (0.5, (0.8, 0.25, 0.04)),
-                     (1.0, (0.3, 0.05, 0.01))])
+    core = _ramp(s, [(0.0, (1.6, 1.0, 0.25)), (0.3, (1.4, 0.75, 0.14)),
+                     (0.65, (1.0, 0.38, 0.05)), (1.0, (0.35, 0.07, 0.01))])
+    edge = _ramp(s, [(0.0, (0.7, 0.25, 0.03)), (0.5, (0.5, 0.14, 0.015)),
+                     (1.0, (0.15, 0.025, 0.005))])
     return core + (edge - core) * _smoothstep(0.4, 1.0, np.abs(x))[..., None]
 
 
 def _campfire(x, s):
-    core = _ramp(s, [(0.0, (1.2, 0.85, 0.4)), (0.25, (1.0, 0.62, 0.2)),
-                     (0.6, (1.0, 0.38, 0.07)), (1.0, (0.5, 0.1, 0.02))])
-    edge = _ramp(s, [(0.0, (1.0, 0.5, 0.12)), (0.5, (0.85, 0.26, 0.04)),
-                     (1.0, (0.3, 0.05, 0.01))])
+    core = _ramp(s, [(0.0, (1.7, 1.1, 0.3)), (0.25, (1.4, 0.8, 0.16)),
+                     (0.6, (1.0, 0.4, 0.05)), (1.0, (0.4, 0.08, 0.01))])
+    edge = _ramp(s, [(0.0, (0.75, 0.28, 0.04)), (0.5, (0.55, 0.15, 0.02)),
+                     (1.0, (0.15, 0.025, 0.005))])
     return core + (edge - core) * _smoothstep(0.35, 1.0, np.abs(x))[..., None]
 
 

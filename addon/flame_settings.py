@@ -26,6 +26,9 @@ LIGHT_UNIT = 2.0e6
 POINTS_RANGE = RANGES["flames.points"]
 FLAMES_PER_SOURCE_RANGE = RANGES["flames.flames_per_source"]
 SUBSTEPS_RANGE = RANGES["flames.substeps"]
+#: A Flame Source's Intensity in stops (2^stops scales eq. 5's E): 40 stops either way covers a
+#: match to a burning house (eq. 5's r^7 puts a candle and a dragon's breath 26 stops apart).
+STOPS_RANGE = (-40.0, 40.0)
 #: Samples per flame when the scene has no camera (no projected area to size them from).
 FIXED_PARTICLES = 4000
 NO_SOURCE = ("Plume: the scene has no Flame Source (make a mesh one with "
@@ -44,30 +47,32 @@ def spines_path(folder, frame):
 class FlameSettings:
     """Scene-level settings at one frame (scene.plume_flames), the paper's symbols in comments."""
 
-    points: int = 16                   # n (§4.1)
-    height_persistent: float = 0.03    # H_p (§4.3)
-    height_intermittent: float = 0.06  # H_i
-    height_max: float = 0.12           # H_max
-    lifespan_scale: float = 0.25       # A (s)
-    breakaway_frequency: float = 0.0   # f (Hz), 0 = 0.50 (g/2r)^½
-    buoyancy: float = 0.5              # β of eq. 2
-    diffusion: float = 1e-4            # d(T_p) of eq. 1, m²/s
+    # The defaults are the Candle preset's (flame_presets.CANDLE_SCENE): a new Flame Source on
+    # any small mesh makes a candle flame.
+    points: int = 12                   # n (§4.1)
+    height_persistent: float = 0.024   # H_p (§4.3)
+    height_intermittent: float = 0.03  # H_i
+    height_max: float = 0.042          # H_max
+    lifespan_scale: float = 1.0 / 24.0  # A (s)
+    breakaway_frequency: float = 0.7   # f (Hz), 0 = 0.50 (g/2r)^½
+    buoyancy: float = 0.4              # β of eq. 2
+    diffusion: float = 2e-6            # d(T_p) of eq. 1, m²/s
     particles_per_pixel: float = 10.0  # §5.3
     max_particles: int = 50000
     merging: bool = True               # §4.5
-    flow_noise: float = 0.15           # §4.5 buoyancy noise (widest radii)
+    flow_noise: float = 0.04           # §4.5 buoyancy noise (widest radii)
     flow_noise_scale: float = 0.8      # λ, widest radii
     flow_noise_frequency: float = 3.0  # ν, Hz
     flow_noise_rotation: float = 0.5   # ω · 2r, rad·m/s
-    kolmogorov: float = 0.003          # §4.5 Kolmogorov noise (m RMS)
+    kolmogorov: float = 0.0001         # §4.5 Kolmogorov noise (m RMS)
     kolmogorov_scale: float = 0.5      # Λ, m
     kolmogorov_frequency: float = 0.5  # ν, Hz
     kolmogorov_drift: Tuple[float, float, float] = (0.0, 0.0, 0.5)  # c, m/s
-    spine_noise: float = 0.04          # §4.2 Kolmogorov velocity on the spine (m/s RMS)
+    spine_noise: float = 0.003         # §4.2 Kolmogorov velocity on the spine (m/s RMS)
     spine_noise_scale: float = 0.25    # Λ, m
     spine_noise_frequency: float = 1.0  # ν, Hz
     spine_noise_drift: Tuple[float, float, float] = (0.0, 0.0, 0.5)  # c, m/s
-    voxel_size: float = 0.002
+    voxel_size: float = 0.001
     temperature_scale: float = 1500.0  # K at d = I (temperature grid, blackbody colour)
     heat_of_combustion: float = 15.0   # H_c, MJ/kg (eq. 5)
     light_unit: float = LIGHT_UNIT     # k of eq. 5: Blender W per W of E
@@ -121,8 +126,9 @@ class FlameSourceInput:
     height_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: 4x4 world matrices at frames frame_start - 1 .. frame_end.
     matrices: List[np.ndarray] = field(default_factory=list)
-    #: (radius r, intensity I, temperature T_p) at frames frame_start .. frame_end.
-    values: List[Tuple[float, float, float]] = field(default_factory=list)
+    #: (radius r, intensity I, temperature T_p, Intensity in stops) at frames frame_start ..
+    #: frame_end.
+    values: List[Tuple[float, float, float, float]] = field(default_factory=list)
 
     @property
     def count(self):
@@ -235,13 +241,16 @@ def _check_noise(s, at, name, label, unit, open_low):
 
 
 def validate_source_values(src: FlameSourceInput):
-    for i, (r, intensity, temp) in enumerate(src.values):
+    lo, hi = STOPS_RANGE
+    for i, (r, intensity, temp, stops) in enumerate(src.values):
         at = f"Flame Source '{src.name}'"
         _check(_finite(r) and r > 0.0, f"{at}: Radius (r) must be > 0 (got {r})")
         _check(_finite(intensity) and intensity >= 0.0,
-               f"{at}: Intensity (I) must be >= 0 (got {intensity})")
+               f"{at}: Density (I) must be >= 0 (got {intensity})")
         _check(_finite(temp) and temp >= 0.0,
                f"{at}: Temperature (T_p) must be >= 0 (got {temp})")
+        _check(_finite(stops) and lo <= stops <= hi,
+               f"{at}: Intensity must be in [{lo:g}, {hi:g}] stops (got {stops})")
 
 
 def validate_snapshot(snap: FlameBakeSnapshot):

@@ -215,7 +215,7 @@ class FlameBakeRunner:
         x0, x1 = (m0 @ p)[:3], (m1 @ p)[:3]
         n = m1[:3, :3] @ src.local_normals[k]
         n = n / max(float(np.linalg.norm(n)), 1e-12)
-        r, intensity, temp = src.values[index]
+        r, intensity, temp, stops = src.values[index]
         fs = self.native.FlameSource()
         fs.position = tuple(x0 + alpha * (x1 - x0))
         fs.normal = tuple(n)
@@ -227,6 +227,7 @@ class FlameBakeRunner:
         fs.diameter_scale = float(src.diameter_scale[k])
         fs.height_scale = float(src.height_scale[k])
         fs.temperature = float(temp)
+        fs.brightness = 2.0 ** float(stops)
         return fs
 
     def _wind(self, system, index):

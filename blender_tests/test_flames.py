@@ -126,9 +126,11 @@ class FlamesTest(unittest.TestCase):
         px = image_pixels(scn.render.filepath)[..., :3]
         lit = float((px.max(axis=2) > 0.05).mean())
         print(f"  {name} render: max {px.max():.3f}, lit pixels {lit * 100:.1f}%")
-        # Measured in 3.4.1-5.3: candle 8.5-9.3%, torch 15.3-18.6%; the floors leave a third
-        # for the Blenders' differences and say the flame fills its part of the frame.
-        self.assertGreater(lit, {"candle": 0.06, "torch": 0.10}[name])
+        # Measured in 3.4.1: candle 4.9% (8.5-9.3% before the Flames defaults became the Candle
+        # preset's: calmer noise, and separated tips thin to wisps), torch 15.2% (3.4.1-5.3
+        # before: 15.3-18.6%); the floors leave a third for the Blenders' differences and say the
+        # flame fills its part of the frame.
+        self.assertGreater(lit, {"candle": 0.033, "torch": 0.10}[name])
         return sp
 
     def test_candle(self):

@@ -42,7 +42,8 @@ PANELS = ("PHYSICS_PT_plume", "PHYSICS_PT_plume_settings", "PHYSICS_PT_plume_for
 FLAME_PANELS = {"PHYSICS_PT_plume_flame_source", "PHYSICS_PT_plume_flames",
                 "PHYSICS_PT_plume_flames_noise"}
 OPERATORS = ("PLUME_OT_role_set", "PLUME_OT_bake", "PLUME_OT_cache_free", "PLUME_OT_flames_bake",
-             "PLUME_OT_flames_free", "PLUME_OT_flames_bake_spines_keyframes")
+             "PLUME_OT_flames_free", "PLUME_OT_flames_bake_spines_keyframes",
+             "PLUME_OT_flame_preset", "PLUME_OT_flames_auto_exposure")
 
 
 class FakeLayout:
@@ -66,6 +67,13 @@ class FakeLayout:
         self.test.assertTrue(hasattr(bpy.types, f"{module.upper()}_OT_{op}"), idname)
         self.log.append(("operator", idname))
         return SimpleNamespace()
+
+    def operator_menu_enum(self, idname, prop, **kwargs):
+        module, op = idname.split(".")
+        cls = getattr(bpy.types, f"{module.upper()}_OT_{op}", None)
+        self.test.assertIsNotNone(cls, idname)
+        self.test.assertEqual(cls.bl_rna.properties[prop].type, 'ENUM', f"{idname}.{prop}")
+        self.log.append(("operator_menu_enum", idname))
 
     def label(self, **kwargs):
         self.log.append(("label", kwargs.get("text", "")))

@@ -7,8 +7,12 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from ..flame_presets import PRESETS
 from ..flame_settings import LIGHT_UNIT
 from ..ranges import text
+
+#: The defaults are the Candle preset's: a new Flame Source on any small mesh makes a candle.
+CANDLE_SOURCE, CANDLE = PRESETS['CANDLE'][2], PRESETS['CANDLE'][3]
 
 PROFILE_ITEMS = (
     ('CANDLE', "Candle", "Figure 3, left: a slim candle flame"),
@@ -60,11 +64,17 @@ class PlumeFlameSourceSettings(bpy.types.PropertyGroup):
                     "evenly over them (area-weighted, deterministic); in "
                     + text('flames.flames_per_source'))
     radius: FloatProperty(
-        name="Radius (r)", default=0.01, soft_min=0.001, soft_max=1.0, unit='LENGTH',
+        name="Radius (r)", default=CANDLE_SOURCE["radius"], soft_min=0.001, soft_max=1.0, unit='LENGTH',
         precision=4, description="r: radius of each flame's source (m): the profile's width and "
                                  "the breakaway frequency f = 0.50 (g/2r)^½ (§4.3); > 0")
-    intensity: FloatProperty(name="Intensity (I)", default=1.0, soft_min=0.0, soft_max=10.0,
-                             description="I of eq. 4: density of the flame's light; >= 0")
+    stops: FloatProperty(
+        name="Intensity", default=0.0, soft_min=-16.0, soft_max=16.0, step=50, precision=1,
+        description="Brightness of this source's flames and of their lights, in stops (+1 doubles, "
+                    "-1 halves) on top of the scene's Light Unit: lets a candle and a campfire "
+                    "share one exposure (k of eq. 5, \"for visual control\"); in [-40, 40]")
+    intensity: FloatProperty(name="Density (I)", default=1.0, soft_min=0.0, soft_max=10.0,
+                             description="I of eq. 4: density of the flame's glowing gas (its "
+                                         "light's share and its opacity); >= 0")
     temperature: FloatProperty(
         name="Temperature (T_p)", default=1.0, soft_min=0.0, soft_max=10.0,
         description="T_p of eq. 1-2 (normalized, ambient T_0 = 0): scales the Brownian "
@@ -107,32 +117,32 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
                           description="Steps of eq. 1 per frame (§4.1); in "
                                       + text('flames.substeps'))
     # --- Structure (§4.1-4.3) ---
-    points: IntProperty(name="Control Points (n)", default=16, soft_min=2, soft_max=64,
+    points: IntProperty(name="Control Points (n)", default=CANDLE["points"], soft_min=2, soft_max=64,
                         description="n: points of a flame's spine (§4.1); in "
                                     + text('flames.points'))
     height_persistent: FloatProperty(
-        name="Persistent Height (H_p)", default=0.03, soft_min=0.0, soft_max=10.0,
+        name="Persistent Height (H_p)", default=CANDLE["height_persistent"], soft_min=0.0, soft_max=10.0,
         unit='LENGTH', description="H_p: top of the continuous region (Figure 2, §4.3); "
                                    "0 <= H_p < H_i")
     height_intermittent: FloatProperty(
-        name="Intermittent Height (H_i)", default=0.06, soft_min=0.0, soft_max=10.0,
+        name="Intermittent Height (H_i)", default=CANDLE["height_intermittent"], soft_min=0.0, soft_max=10.0,
         unit='LENGTH', description="H_i: top of the intermittent region; longer flames may "
                                    "flicker or break (§4.3); H_p < H_i <= H_max")
     height_max: FloatProperty(
-        name="Max Height (H_max)", default=0.12, soft_min=0.0, soft_max=20.0, unit='LENGTH',
+        name="Max Height (H_max)", default=CANDLE["height_max"], soft_min=0.0, soft_max=20.0, unit='LENGTH',
         description="H_max: artistic limit on flame length, D(h) = 1 past it (§4.3); >= H_i")
     lifespan_scale: FloatProperty(
-        name="Lifespan Scale (A)", default=0.25, soft_min=1.0 / 24.0, soft_max=2.0,
+        name="Lifespan Scale (A)", default=CANDLE["lifespan_scale"], soft_min=1.0 / 24.0, soft_max=2.0,
         unit='TIME_ABSOLUTE', description="A: a separated flame lives A·i³, i uniform in [0,1] "
                                           "(§4.3); in [1/24, 2] s")
     breakaway_frequency: FloatProperty(
-        name="Breakaway Frequency (f)", default=0.0, soft_min=0.0, soft_max=50.0,
+        name="Breakaway Frequency (f)", default=CANDLE["breakaway_frequency"], soft_min=0.0, soft_max=50.0,
         description="f: breakaway rate past H_i in Hz (§4.3); 0 = automatic, 0.50 (g/2r)^½")
-    buoyancy: FloatProperty(name="Buoyancy (β)", default=0.5, soft_min=0.0, soft_max=10.0,
+    buoyancy: FloatProperty(name="Buoyancy (β)", default=CANDLE["buoyancy"], soft_min=0.0, soft_max=10.0,
                             description="β of eq. 2: thermal buoyancy c = β |g| (T_p − T_0) t_p; "
                                         "in [0, 100]")
     diffusion: FloatProperty(
-        name="Diffusion", default=1e-4, soft_min=0.0, soft_max=0.01, precision=5,
+        name="Diffusion", default=CANDLE["diffusion"], soft_min=0.0, soft_max=0.01, precision=5,
         description="d(T_p) of eq. 1: Brownian diffusion coefficient (m²/s) scaled by T_p; "
                     "in [0, 10]")
     # --- Shape and detail (§4.4-4.5) ---
@@ -147,7 +157,7 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
                           description="§4.5: drop particles inside a neighbouring flame and "
                                       "outside their own (flames appear to merge)")
     # --- Noise (§4.2 on the spine, §4.5 on the render particles) ---
-    flow_noise: FloatProperty(name="Flow Noise", default=0.15, soft_min=0.0, soft_max=1.0,
+    flow_noise: FloatProperty(name="Flow Noise", default=CANDLE["flow_noise"], soft_min=0.0, soft_max=1.0,
                               description="§4.5: buoyancy (flow) noise amplitude, in widest "
                                           "radii of the profile; 0 turns it off; in "
                                           + text('flames.flow_noise'))
@@ -165,7 +175,7 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
         description="ω × source diameter 2r (rad·m/s): the flow noise's gradients turn at "
                     "ω = this / 2r, faster on small sources (§4.5); in "
                     + text('flames.flow_noise_rotation'))
-    kolmogorov: FloatProperty(name="Kolmogorov Noise", default=0.003, soft_min=0.0,
+    kolmogorov: FloatProperty(name="Kolmogorov Noise", default=CANDLE["kolmogorov"], soft_min=0.0,
                               soft_max=0.1, unit='LENGTH', precision=4,
                               description="§4.5: RMS displacement of the render particles by the "
                                           "Kolmogorov-spectrum turbulence (m); 0 turns it off; "
@@ -185,7 +195,7 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
         description="c: velocity carrying the render particles' frozen Kolmogorov turbulence "
                     "(m/s, §4.5); each axis in " + text('flames.kolmogorov_drift'))
     spine_noise: FloatProperty(
-        name="Spine Noise", default=0.04, soft_min=0.0, soft_max=0.5, unit='VELOCITY',
+        name="Spine Noise", default=CANDLE["spine_noise"], soft_min=0.0, soft_max=0.5, unit='VELOCITY',
         precision=3,
         description="§4.2, §7: RMS speed (m/s) of the Kolmogorov-spectrum velocity added to eq. "
                     "1 for every control point of the spines (the torch's \"thermal buoyancy and "
@@ -225,11 +235,11 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
         description="§6.1: spine points are pushed out of the scene's Obstacle objects (closed "
                     "meshes, voxelized at Voxel Size at the first frame)")
     # --- Rendering (§5) ---
-    voxel_size: FloatProperty(name="Voxel Size", default=0.002, soft_min=0.0005, soft_max=0.1,
+    voxel_size: FloatProperty(name="Voxel Size", default=CANDLE["voxel_size"], soft_min=0.0005, soft_max=0.1,
                               unit='LENGTH', precision=4,
                               description="Δx of the flame VDB grids (m); > 0")
     temperature_scale: FloatProperty(
-        name="Temperature (K)", default=1500.0, soft_min=500.0, soft_max=4000.0,
+        name="Temperature (K)", default=CANDLE["temperature_scale"], soft_min=500.0, soft_max=4000.0,
         description="Kelvin where d = I: the temperature grid, and the particle colour of "
                     "sources whose Colour is Blackbody (§5.1); in [500, 40000]")
     emission: FloatProperty(

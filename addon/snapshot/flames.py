@@ -247,7 +247,7 @@ def flames_snapshot(context):
                 fl = ob.plume.flame
                 if frame >= f.frame_start:
                     src.values.append((float(fl.radius), float(fl.intensity),
-                                       float(fl.temperature)))
+                                       float(fl.temperature), float(fl.stops)))
             if frame >= f.frame_start:
                 settings.append(settings_now(f))
                 winds.append(_winds(scene, f))

@@ -26,6 +26,7 @@ class PHYSICS_PT_plume_flame_source(FlameSourcePanel, bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         fl = context.object.plume.flame
+        layout.operator_menu_enum("plume.flame_preset", "preset", text="Preset", icon='PRESET')
         layout.prop(fl, "profile")
         sub = layout.column()
         sub.active = fl.profile == 'CUSTOM'
@@ -33,7 +34,7 @@ class PHYSICS_PT_plume_flame_source(FlameSourcePanel, bpy.types.Panel):
         layout.prop(fl, "color_source")
         if fl.color_source == 'IMAGE':
             layout.prop(fl, "color_image")
-        for name in ("flames", "radius", "intensity", "temperature"):
+        for name in ("flames", "radius", "stops", "intensity", "temperature"):
             layout.prop(fl, name)
         col = layout.column(heading="Spread")
         col.prop(fl, "spread")
@@ -55,6 +56,7 @@ def draw_flames(layout, scene):
     row.operator("plume.flames_bake", icon='PHYSICS')
     row.operator("plume.flames_free", icon='TRASH')
     layout.operator("plume.flames_bake_spines_keyframes", icon='KEYINGSET')
+    layout.operator("plume.flames_auto_exposure", icon='LIGHT_SUN')
     col = layout.column(align=True)
     col.prop(f, "frame_start", text="Frame Start")
     col.prop(f, "frame_end", text="End")

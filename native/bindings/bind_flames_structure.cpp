@@ -96,7 +96,9 @@ void bindSettings(py::module_& m) {
       .def_readwrite("intensity", &FlameSource::intensity)
       .def_readwrite("diameter_scale", &FlameSource::diameterScale)
       .def_readwrite("height_scale", &FlameSource::heightScale)
-      .def_readwrite("temperature", &FlameSource::temperature);
+      .def_readwrite("temperature", &FlameSource::temperature)
+      .def_readwrite("brightness", &FlameSource::brightness,
+                     "2^(Intensity in stops): scales eq. 5's E of its flames (emission and light), not their opacity");
 }
 
 void bindFields(py::module_& m) {

@@ -269,6 +269,9 @@ Flame flameArg(const py::handle& h, std::size_t index) {
   f.radius = d.contains("radius") ? d["radius"].cast<double>() : 0.0;
   if (d.contains("intensity")) f.intensity = d["intensity"].cast<double>();
   if (d.contains("temperature")) f.temperature = d["temperature"].cast<double>();
+  if (d.contains("brightness")) f.brightness = d["brightness"].cast<double>();
+  if (d.contains("age")) f.age = d["age"].cast<double>();
+  if (d.contains("lifespan")) f.lifespan = d["lifespan"].cast<double>();
   f.id = d.contains("id") ? d["id"].cast<std::uint32_t>() : std::uint32_t(index + 1);
   if (d.contains("source")) f.source = d["source"].cast<int>();
   if (d.contains("separated")) f.separated = d["separated"].cast<bool>();
@@ -294,6 +297,7 @@ py::dict flameDict(const Flame& f) {
   d["radius"] = f.radius;
   d["intensity"] = f.intensity;
   d["temperature"] = f.temperature;
+  d["brightness"] = f.brightness;
   d["points"] = rowsArray(x);
   d["velocities"] = rowsArray(v);
   d["ages"] = ages;

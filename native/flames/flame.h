@@ -31,6 +31,10 @@ struct Flame {
   double radius = 0.0;    ///< r, the source radius (m): the profile's scale and f's r (§4.3)
   double intensity = 1.0; ///< I of eq. 4 times the artist's intensity (spread maps, §6.2)
   double temperature = 1.0;  ///< T_p, normalized flame temperature (diffusion, buoyancy: eq. 1–2)
+  /// The artist's brightness, 2^(Intensity in stops) of its source: k of eq. 5 ("for visual
+  /// control") per source, on top of the one physical Light Unit. Scales E (emission and light)
+  /// only, never the opacity.
+  double brightness = 1.0;
   /// Separated pieces: h of the flame they broke from, at the split (0: attached, or unknown).
   /// Eq. 5's 1/h would make a short piece brighter than its whole parent; a piece carries the
   /// parent's fuel over its share of the length instead: E = E(h_split) · h / h_split.

@@ -77,6 +77,7 @@ void FlameSource::validate(int index) const {
   requirePositive(p + "diameter_scale", diameterScale, 100.0, "");
   requirePositive(p + "height_scale", heightScale, 100.0, "");
   requireIn(p + "temperature", temperature, 0.0, 100.0, "");
+  requirePositive(p + "brightness", brightness, 1099511627776.0, "");
 }
 
 }  // namespace plume

@@ -72,6 +72,7 @@ struct FlameSource {
   double diameterScale = 1.0;       ///< scales radius (§6.2 diameter map), in (0, 100]
   double heightScale = 1.0;         ///< scales H_p, H_i, H_max (§6.2 height map), in (0, 100]
   double temperature = 1.0;         ///< T_p of the flames it feeds (normalized), in [0, 100]
+  double brightness = 1.0;          ///< 2^(Intensity stops): scales E of its flames, in (0, 2^40]
 
   /// Throws std::invalid_argument naming "sources[index].<setting>" and its range.
   void validate(int index) const;

@@ -36,9 +36,37 @@ void checkFlame(const Flame& flame, std::size_t f) {
     throw std::invalid_argument(flameName(f) + ": split_length must be a finite number >= 0 m");
   if (!(flame.intensity >= 0.0) || !std::isfinite(flame.intensity))
     throw std::invalid_argument(flameName(f) + ": intensity must be a finite number >= 0");
+  if (!(flame.brightness > 0.0) || !std::isfinite(flame.brightness))
+    throw std::invalid_argument(flameName(f) + ": brightness must be a finite number > 0");
+  if (!(flame.age >= 0.0 && flame.lifespan >= 0.0) || !std::isfinite(flame.age + flame.lifespan))
+    throw std::invalid_argument(flameName(f) + ": age and lifespan must be finite numbers >= 0 s");
   for (const SpinePoint& p : flame.points)
     if (!std::isfinite(p.x.x + p.x.y + p.x.z + p.v.x + p.v.y + p.v.z + p.age))
       throw std::invalid_argument(flameName(f) + ": spine points must be finite");
+}
+
+/// h / h_split of a separated piece of spine length `length` (1: attached, or unknown).
+double pieceShare(const Flame& flame, double length) {
+  return flame.separated && flame.splitLength > length ? length / flame.splitLength : 1.0;
+}
+
+/// The life a separated piece has left, 1 - age / (A i³) in [0, 1] (1: attached).
+double lifeLeft(const Flame& flame) {
+  if (!flame.separated || !(flame.lifespan > 0.0)) return 1.0;
+  return std::clamp(1.0 - flame.age / flame.lifespan, 0.0, 1.0);
+}
+
+/// Smallest width factor of a dying piece: it thins to a wisp, never to nothing.
+constexpr double kWispWidth = 0.05;
+
+/// The profile's widest radius R of a flame of spine length `length`: width × r. A separated
+/// piece keeps its parent's width only at birth and in proportion: R × √(h / h_split × life
+/// left), so a piece a third of its flame's length is a slimmer flame of nearly the parent's
+/// aspect, not a ball of the parent's width, and it thins as it fades (§4.3 gives pieces a
+/// lifespan, not a look: "there's no good model for how long it will remain visible").
+double shapeRadius(const FlameShapeParams& params, const Flame& flame, double length) {
+  return params.width * flame.radius *
+         std::sqrt(std::max(pieceShare(flame, length) * lifeLeft(flame), kWispWidth));
 }
 
 }  // namespace
@@ -124,17 +152,18 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const Flame& flame = flames[std::size_t(f)];
     const ProfileDensity& density = *mDensities[std::size_t(profileIndex(flame))];
     auto spine = std::make_unique<SpineFrame>(flame);
-    const double radius = mParams.width * flame.radius, length = spine->length();
+    const double length = spine->length(), radius = shapeRadius(mParams, flame, length);
     const int n = particleCount(mParams.sampling, density, *spine, radius, camera);
     glm::dvec3 meanVelocity(0.0);
     for (const SpinePoint& p : flame.points) meanVelocity += p.v;
     meanVelocity /= double(flame.points.size());
-    // Eq. 5; a separated piece: its share h / h_split of the flame it broke from (Flame::splitLength).
+    // Eq. 5 times the source's brightness (its Intensity in stops); a separated piece: its share
+    // h / h_split of the flame it broke from (Flame::splitLength), fading with the life it has left.
     const bool piece = flame.separated && flame.splitLength > length;
     const double energy =
-        flame.intensity *
+        flame.intensity * flame.brightness * lifeLeft(flame) *
         flameEnergy(mParams.incandescence, glm::length(meanVelocity), flame.radius, piece ? flame.splitLength : length) *
-        (piece ? length / flame.splitLength : 1.0);
+        pieceShare(flame, length);
     glm::dvec3 c, t, nn, b;
     spine->frameAt(0.5, &c, &t, &nn, &b);
     out.sampled[std::size_t(f)] = n;
@@ -176,7 +205,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
   if (merging) {
     for (int f = 0; f < count; ++f) {
       const ProfileDensity& density = *mDensities[std::size_t(profileIndex(flames[std::size_t(f)]))];
-      const double radius = mParams.width * flames[std::size_t(f)].radius;
+      const double radius = shapeRadius(mParams, flames[std::size_t(f)], spines[std::size_t(f)]->length());
       MergeVolume v = mergeVolume(*spines[std::size_t(f)], density.profile(), radius);
       // Glow shell, the ends' extension along the tangents, and both noises.
       const double ends = (density.zMax() - density.profile().aspect()) / density.profile().aspect() *
@@ -198,11 +227,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const ProfileDensity& density = *mDensities[std::size_t(pi)];
     const ColorImage* image = mImages.empty() ? nullptr : &mImages[mImages.size() == 1 ? 0 : std::size_t(pi)];
     const SpineFrame& spine = *spines[std::size_t(chunk.flame)];
-    const double aspect = density.profile().aspect(), radius = mParams.width * flame.radius;
+    const double aspect = density.profile().aspect(), radius = shapeRadius(mParams, flame, spine.length());
     // The colour image's v: a separated piece was the top h / h_split of its flame, so it takes
     // the top of the image (no blue base on a piece of flame with no fuel under it).
-    const double pieceShare =
-        flame.separated && flame.splitLength > spine.length() ? spine.length() / flame.splitLength : 1.0;
+    const double share = pieceShare(flame, spine.length());
     const int n = out.sampled[std::size_t(chunk.flame)];
     const std::vector<int>& near = neighbours[std::size_t(chunk.flame)];
     glm::dvec3 colorSum(0.0);
@@ -216,7 +244,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       spine.motionAt(std::clamp(p.z / aspect, 0.0, 1.0), &velocity, &age);
       // §5.1: the image on the profile's side view (u across the widest diameter, v from base
       // to tip; the glow outside takes the nearest edge's colour), else a blackbody.
-      const double v = 1.0 - pieceShare * (1.0 - p.z / aspect);
+      const double v = 1.0 - share * (1.0 - p.z / aspect);
       const glm::vec3 color = image && image->width > 0 ? image->sample(0.5 + 0.5 * p.x, v)
                                                         : (*mBlackbody)(s.density);
       p += mFlow.displacement(p, time - age, flame.radius);

@@ -61,6 +61,7 @@ void FlameSystem::startFlame(int source) {
   f.radius = s.scaledRadius();
   f.intensity = s.intensity;
   f.temperature = s.temperature;
+  f.brightness = s.brightness;
   // §4.1: "a particle is generated at a fixed point on the burning surface and released into a
   // wind field"; the step that follows advances it and adds the next one at the surface.
   // Released where the source was at the start of this step: the step then carries it with the
@@ -94,6 +95,7 @@ void FlameSystem::updateSources() {
       f.radius = s.scaledRadius();
       f.intensity = s.intensity;
       f.temperature = s.temperature;
+      f.brightness = s.brightness;
     }
   }
 }

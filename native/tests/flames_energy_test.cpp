@@ -93,6 +93,55 @@ TEST(FlameEnergy, ScalesWithIntensityAndInverselyWithHeight) {
   EXPECT_NEAR(frame.energy[2] / frame.energy[0], 3.0, 1e-12);
 }
 
+TEST(FlameEnergy, BrightnessScalesEnergyNotOpacity) {
+  // A source's Intensity in stops (Flame::brightness = 2^stops) scales E, so the flame's
+  // emission and its light, and leaves its particles' density and mass (the opacity of §5.3)
+  // alone.
+  const FlameShaper shaper = shaperFor(1.0, 15.0e6, 0.0);
+  const Flame bright = straightFlame({0.0, 0.0, 0.0}, 0.1, 0.02, {0.0, 0.0, 0.6}, 1);
+  Flame dim = bright;
+  dim.brightness = 0.125;  // -3 stops
+  const FlameShapeFrame a = shaper.shape({bright}, 0.0, camera());
+  const FlameShapeFrame b = shaper.shape({dim}, 0.0, camera());
+  EXPECT_NEAR(b.energy[0] / a.energy[0], 0.125, 1e-12);
+  EXPECT_NEAR(b.lights[0].energy / a.lights[0].energy, 0.125, 1e-12);
+  EXPECT_EQ(a.particles.density, b.particles.density);
+  EXPECT_EQ(a.particles.mass, b.particles.mass);
+  EXPECT_EQ(a.particles.positions, b.particles.positions);
+}
+
+TEST(FlameEnergy, SeparatedPieceFadesAndThins) {
+  // A separated piece a third of its flame's length is a slim flame, not a ball of the parent's
+  // width (its widest radius × √(h / h_split)), and as its life runs out it dims (E × life
+  // left) and thins (× √life left) to a wisp.
+  FlameShapeParams params;
+  params.sampling.fixedCount = 4096;  // the RMS width to well under 1 %
+  params.merging = false;
+  params.flowNoise.amplitude = 0.0;  // the width is the profile's alone
+  params.kolmogorov.amplitude = 0.0;
+  const FlameShaper shaper({FlameProfile::library(ProfileShape::Torch)}, params);
+  const glm::dvec3 v(0.0, 0.0, 0.6);
+  auto piece = [&](double age) {
+    Flame f = straightFlame({0.0, 0.0, 0.0}, 0.05, 0.02, v, 1);
+    f.separated = true;
+    f.splitLength = 0.15;
+    f.lifespan = 0.2;
+    f.age = age;
+    return f;
+  };
+  auto width = [](const FlameShapeFrame& frame) {  // RMS distance of the particles from the spine
+    double sum = 0.0;
+    for (const glm::vec3& x : frame.particles.positions) sum += double(x.x) * x.x + double(x.y) * x.y;
+    return std::sqrt(sum / double(frame.particles.size()));
+  };
+  const FlameShapeFrame full = shaper.shape({straightFlame({0.0, 0.0, 0.0}, 0.05, 0.02, v, 1)}, 0.0, camera());
+  const FlameShapeFrame young = shaper.shape({piece(0.0)}, 0.0, camera());
+  const FlameShapeFrame old = shaper.shape({piece(0.15)}, 0.0, camera());  // a quarter left
+  EXPECT_NEAR(old.energy[0] / young.energy[0], 0.25, 1e-12);
+  EXPECT_NEAR(width(young) / width(full), std::sqrt(0.05 / 0.15), 0.01);
+  EXPECT_NEAR(width(old) / width(young), 0.5, 0.01);
+}
+
 TEST(FlameEnergy, MeanControlPointVelocity) {
   // v_c is the mean velocity of the control points: 9 points moving at 0.2 and 1.0 m/s
   // alternately (five at 0.2, four at 1.0: mean 5/9 m/s) give the E of a flame moving at 5/9 m/s
