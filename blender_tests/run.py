@@ -57,6 +57,8 @@ SUBSET = [
     "test_toon_smoke.py",      # toon smoke: Build Toon Smoke, render's outline = _native's
     "test_flowgraph_fire.py",  # flow-graph fire: 2 states, Flow Graph, Synthesize Fire, render
     "test_flames.py",          # structural flames: Bake Flames, grids, spines, lights, render
+    "test_flame_presets.py",   # flames' look per Blender's own view transform, presets, stops
+    "test_fire_look.py",       # combustion fire under the default view transform: hue, taper
     "test_job_child.py",       # jobs in a child: injected crashes cost the job, resume, CLI
 ]
 #: bpy wheels whose process teardown crashes after the tests: the 4.2 module frees registered
