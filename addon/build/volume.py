@@ -15,20 +15,28 @@ SMOKE_DENSITY = 5.0
 #: Fire material (a fire a compositor would take: bright orange-yellow flames, cooling to dark
 #: red and soot at the top, on black): the emission colour is fire_colors.FIRE_RAMP of T / T_max
 #: (a Color Ramp the artist can edit; measured to read orange-yellow under both AgX and Filmic,
-#: where a blackbody reads salmon under AgX); the flame grid (0..1) scaled by FIRE_EMISSION is
-#: the emission strength; the soot density is the density grid times
-#: FIRE_DENSITY · clamp(1 - FIRE_SOOT_FADE flame, 0, 1): none where the flame burns (real flames
-#: are nearly transparent, so the hot core is not dimmed by its own fuel), all of it where the
-#: flame has gone out, scattering little (FIRE_SOOT_COLOR) and absorbing the rest, so cooled
-#: smoke above the flames reads dark. The Principled Volume's own blackbody is off: the emission
-#: is the flame grid's alone.
-FIRE_EMISSION = 40.0
+#: where a blackbody reads salmon under AgX). The emission strength is FIRE_EMISSION · b², b =
+#: clamp((flame - FIRE_FLAME_LOW) / (FIRE_FLAME_HIGH - FIRE_FLAME_LOW), 0, 1) (node "Burning"):
+#: the solver's flame grid is the unburnt fuel (0..1), which decays as e^(-r t) and never reaches
+#: 0, so emission proportional to it lit the whole rising column to the domain's top (a uniform
+#: glowing tube); the threshold ends the flame where little fuel is left, earlier at its edges
+#: (mixed with air) than on its axis, so it tapers, and b² keeps the base bright and the tips dim.
+#: The soot density is the density grid times FIRE_DENSITY · clamp(1 - FIRE_SOOT_FADE b, 0, 1):
+#: none where the flame burns (real flames are nearly transparent, so the hot core is not dimmed
+#: by its own fuel), all of it where the flame has gone out, scattering little (FIRE_SOOT_COLOR)
+#: and absorbing the rest, so cooled smoke above the flames reads dark. The Principled Volume's
+#: own blackbody is off. Measured on the 1 m combustion scene of blender_tests/test_fire_look.py
+#: (domain defaults): see that file for the hue, white and lit numbers per Blender.
+FIRE_EMISSION = 10.0
+FIRE_FLAME_LOW = 0.05
+FIRE_FLAME_HIGH = 0.8
+FIRE_FLAME_POWER = 2.0
 FIRE_DENSITY = 4.0
 FIRE_SOOT_FADE = 4.0
 FIRE_SOOT_COLOR = (0.05, 0.04, 0.035, 1.0)
 #: Layout version of "Plume Fire" (custom property "plume_version"): a Plume Fire made by an
 #: older Plume is rebuilt; a material the artist put in its place is left alone.
-FIRE_MATERIAL_VERSION = 3
+FIRE_MATERIAL_VERSION = 4
 
 
 def volume_name(domain):
@@ -51,17 +59,39 @@ def _setup_material(nt, out, combustion, max_temperature):
 def _setup_fire(nt, pv, max_temperature):
     """The fire's emission and soot on Principled Volume `pv` (see FIRE_EMISSION)."""
     pv.inputs["Color"].default_value = FIRE_SOOT_COLOR
-    flame = _scaled_attribute(nt, "flame", FIRE_EMISSION, -300)
-    nt.links.new(flame.outputs[0], pv.inputs["Emission Strength"])
-    burnt = nt.nodes.new("ShaderNodeMath")  # 1 - FIRE_SOOT_FADE flame, clamped to [0, 1]
-    burnt.location = (-200, 150)
+    flame = nt.nodes.new("ShaderNodeAttribute")
+    flame.location = (-800, 150)
+    flame.attribute_name = "flame"
+    # burning = clamp((flame - FIRE_FLAME_LOW) / (FIRE_FLAME_HIGH - FIRE_FLAME_LOW), 0, 1)
+    span = max(FIRE_FLAME_HIGH - FIRE_FLAME_LOW, 1e-3)
+    burning = nt.nodes.new("ShaderNodeMath")
+    burning.location = (-600, 150)
+    burning.label = "Burning"
+    burning.operation = 'MULTIPLY_ADD'
+    burning.use_clamp = True
+    nt.links.new(flame.outputs["Fac"], burning.inputs[0])
+    burning.inputs[1].default_value = 1.0 / span
+    burning.inputs[2].default_value = -FIRE_FLAME_LOW / span
+    shaped = nt.nodes.new("ShaderNodeMath")  # burning ** FIRE_FLAME_POWER
+    shaped.location = (-400, 250)
+    shaped.operation = 'POWER'
+    nt.links.new(burning.outputs[0], shaped.inputs[0])
+    shaped.inputs[1].default_value = FIRE_FLAME_POWER
+    strength = nt.nodes.new("ShaderNodeMath")
+    strength.location = (-200, 250)
+    strength.operation = 'MULTIPLY'
+    nt.links.new(shaped.outputs[0], strength.inputs[0])
+    strength.inputs[1].default_value = FIRE_EMISSION
+    nt.links.new(strength.outputs[0], pv.inputs["Emission Strength"])
+    burnt = nt.nodes.new("ShaderNodeMath")  # 1 - FIRE_SOOT_FADE burning, clamped to [0, 1]
+    burnt.location = (-400, 100)
     burnt.operation = 'MULTIPLY_ADD'
     burnt.use_clamp = True
-    nt.links.new(flame.inputs[0].links[0].from_socket, burnt.inputs[0])  # the flame attribute
+    nt.links.new(burning.outputs[0], burnt.inputs[0])
     burnt.inputs[1].default_value = -FIRE_SOOT_FADE
     burnt.inputs[2].default_value = 1.0
     soot = nt.nodes.new("ShaderNodeMath")
-    soot.location = (-50, 150)
+    soot.location = (-200, 100)
     soot.operation = 'MULTIPLY'
     nt.links.new(burnt.outputs[0], soot.inputs[0])
     soot.inputs[1].default_value = FIRE_DENSITY

@@ -147,7 +147,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     # --- Combustion (graph_fire_synthesis.txt eqs. 1-5) ---
     combustion: BoolProperty(name="Combustion", default=False,
                              description="Burn fuel into heat and soot: the domain becomes a fire simulation")
-    burn_rate: FloatProperty(name="Burn Rate (r)", default=4.0, soft_min=0.0, soft_max=20.0,
+    burn_rate: FloatProperty(name="Burn Rate (r)", default=10.0, soft_min=0.0, soft_max=20.0,
                              description="r: fuel burnt per second, dF/dt = -r F (eq. 3)")
     soot_yield: FloatProperty(name="Soot Yield (k_S)", default=0.5, soft_min=0.0, soft_max=5.0,
                               description="k_S: soot made per unit of fuel burnt (eq. 4)")
@@ -156,12 +156,12 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     conductivity: FloatProperty(name="Conductivity (κ)", default=0.0, soft_min=0.0, soft_max=1.0,
                                 description="κ: thermal conductivity (heat diffusion), m²/s (eq. 5)")
     cooling_rate: FloatProperty(
-        name="Cooling (c)", default=1.0, soft_min=0.0, soft_max=10.0,
+        name="Cooling (c)", default=8.0, soft_min=0.0, soft_max=10.0,
         description="c: cooling c ((T - T_0)/(T_max - T_0))^4 per second (eq. 5)")
     max_temperature: FloatProperty(name="Max Temperature (T_max)", default=4.0, soft_min=0.0,
                                    soft_max=20.0, description="T_max: temperature of the hottest flame (eq. 5)")
     expansion: FloatProperty(
-        name="Expansion (φ)", default=1.0, soft_min=0.0, soft_max=10.0,
+        name="Expansion (φ)", default=5.0, soft_min=0.0, soft_max=10.0,
         description="φ: divergence per unit of fuel burnt per second in the reaction zone (eq. 1)")
     # --- Flame Smoke (structural_flames.txt §6.3, flame_smoke.py) ---
     flame_smoke: BoolProperty(
