@@ -5,8 +5,11 @@ Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 
          --python blender_tests/test_bad_input.py
 """
 
+import contextlib
+import io
 import os
 import sys
+import types
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -15,6 +18,26 @@ import bpy  # noqa: E402
 
 from helpers import (add_domain, add_sphere_source, reset_scene, rmtree, run,  # noqa: E402
                      select_only, temp_dir, tree_listing)
+
+
+class _Layout:
+    """Stands for a panel's layout: keeps the labels draw() puts in it ((text, icon)) and the
+    alert of the column each is in; every other call does nothing."""
+
+    def __init__(self, labels=None):
+        self.labels = [] if labels is None else labels
+        self.alert = False
+
+    def __getattr__(self, name):  # prop, operator, separator...
+        return lambda *args, **kwargs: None
+
+    def column(self, *args, **kwargs):
+        return _Layout(self.labels)
+
+    row = column
+
+    def label(self, text="", icon='NONE', **kwargs):
+        self.labels.append((text, icon, self.alert))
 
 
 class BadInputTest(unittest.TestCase):
@@ -109,6 +132,56 @@ class BadInputTest(unittest.TestCase):
         self.assertIsNotNone(bpy.data.objects.get("Domain_smoke"))
         self.assertEqual(len([n for n in os.listdir(os.path.join(self.cache, "Domain"))
                               if n.endswith(".vdb")]), 3)
+
+    def bake_printed(self):
+        """plume.bake as a script calls it; what it printed, its reports included ("Warning: ..."
+        as Blender writes them)."""
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            bpy.ops.plume.bake()
+        sys.stdout.write(out.getvalue())
+        return out.getvalue()
+
+    def source_panel_labels(self):
+        """The labels the Source panel (Physics > Plume > Source) draws for self.source."""
+        from plume.ui.panels import PHYSICS_PT_plume_source
+        select_only(self.source)
+        try:
+            panel = types.SimpleNamespace(layout=_Layout())
+            PHYSICS_PT_plume_source.draw(panel, bpy.context)
+            return panel.layout.labels
+        finally:
+            select_only(self.domain)
+
+    def test_fuel_without_combustion_warns(self):
+        # Issue 30: Fuel with Combustion off burns nothing; the panel and the bake say so, and
+        # the bake still runs (a warning, not an error).
+        self.source.plume.source.fuel = 1.0
+        self.assertFalse(self.domain.plume.domain.combustion)
+        labels = self.source_panel_labels()
+        alerts = [text for text, _icon, alert in labels if alert]
+        self.assertEqual(labels[0][1], 'ERROR', labels)
+        self.assertEqual(alerts, ["Fuel 1.0 of 'Source' burns only with Combustion on:",
+                                  "select the domain 'Domain' and enable",
+                                  "Physics › Plume › Combustion"])
+        out = self.bake_printed()
+        self.assertIsNotNone(bpy.data.objects.get("Domain_smoke"), "the bake must run")
+        self.assertEqual(len([n for n in os.listdir(os.path.join(self.cache, "Domain"))
+                              if n.endswith(".vdb")]), 3)
+        warnings = [line for line in out.splitlines() if line.startswith("Warning: ")]
+        self.assertEqual(len(warnings), 1, out)
+        for words in ("'Domain' baked", "Fuel", "'Source'", "Combustion", " ".join(alerts)):
+            self.assertIn(words, warnings[0])
+
+    def test_fuel_with_combustion_says_nothing(self):
+        self.source.plume.source.fuel = 1.0
+        self.domain.plume.domain.combustion = True
+        self.assertEqual([lb for lb in self.source_panel_labels() if lb[2]], [])
+        out = self.bake_printed()
+        self.assertIsNotNone(bpy.data.objects.get("Domain_smoke"))
+        self.assertNotIn("Warning: ", out)
+        self.assertNotIn("burns only with Combustion", out)
+        self.assertIn("Info: Plume: 'Domain' baked", out)
 
 
 if __name__ == "__main__":

@@ -32,6 +32,8 @@ class BakeJob(JobRunner):
     title = "Bake"
     kind = "bake"
     keeps_partial = True  # complete frames stay and resume
+    #: bake_runner.unburnt_fuel() of the snapshot: Fuel with Combustion off, said in the report
+    unburnt_fuel = ()
 
     def prepare(self, context):
         """Snapshot + the checks that need no solver; BakeError on bad input, nothing written
@@ -41,6 +43,7 @@ class BakeJob(JobRunner):
         self.objects = (snap.domain_name,)
         if snap.mantaflow is None:
             bake_runner.check_input(snap, _native)
+        self.unburnt_fuel = bake_runner.unburnt_fuel(snap)  # a warning: the bake runs
         self.claim(domain_key(snap.domain_name))
         self.lock_folder(snap.cache_folder, f"cache_directory '{snap.cache_directory}'")
         self.snapshot, self.folder = snap, snap.cache_folder
@@ -67,6 +70,8 @@ class BakeJob(JobRunner):
         text = (f"Plume: '{snap.domain_name}' {what}: frames {snap.frame_start}-"
                 f"{result.last_complete_frame} of {snap.frame_start}-{snap.frame_end} "
                 f"({len(result.computed_frames)} computed{resumed}, {result.seconds:.1f} s)")
+        if self.unburnt_fuel:
+            return 'WARNING', f"{text}; {' '.join(self.unburnt_fuel)}"
         return ('WARNING' if result.cancelled else 'INFO'), text
 
     def error_text(self, exc):

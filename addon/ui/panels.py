@@ -4,6 +4,7 @@ Mantaflow's): role buttons, then the settings of the object's role."""
 import bpy
 
 from .. import streak_count
+from ..bake_runner import fuel_without_combustion
 from ..native import _native
 from ..operators.bake import is_baking, is_busy
 from .. import cache_state
@@ -348,6 +349,16 @@ class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
             layout.label(text=f"Points: {g.points_object}", icon='OUTLINER_OB_POINTCLOUD')
 
 
+def source_fuel_warning(scene, ob):
+    """bake_runner.fuel_without_combustion() of Source `ob`: its Fuel and the domains of the
+    scene it feeds (every Plume domain simulating with Plume, as the bake's snapshot takes
+    every Source of the scene)."""
+    domains = [(o.name, o.plume.domain.combustion) for o in scene.objects
+               if o.type == 'MESH' and o.plume.role == 'DOMAIN'
+               and o.plume.domain.motion_source != 'MANTAFLOW']
+    return fuel_without_combustion([(ob.name, ob.plume.source.fuel)], domains)
+
+
 class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
     bl_label = "Source"
     bl_parent_id = "PHYSICS_PT_plume"
@@ -364,6 +375,12 @@ class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
         layout.prop(s, "density")
         layout.prop(s, "temperature")
         layout.prop(s, "fuel")
+        warning = source_fuel_warning(context.scene, context.object)
+        if warning:
+            col = layout.column(align=True)
+            col.alert = True
+            for i, line in enumerate(warning):
+                col.label(text=line, icon='ERROR' if i == 0 else 'BLANK1')
         layout.prop(s, "velocity")
         layout.prop(s, "motion_factor")
         col = layout.column(heading="Streak Surfaces")
