@@ -229,8 +229,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const SpineFrame& spine = *spines[std::size_t(chunk.flame)];
     const double aspect = density.profile().aspect(), radius = shapeRadius(mParams, flame, spine.length());
     // The colour image's v: a separated piece was the top h / h_split of its flame, so it takes
-    // the top of the image (no blue base on a piece of flame with no fuel under it).
-    const double share = pieceShare(flame, spine.length());
+    // the top of the image (no blue base on a piece of flame with no fuel under it), and as its
+    // life runs out it cools towards the tip's colour (v → 1): a breath of fire reddens along
+    // its length as its pieces age.
+    const double share = pieceShare(flame, spine.length()) * lifeLeft(flame);
     const int n = out.sampled[std::size_t(chunk.flame)];
     const std::vector<int>& near = neighbours[std::size_t(chunk.flame)];
     glm::dvec3 colorSum(0.0);

@@ -108,6 +108,32 @@ TEST(FlamesEmission, ASeparatedPieceCarriesItsShareOfTheParentsEnergy) {
   EXPECT_LT(frame.energy[1], frame.energy[0]);
 }
 
+TEST(FlamesEmission, AnAgeingPieceCoolsToTheTipsColour) {
+  // A separated piece takes the top h / h_split of the image at birth and, as its life runs
+  // out, moves to the image's top row: a young piece 0.4 of its flame's length spans mostly the
+  // red band (g/r 0.2) under the yellow top (0.9); near its end it is all top-row yellow.
+  FlameShapeParams params;
+  params.sampling.fixedCount = 4000;
+  params.flowNoise.amplitude = 0.0;
+  params.kolmogorov.amplitude = 0.0;
+  const FlameShaper shaper({FlameProfile::library(ProfileShape::Torch)}, params, {threeBands()});
+  FlameCamera camera;
+  auto meanGreenOverRed = [&](double age) {
+    Flame piece = uprightFlame(0.03, 0.02, 1.0, 2);
+    piece.separated = true;
+    piece.splitLength = 0.075;
+    piece.lifespan = 0.2;
+    piece.age = age;
+    const FlameParticles& p = shaper.shape({piece}, 0.0, camera).particles;
+    double g = 0.0, r = 0.0;
+    for (const glm::vec3& c : p.colors) g += c.y, r += c.x;
+    return g / r;
+  };
+  const double young = meanGreenOverRed(0.0), old = meanGreenOverRed(0.198);
+  EXPECT_LT(young, 0.7);        // measured 0.65: the red band blending into the top
+  EXPECT_NEAR(old, 0.9, 0.02);  // all top row
+}
+
 TEST(FlamesEmission, ColoursComeFromTheImageOnTheProfileWithMeanLuminanceOne) {
   FlameShapeParams params;
   params.sampling.fixedCount = 20000;
