@@ -72,7 +72,8 @@ class FakeLayout:
         module, op = idname.split(".")
         cls = getattr(bpy.types, f"{module.upper()}_OT_{op}", None)
         self.test.assertIsNotNone(cls, idname)
-        self.test.assertEqual(cls.bl_rna.properties[prop].type, 'ENUM', f"{idname}.{prop}")
+        rna = getattr(getattr(bpy.ops, module), op).get_rna_type()
+        self.test.assertEqual(rna.properties[prop].type, 'ENUM', f"{idname}.{prop}")
         self.log.append(("operator_menu_enum", idname))
 
     def label(self, **kwargs):
