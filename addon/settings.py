@@ -59,13 +59,13 @@ class SolverSettings:
     pressure_tolerance: float = 1e-4
     max_pressure_iterations: int = 200
     combustion: bool = False
-    burn_rate: float = 10.0
+    burn_rate: float = 6.0
     soot_yield: float = 0.5
     heat_yield: float = 4.0
     conductivity: float = 0.0
     cooling_rate: float = 8.0
     max_temperature: float = 4.0
-    expansion: float = 5.0
+    expansion: float = 3.0
     seed: int = 0
     threads: int = 0
 

@@ -28,7 +28,7 @@ SMOKE_DENSITY = 5.0
 #: own blackbody is off. Measured on the 1 m combustion scene of blender_tests/test_fire_look.py
 #: (domain defaults): see that file for the hue, white and lit numbers per Blender.
 FIRE_EMISSION = 10.0
-FIRE_FLAME_LOW = 0.05
+FIRE_FLAME_LOW = 0.1
 FIRE_FLAME_HIGH = 0.8
 FIRE_FLAME_POWER = 2.0
 FIRE_DENSITY = 4.0
