@@ -5,8 +5,10 @@ pathlines.bin), the graph built from them, and the synthesis that walks it.
     graph = build_graph(native, states, FlowGraphSettings(), out_folder)   # flowgraph.npz + PNG
     SynthesisRunner(native, out_folder, SynthesisSettings(...)).run()      # fire/fire_####.vdb
 
-The graph's nodes are the pathline groups of every state, state by state in file order, so node
-n of the graph is group node_steps[n] of state node_states[n]'s pathline file.
+The graph's nodes are the pathline groups of every state, state by state in file order, from
+each state's first_group on (the groups seeded before it, while the fire starts up from still
+air, are left out: startup_groups), so node n of the graph is group
+node_steps[n] + states[node_states[n]].first_group of its state's pathline file (node_groups).
 """
 
 import math
@@ -162,11 +164,38 @@ def turbulence_velocity(resolution, cell_size, origin, fields, t):
 
 @dataclass
 class State:
-    """One fire bake used as a state: its name, cache folder and open pathline file."""
+    """One fire bake used as a state: its name, cache folder and open pathline file, and its
+    first group that is a node of the graph (the groups before it are its start-up)."""
 
     name: str
     folder: str
     file: object  # _native.PathlineFile
+    first_group: int = 0
+
+    @property
+    def node_count(self):
+        """The state's nodes in the graph: its groups from first_group on."""
+        return int(self.file.node_count) - self.first_group
+
+
+def startup_groups(s: FlowGraphSettings, layout):
+    """The groups left out at the start of every state (FlowGraphSettings.startup_groups): the
+    pathlines' lifetime L in node steps by default. A bake starts from still air with no fire:
+    the groups seeded during its first t_max rise into a flow that is not yet the fire's (its
+    first particles have not yet died, the flame is still growing). Bakes that start alike
+    (the same domain, Source and feed, whatever their other settings) give nearly the same such
+    groups, so without this their block minima are hops between the states' first moments,
+    far cheaper than any candidate of the burning fire: a = min of the candidates falls, ε =
+    (2a + b)/3 with it, and almost no transition is kept (measured in
+    examples/flowgraph_fire/README.md)."""
+    return int(layout.samples) if s.startup_groups < 0 else int(s.startup_groups)
+
+
+def node_groups(graph, states: List[State]):
+    """The pathline group, in its state's file, of every node of `graph` (N,) int64."""
+    node_states = np.asarray(graph.node_states, np.int64)
+    first = np.asarray([st.first_group for st in states], np.int64)
+    return np.asarray(graph.node_steps, np.int64) + first[node_states]
 
 
 def open_states(native, named_folders: Sequence[Tuple[str, str]]) -> List[State]:
@@ -220,15 +249,37 @@ def _params(native, s: FlowGraphSettings, alpha, beta):
     return p
 
 
+def set_first_groups(states: List[State], s: FlowGraphSettings):
+    """Sets every state's first_group to startup_groups(); BakeError when a state has fewer than
+    two groups after its start-up (the bake is too short)."""
+    first = startup_groups(s, states[0].file.layout)
+    for st in states:
+        st.first_group = first
+        if st.node_count < 2:
+            raise BakeError(f"Plume: domain '{st.name}' holds {st.file.node_count} pathline "
+                            f"groups, {first} of them seeded while its fire starts up (the "
+                            "first pathline lifetime of the bake, left out of the graph): bake "
+                            "more frames (at least three times the pathline lifetime)")
+
+
+def graph_nodes(states: List[State]):
+    """Indices of the graph's nodes among all groups of all states (state by state): the
+    groups of each state from its first_group on."""
+    offsets = np.cumsum([0] + [int(st.file.node_count) for st in states])
+    return np.concatenate([np.arange(o + st.first_group, o + st.file.node_count)
+                           for o, st in zip(offsets, states)])
+
+
 def cost_matrix(native, states: List[State], s: FlowGraphSettings,
                 on_job: Optional[Callable[[object], None]] = None):
-    """C of eq. 9-10 over every group of every state, state by state: (cost, node counts per
-    state, FlowGraphParams with the weights α, β). BakeError on bad settings. The groups are
-    streamed from the states' pathline files (a bounded number in memory, never all of them).
-    on_job receives the native CostMatrixJob before it runs (another thread may read its
-    progress or cancel it)."""
+    """C of eq. 9-10 over the graph's nodes, state by state (each state's groups from its
+    first_group on, set here: set_first_groups): (cost, node counts per state, FlowGraphParams
+    with the weights α, β). BakeError on bad settings. The groups are streamed from the states'
+    pathline files (a bounded number in memory, never all of them). on_job receives the native
+    CostMatrixJob before it runs (another thread may read its progress or cancel it)."""
+    set_first_groups(states, s)
     pathline_files = [st.file for st in states]
-    counts = [st.file.node_count for st in states]
+    counts = [st.node_count for st in states]
     alpha, beta = ((native.same_magnitude_weights_of_files(pathline_files)) if s.auto_weights
                    else (s.alpha, s.beta))
     try:
@@ -241,7 +292,9 @@ def cost_matrix(native, states: List[State], s: FlowGraphSettings,
         on_job(job)
     if not job.run():
         raise BakeError("Plume: flow graph: cancelled")
-    return job.cost, counts, params
+    # The native job compares every group of the files; the start-up's rows and columns go.
+    keep = graph_nodes(states)
+    return np.ascontiguousarray(np.asarray(job.cost)[np.ix_(keep, keep)]), counts, params
 
 
 def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
@@ -265,12 +318,14 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
                "b": float(t["b"]), "epsilon": float(t["epsilon"]),
                "candidates": int(len(t["kept"])), "kept": int(np.sum(t["kept"])),
                "pruned": [int(v) for v in graph.pruned_per_state],
-               "nodes": [int(v) for v in counts]}
+               "nodes": [int(v) for v in counts],
+               "startup": [int(st.first_group) for st in states]}
     os.makedirs(out_folder, exist_ok=True)
     files.save_npz(graph_path(out_folder), compressed=True, cost=cost,
                    state_node_counts=np.asarray(counts, np.int64),
                    state_names=np.asarray([st.name for st in states]),
                    state_folders=np.asarray([st.folder for st in states]),
+                   first_groups=np.asarray([st.first_group for st in states], np.int64),
                    settings=np.asarray([s.block_size, s.min_node_gap, s.epsilon, alpha, beta],
                                        np.float64))
     files.write_bytes(image_path(out_folder), png_rgb(np.asarray(image)))
@@ -316,11 +371,16 @@ def load_graph(native, folder, owner):
             names = [str(v) for v in data["state_names"]]
             folders = [str(v) for v in data["state_folders"]]
             block, gap, eps, alpha, beta = (float(v) for v in data["settings"])
+            # Graphs built before the start-up was left out begin at group 0.
+            first = ([int(v) for v in data["first_groups"]] if "first_groups" in data.files
+                     else [0] * len(counts))
     except (OSError, KeyError, ValueError) as e:
         raise BakeError(f"Plume: {owner}: flow graph {path} cannot be read ({e}): build it "
                         "again") from None
     states = open_states(native, list(zip(names, folders)))
-    if [st.file.node_count for st in states] != counts:
+    for st, f in zip(states, first):
+        st.first_group = f
+    if len(first) != len(states) or [st.node_count for st in states] != counts:
         raise BakeError(f"Plume: {owner}: a state was baked again after the flow graph was "
                         "built: build the flow graph again")
     s = FlowGraphSettings(block_size=int(block), min_node_gap=int(gap), epsilon=eps,
@@ -408,7 +468,7 @@ class SynthesisRunner:
             max_temperature=settings.max_temperature,
             sheet_interval=float(f.layout.sample_dt))  # a group is emitted every node step
         self.hold = transition_hold_steps(settings, f.layout, self.steps_per_frame,
-                                          [(st.name, st.file.node_count) for st in states], owner)
+                                          [(st.name, st.node_count) for st in states], owner)
         self.walk = native.RandomWalk(
             graph, int(settings.seed),
             bias=(native.WalkBias.TEMPORAL if settings.traversal == 'BIASED'
@@ -421,7 +481,7 @@ class SynthesisRunner:
             raise BakeError(f"Plume: {owner}: the fire source's transforms cover "
                             f"{np.shape(self.placements)} node steps, not ({steps}, 4, 4)")
         self.node_states = np.asarray(graph.node_states)
-        self.node_steps = np.asarray(graph.node_steps)
+        self.node_steps = node_groups(graph, states)  # the group in the state's file
 
     def external_velocity(self, i):
         """u_ext of frame index i: the uniform wind, or a VelocityField with the turbulence."""

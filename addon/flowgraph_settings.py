@@ -27,6 +27,9 @@ class FlowGraphSettings:
     alpha: float = 1.0          # α (density) when not automatic
     beta: float = 1.0           # β (temperature) when not automatic
     min_node_gap: int = 8       # transitions between nodes this close in one state are dropped
+    #: groups left out at the start of every state, seeded while its fire starts up from still
+    #: air; -1 = the pathlines' lifetime L (flowgraph.startup_groups)
+    startup_groups: int = -1
 
 
 @dataclass
@@ -64,6 +67,9 @@ def validate_graph_settings(s: FlowGraphSettings, owner):
         raise BakeError(f"Plume: {owner}: block_size (B) must be >= 1 (got {s.block_size})")
     if s.min_node_gap < 0:
         raise BakeError(f"Plume: {owner}: min_node_gap must be >= 0 (got {s.min_node_gap})")
+    if s.startup_groups < -1:
+        raise BakeError(f"Plume: {owner}: startup_groups must be -1 (the pathline lifetime) or "
+                        f">= 0 (got {s.startup_groups})")
     if not (math.isfinite(s.epsilon) and s.epsilon >= 0.0):
         raise BakeError(f"Plume: {owner}: epsilon (ε) must be 0 (automatic: (2a+b)/3) or a "
                         f"cost in [a, b] (got {s.epsilon})")

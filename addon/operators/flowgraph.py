@@ -77,7 +77,8 @@ class FlowGraphJob(JobRunner):
         self.staging.commit()
         s, states = self.result["summary"], self.states
         g.state_names = ", ".join(f"{i}: {st.name}" for i, st in enumerate(states))
-        g.summary = (f"{sum(s['nodes'])} nodes, {s['kept']} of {s['candidates']} transitions "
+        g.summary = (f"{sum(s['nodes'])} nodes ({max(s['startup'])} start-up groups per state "
+                     f"left out), {s['kept']} of {s['candidates']} transitions "
                      f"(ε = {s['epsilon']:.3g} in [{s['a']:.3g}, {s['b']:.3g}]), pruned "
                      f"{sum(s['pruned'])}")
         show_cost_image(domain, self.folder)
@@ -129,7 +130,7 @@ class SynthesisJob(JobRunner):
         source = fire_source(domain, owner)
         steps_per_frame = int(states[0].file.nodes_per_frame)
         flowgraph.transition_hold_steps(settings, states[0].file.layout, steps_per_frame,
-                                        [(st.name, st.file.node_count) for st in states], owner)
+                                        [(st.name, st.node_count) for st in states], owner)
         settings.targets, settings.winds, settings.turbulence = frame_inputs(
             context, domain, settings.frame_start, settings.frame_end)
         if source is not None:

@@ -31,6 +31,11 @@ class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
         name="Min Node Gap", default=8, min=0, soft_max=64,
         description="Transitions between nodes of one state closer than this many node steps "
                     "are dropped (§4.3: they would stutter)")
+    startup_groups: IntProperty(
+        name="Start-up Groups", default=-1, min=-1, soft_max=256,
+        description="Pathline groups left out at the start of every state: those seeded while "
+                    "its bake starts up from still air, alike in states fed alike, whose cheap "
+                    "hops would set the threshold's a. -1 = one pathline lifetime")
     # --- Synthesis (§5) ---
     frame_start: IntProperty(name="Start", default=1, description="First synthesized frame")
     frame_end: IntProperty(name="End", default=250, description="Last synthesized frame")
