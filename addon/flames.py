@@ -82,7 +82,7 @@ class FlameNative:
             kolmogorov_frequency=float(s.kolmogorov_frequency),
             kolmogorov_drift=tuple(float(v) for v in s.kolmogorov_drift),
             heat_of_combustion=float(s.heat_of_combustion) * 1e6, merging=bool(s.merging),
-            temperature=float(s.temperature_scale))
+            temperature=float(s.temperature_scale), cooling_time=float(s.lifespan_scale))
 
     def profile(self, src: FlameSourceInput):
         if src.profile == 'CUSTOM':
@@ -106,7 +106,7 @@ def shape_key(s: FlameSettings):
     return (s.particles_per_pixel, s.max_particles, s.merging, s.flow_noise, s.flow_noise_scale,
             s.flow_noise_frequency, s.flow_noise_rotation, s.kolmogorov, s.kolmogorov_scale,
             s.kolmogorov_frequency, tuple(s.kolmogorov_drift), s.heat_of_combustion,
-            s.temperature_scale)
+            s.temperature_scale, s.lifespan_scale)
 
 
 #: The motion blur the velocity grid is made for: a shutter of one frame (Blender's default 0.5

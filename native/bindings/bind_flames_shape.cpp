@@ -99,7 +99,7 @@ void bindFlamesShape(py::module_& m) {
                   double flowAmplitude, double flowScale, double flowFrequency, double flowRotation,
                   double kAmplitude, double kScale, const py::object& kDrift, double kFrequency, int kResolution,
                   double energyScale, double heat, double fuelArea, double width, bool merging, double temperature,
-                  int threads) {
+                  int threads, double coolingTime) {
         FlameShapeParams p;
         p.seed = seed;
         p.density.falloff = falloff;
@@ -119,6 +119,7 @@ void bindFlamesShape(py::module_& m) {
         p.merging = merging;
         p.temperature = temperature;
         p.threads = threads;
+        p.coolingTime = coolingTime;
         std::vector<ColorImage> list;
         if (!images.is_none())
           for (const py::handle& h : images) list.push_back(imageArg(h));
@@ -133,10 +134,11 @@ void bindFlamesShape(py::module_& m) {
       py::arg("kolmogorov_drift") = py::make_tuple(0.0, 0.0, 0.5), py::arg("kolmogorov_frequency") = 0.5,
       py::arg("kolmogorov_resolution") = 32, py::arg("energy_scale") = 1.0, py::arg("heat_of_combustion") = 15.0e6,
       py::arg("fuel_area") = 0.0, py::arg("width") = 1.0, py::arg("merging") = true, py::arg("temperature") = 1500.0,
-      py::arg("threads") = 0,
+      py::arg("threads") = 0, py::arg("cooling_time") = 0.0,
       "profiles: flame f uses profiles[min(source, len-1)]; images: None, one, or one per profile, float "
       "(height, width, 3) row 0 at the bottom, on the profile's side view; a flame without one takes the "
-      "blackbody colour of temperature x d (K). ValueError on bad settings.");
+      "blackbody colour of temperature x d (K); cooling_time: A (s), a separated piece's colour moves to the "
+      "profile's tip as its gas ages (e^(-t_p / A); 0 off). ValueError on bad settings.");
   shaper.def(
       "set_obstacles",
       [](FlameShaper& s, const std::vector<std::shared_ptr<ObstacleSdf>>& obstacles) {

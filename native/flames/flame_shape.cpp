@@ -82,6 +82,8 @@ void FlameShapeParams::validate() const {
   if (!(temperature >= 500.0 && temperature <= 40000.0))
     throw std::invalid_argument("temperature must be in [500, 40000] K (got " + std::to_string(temperature) + ")");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all cores)");
+  if (!(coolingTime >= 0.0 && coolingTime <= 1000.0))
+    throw std::invalid_argument("cooling_time must be in [0, 1000] s (got " + std::to_string(coolingTime) + ")");
 }
 
 void FlameParticles::resize(std::size_t n) {
@@ -155,13 +157,19 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const double length = spine->length(), radius = shapeRadius(mParams, flame, length);
     const int n = particleCount(mParams.sampling, density, *spine, radius, camera);
     glm::dvec3 meanVelocity(0.0);
-    for (const SpinePoint& p : flame.points) meanVelocity += p.v;
+    double meanAge = 0.0;
+    for (const SpinePoint& p : flame.points) meanVelocity += p.v, meanAge += p.age;
     meanVelocity /= double(flame.points.size());
+    meanAge /= double(flame.points.size());
+    // A separated piece's gas cools as it ages (FlameShapeParams::coolingTime): e^(−mean t_p / A).
+    const double cooled =
+        flame.separated && mParams.coolingTime > 0.0 ? std::exp(-meanAge / mParams.coolingTime) : 1.0;
     // Eq. 5 times the source's brightness (its Intensity in stops); a separated piece: its share
-    // h / h_split of the flame it broke from (Flame::splitLength), fading with the life it has left.
+    // h / h_split of the flame it broke from (Flame::splitLength), fading with the life it has left
+    // and as its gas cools.
     const bool piece = flame.separated && flame.splitLength > length;
     const double energy =
-        flame.intensity * flame.brightness * lifeLeft(flame) *
+        flame.intensity * flame.brightness * lifeLeft(flame) * cooled *
         flameEnergy(mParams.incandescence, glm::length(meanVelocity), flame.radius, piece ? flame.splitLength : length) *
         pieceShare(flame, length);
     glm::dvec3 c, t, nn, b;
@@ -230,9 +238,10 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
     const double aspect = density.profile().aspect(), radius = shapeRadius(mParams, flame, spine.length());
     // The colour image's v: a separated piece was the top h / h_split of its flame, so it takes
     // the top of the image (no blue base on a piece of flame with no fuel under it), and as its
-    // life runs out it cools towards the tip's colour (v → 1): a breath of fire reddens along
-    // its length as its pieces age.
+    // life runs out and its gas ages it cools towards the tip's colour (v → 1): a breath of fire
+    // reddens along its length, though its pieces split again and again.
     const double share = pieceShare(flame, spine.length()) * lifeLeft(flame);
+    const double cooling = flame.separated && mParams.coolingTime > 0.0 ? 1.0 / mParams.coolingTime : 0.0;
     const int n = out.sampled[std::size_t(chunk.flame)];
     const std::vector<int>& near = neighbours[std::size_t(chunk.flame)];
     glm::dvec3 colorSum(0.0);
@@ -246,7 +255,7 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       spine.motionAt(std::clamp(p.z / aspect, 0.0, 1.0), &velocity, &age);
       // §5.1: the image on the profile's side view (u across the widest diameter, v from base
       // to tip; the glow outside takes the nearest edge's colour), else a blackbody.
-      const double v = 1.0 - share * (1.0 - p.z / aspect);
+      const double v = 1.0 - share * std::exp(-age * cooling) * (1.0 - p.z / aspect);
       const glm::vec3 color = image && image->width > 0 ? image->sample(0.5 + 0.5 * p.x, v)
                                                         : (*mBlackbody)(s.density);
       p += mFlow.displacement(p, time - age, flame.radius);

@@ -36,6 +36,10 @@ struct FlameShapeParams {
   double width = 1.0;    ///< the flame's widest radius R = width · Flame::radius
   double temperature = 1500.0;  ///< K at d = I: the blackbody base colour of a flame without a colour image
   bool merging = true;   ///< §4.5 (the paper switched it off for the dragon)
+  /// A of §4.3 (s): a separated piece's colour moves to its profile's tip colour as its gas ages,
+  /// by e^(−t_p / A) of each particle's age t_p since it left the burning surface, and its E
+  /// fades by e^(−mean t_p / A) (0: off).
+  double coolingTime = 0.0;
   std::uint64_t seed = 0;
   int threads = 0;       ///< 0: all cores
   /// Throws std::invalid_argument naming the setting and its accepted range.

@@ -132,6 +132,34 @@ TEST(FlamesEmission, AnAgeingPieceCoolsToTheTipsColour) {
   const double young = meanGreenOverRed(0.0), old = meanGreenOverRed(0.198);
   EXPECT_LT(young, 0.7);        // measured 0.65: the red band blending into the top
   EXPECT_NEAR(old, 0.9, 0.02);  // all top row
+
+  // With a cooling time A, its gas's age t_p (since it left the burning surface) cools it too:
+  // the same young piece whose points are 1 s old, A = 0.1 s: e^(-10), all top row.
+  FlameShapeParams cooled = params;
+  cooled.coolingTime = 0.1;
+  const FlameShaper aged({FlameProfile::library(ProfileShape::Torch)}, cooled, {threeBands()});
+  Flame piece = uprightFlame(0.03, 0.02, 1.0, 2);
+  piece.separated = true;
+  piece.splitLength = 0.075;
+  piece.lifespan = 0.2;
+  for (SpinePoint& q : piece.points) q.age += 1.0;
+  double g = 0.0, r = 0.0;
+  for (const glm::vec3& c : aged.shape({piece}, 0.0, camera).particles.colors) g += c.y, r += c.x;
+  EXPECT_NEAR(g / r, 0.9, 0.02);
+  // ... and its light fades with its gas's mean age: e^(-mean t_p / A).
+  Flame fresh = piece;
+  double meanAge = 0.0;
+  for (SpinePoint& q : fresh.points) q.age -= 1.0, meanAge += q.age + 1.0;
+  meanAge /= double(fresh.points.size());
+  EXPECT_NEAR(aged.shape({piece}, 0.0, camera).energy[0] / shaper.shape({piece}, 0.0, camera).energy[0],
+              std::exp(-meanAge / 0.1), 1e-12);
+  // An attached flame never cools: its colours are the image's, base to tip.
+  Flame attached = uprightFlame(0.03, 0.02, 1.0, 2);
+  for (SpinePoint& q : attached.points) q.age += 1.0;
+  const FlameParticles a = aged.shape({attached}, 0.0, camera).particles;
+  const FlameParticles b = FlameShaper({FlameProfile::library(ProfileShape::Torch)}, params, {threeBands()})
+                               .shape({attached}, 0.0, camera).particles;
+  EXPECT_EQ(a.colors, b.colors);
 }
 
 TEST(FlamesEmission, ColoursComeFromTheImageOnTheProfileWithMeanLuminanceOne) {
