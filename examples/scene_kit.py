@@ -191,12 +191,20 @@ def render_strip(scene, frames, out_dir, prefix):
     return seconds, strip(paths, os.path.join(out_dir, prefix + "_strip.png"))
 
 
+def cpu_seconds():
+    """CPU seconds of this process (all threads) and of its waited-for children: a bake runs in
+    a job process of its own (addon/jobs/)."""
+    import resource
+    return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
+                                                 resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+
 def run_op_cpu(op, tag, what):
-    """run_op, also returning the CPU time of the process (all threads) it took: (wall s, CPU s).
-    On a shared machine the CPU time is the steadier measure."""
-    c0 = time.process_time()
+    """run_op, also returning the CPU time it took, of this process and of the job process it
+    ran in: (wall s, CPU s). On a shared machine the CPU time is the steadier measure."""
+    c0 = cpu_seconds()
     wall = run_op(op, tag, what)
-    return wall, time.process_time() - c0
+    return wall, cpu_seconds() - c0
 
 
 def run_op(op, tag, what):
@@ -301,24 +309,15 @@ def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
     return src
 
 
-def refeed(sources, flicker_args, seed):
-    """Keys the feed of every Source of `sources` anew (flicker(src, **flicker_args) with seeds
-    seed, seed + 1, ...) from an even feed of fuel 1 at rest: one state's own fuel feed, so that
-    no two states share a feed's time line (states fed alike resemble each other at equal times,
-    which would make the flow graph's cheapest transitions mere hops between them)."""
-    for n, src in enumerate(sources):
-        src.animation_data_clear()
-        src.plume.source.fuel, src.plume.source.velocity = 1.0, (0.0, 0.0, 0.0)
-        flicker(src, seed=seed + n, **flicker_args)
-
-
 def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
     """Keys a fuel Source's feed with smooth noise over frames 1 .. frames + 1: a key every
     `key_every` frames with a random horizontal velocity within ±`speed` m/s and fuel within
     ±`fuel_share` of itself, drawn independently by a generator seeded with `seed`, Bézier in
     between (the first key is the still, even feed). Nothing repeats: the feed has no period, so
     no group of pathlines recurs by construction and every transition the flow graph finds is a
-    similarity of the fire itself (§4.3). Keys half a puff apart put the feed's energy near the
+    similarity of the fire itself (§4.3). Every state of a graph is baked from the same keys:
+    Build Flow Graph leaves out each bake's start-up (flowgraph.startup_groups), the only
+    stretch where states fed alike look alike. Keys half a puff apart put the feed's energy near the
     puffing rate of a fire (~1.5/√D Hz for a pool fire of diameter D m): give `key_every` half
     the puff period in frames. A log pile does not burn evenly: the uneven feed breaks the
     symmetry of the flame, which then flickers as a fire does."""
@@ -337,16 +336,13 @@ def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
     return src
 
 
-def bake_fire_states(domains, tag, feed=None):
-    """Bakes every state (with its pathlines.bin), after feed(n) (when given) for state n, e.g.
-    keying its own fuel feed; prints per state the bake time (per frame) and the pathline file
-    (size, nodes, |Ω|, L, bytes per node), and the size of all their groups. Returns the
-    bake seconds per state; exits on failure."""
+def bake_fire_states(domains, tag):
+    """Bakes every state (with its pathlines.bin); prints per state the bake time (per frame)
+    and the pathline file (size, nodes, |Ω|, L, bytes per node), and the size of all their
+    groups. Returns the bake seconds per state; exits on failure."""
     native, cache, snapshot = (addon_module(n) for n in ("_native", "cache", "snapshot"))
     seconds, ram = [], 0
-    for n, dom in enumerate(domains):
-        if feed is not None:
-            feed(n)
+    for dom in domains:
         select([dom], dom)
         s, cpu = run_op_cpu(bpy.ops.plume.bake, tag, f"the bake of '{dom.name}'")
         d = dom.plume.domain
@@ -424,11 +420,12 @@ def lit_share(path, level=0.05):
     return float((px.reshape(-1, 4)[:, :3].max(axis=1) > level).mean())
 
 
-def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph, feed=None):
+def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene) builds
-    the scene (fuel Sources, camera) and returns the state domains in name order; feed(n), when
-    given, keys state n's fuel feed before its bake (bake_fire_states); the look is a 640 x 360
-    Cycles render on a black world, motion blurred by the fire VDBs' velocity grid. Then the
+    the scene (fuel Sources, keyed once: every state is baked from the same feed; camera) and
+    returns the state domains in name order; the look is a 640 x 360 Cycles render on a black
+    world through the scene's own view transform (each Blender's default: Filmic in 3.4, AgX in
+    4.x/5.x), motion blurred by the fire VDBs' velocity grid. Then the
     .blend is saved to OUT_DIR/TAG.blend, every state is baked, Build Flow Graph (kept with
     state 0; `graph`: the keywords of build_flow_graph), the target state is keyed at the
     (fraction of the shot, state) pairs `targets`, FRAMES frames are synthesized, the
@@ -444,13 +441,10 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph, f
     # Cycles blurs the fire along its velocity grid (m/s) over half a frame, as a film camera.
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 0.5
-    # Filmic in every Blender (3.4's default; 4.x/5.x default to AgX, which renders the blackbody
-    # fire salmon-pink instead of orange-yellow): the manuals' strips are reproducible in each.
-    scene.view_settings.view_transform = 'Filmic'
     keys = [(max(1, round(f * frames)), state) for f, state in targets]
     scene.frame_start, scene.frame_end = 1, frames
     save_blend(out_dir, tag)
-    bake_fire_states(domains, tag, feed)
+    bake_fire_states(domains, tag)
     keeper = domains[0]
     build_flow_graph(domains, keeper, tag, **graph)
     key_target_states(keeper, keys)

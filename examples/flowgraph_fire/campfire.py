@@ -7,12 +7,13 @@ Three fire domains on the same 2 x 1 x 1 m box at 128 x 64 x 64 (Table 1's grid)
 states, in name order: "State0 Calm" (no wind), "State1 Breeze" and "State2 Gale" (the air is
 pulled towards a wind along +x). One fuel Source, a round burner on the floor under four logs,
 feeds all of them; its feed flickers with smooth noise that never repeats (random velocity and
-fuel keyed every 4 frames, half a puff at the puffing rate of a fire that size, ~3 Hz), drawn
-anew for each state. Each state is a fire bake of 100 frames with Record Pathlines on: every
+fuel keyed every 4 frames, half a puff at the puffing rate of a fire that size, ~3 Hz), the same
+keys for every state. Each state is a fire bake of 100 frames with Record Pathlines on: every
 node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the burner and
 followed for t_max (§4.2). Build Flow Graph joins the three states into one graph with the
 paper's settings (transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B
-= 32, ε = (2a+b)/3, dead ends and traps pruned; the cost matrix is drawn like Figure 4), and
+= 32, ε = (2a+b)/3, dead ends and traps pruned; the cost matrix is drawn like Figure 4; each
+bake's first t_max, its start-up from still air, left out), and
 Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake),
 steered by keyed target states: calm, then gale from a quarter of the shot, then breeze from 60%
 on. Every frame the live particles are rasterized into a VDB (density, temperature, flame) that
@@ -69,7 +70,6 @@ STATES = (("State0 Calm", 0.0, 0.0), ("State1 Breeze", 0.5, 2.0), ("State2 Gale"
 TARGETS = ((0.0, 0), (0.25, 2), (0.6, 1))
 SHOW = (0.2, 0.45, 0.55, 0.9)  # rendered frames: calm, gale, gale, breeze
 LOG_COLOR = (0.012, 0.006, 0.003)
-SOURCES = []                   # the fuel Sources, for feed()
 PUFF_KEYS = 4                  # frames between the feed's keys: half a puff at ~3 Hz, 1.5/√D for
                                # D = 0.24 m (the noise has no period)
 
@@ -77,7 +77,8 @@ PUFF_KEYS = 4                  # frames between the feed's keys: half a puff at 
 def make_states(frames_baked):
     burner = scene_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
                                    BURNER_SIZE)
-    SOURCES[:] = [burner]
+    # One feed for all three states: the noise keyed once.
+    scene_kit.flicker(burner, speed=1.0, fuel_share=0.4, frames=frames_baked, key_every=PUFF_KEYS)
     domains = []
     for name, speed, strength in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, frames_baked,
@@ -85,12 +86,6 @@ def make_states(frames_baked):
         dom.plume.domain.wind, dom.plume.domain.wind_strength = (speed, 0.0, 0.0), strength
         domains.append(dom)
     return domains
-
-
-def feed(state):
-    """State `state`'s own noise feed of the burner (scene_kit.refeed)."""
-    scene_kit.refeed(SOURCES, dict(speed=1.0, fuel_share=0.4, frames=BAKE_FRAMES,
-                                   key_every=PUFF_KEYS), seed=100 * state)
 
 
 def logs():
@@ -114,7 +109,7 @@ def setup(scene):
 
 def main():
     scene, keeper, fire, out_dir = scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
-                                                               TARGETS, SHOW, GRAPH, feed)
+                                                               TARGETS, SHOW, GRAPH)
     print(f"{TAG}: transition strip -> "
           f"{transition_strip.transition_strip(scene, keeper, fire, out_dir, TAG)}", flush=True)
 

@@ -3,7 +3,7 @@ graph_fire_synthesis.txt (Table 1: "the fire source is attached on a dynamic mes
 
     blender -b --factory-startup --python examples/flowgraph_fire/fire_blade.py -- OUT_DIR [FRAMES]
 
-Two short fire bakes (each with its own noise fuel feed) of a blade-shaped fuel Source lying
+Two short fire bakes (from the same noise fuel feed) of a blade-shaped fuel Source lying
 still in a 1.4 x 0.5 x 1 m box (96 x 34 x 68 cells) are the states: "State0 Low" (weak vorticity confinement: smooth flames) and
 "State1 High" (strong: curling tongues). Build Flow Graph joins them (the paper's ε = (2a+b)/3).
 The visible blade, parented to a hilt that is keyed to swing it up through 75 degrees and down
@@ -44,7 +44,6 @@ LIFETIME = 0.5                 # t_max, s: L = 36 node steps
 BAKE_FRAMES = 96               # 4 s per state: 254 nodes each
 COOLING = 15.0                 # c: slow cooling, flames tall enough to trail behind the swing
 GRAPH = dict(block_size=32, min_node_gap=16)  # ε = (2a + b)/3, the paper's
-SOURCES = []                   # the fuel Source, for feed()
 DEFAULT_FRAMES = 144
 #: (name, vorticity confinement ε); names sort in state order.
 STATES = (("State0 Low", 0.1), ("State1 High", 1.5))
@@ -79,15 +78,10 @@ def blade(frames):
     return steel
 
 
-def feed(state):
-    """State `state`'s own noise feed of the blade's fuel (scene_kit.refeed)."""
-    scene_kit.refeed(SOURCES, dict(speed=0.6, fuel_share=0.4, frames=BAKE_FRAMES, key_every=4),
-                     seed=10 * state)
-
-
 def setup(scene, frames):
-    SOURCES.append(scene_kit.fuel_source("BladeFuel", bpy.ops.mesh.primitive_cube_add,
-                                         BLADE_AT, FUEL_SIZE))
+    fuel = scene_kit.fuel_source("BladeFuel", bpy.ops.mesh.primitive_cube_add, BLADE_AT,
+                                 FUEL_SIZE)
+    scene_kit.flicker(fuel, speed=0.6, fuel_share=0.4, frames=BAKE_FRAMES, key_every=4)
     domains = []
     for name, vorticity in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, BAKE_FRAMES, NODES_PER_FRAME,
@@ -104,7 +98,7 @@ def setup(scene, frames):
 def main():
     _, frames = scene_kit.parse_args(USAGE, DEFAULT_FRAMES)
     scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, lambda scene: setup(scene, frames),
-                                TARGETS, SHOW, GRAPH, feed)
+                                TARGETS, SHOW, GRAPH)
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@
     blender -b --factory-startup --python examples/flowgraph_fire/firewall.py -- OUT_DIR [FRAMES]
 
 A long, thin line of fuel (1.6 m x 2.5 cm on the floor: eight Sources, each with its own feed of
-smooth noise that never repeats, drawn anew for each state) burns in a 2 x 0.5 x 1 m box at 128
+smooth noise that never repeats, the same keys in both states) burns in a 2 x 0.5 x 1 m box at 128
 x 32 x 64. Two fire domains on that box are the two states, in name order: "State0 Low" (weak
 vorticity confinement: the flames rise smoothly) and "State1 High" (strong confinement: they
 break into curling tongues). Each is a bake of 128 frames with Record Pathlines on; Build Flow
@@ -38,7 +38,6 @@ CENTRE = (0.0, 0.0, 0.5)
 WALL = (0.0, 0.0, 0.0465)
 WALL_SIZE = (1.6, 0.025, 0.027)  # two cell layers: about 3,300 seeds
 SEGMENTS = 8
-SOURCES = []                   # the fuel Sources, for feed()
 PUFF_KEYS = 4                  # frames between a piece's feed keys: half a puff at ~3 Hz
 # Memory of the graph build: 3,328 seeds x L = 36 samples x 20 B = 2.4 MB per node,
 # 3 BAKE_FRAMES - L + 2 = 350 nodes per state, 1.7 GB.
@@ -55,12 +54,6 @@ TARGETS = ((0.0, 0), (0.4, 1))  # keyed target states: (fraction of the shot, st
 SHOW = (0.2, 0.35, 0.6, 0.9)    # rendered frames: low, low, high, high
 
 
-def feed(state):
-    """State `state`'s own noise feeds of the pieces (scene_kit.refeed)."""
-    scene_kit.refeed(SOURCES, dict(speed=0.8, fuel_share=0.5, frames=BAKE_FRAMES,
-                                   key_every=PUFF_KEYS), seed=100 * state)
-
-
 def setup(scene):
     # The line of fuel in SEGMENTS pieces, each flickering on its own: a uniform line would give
     # a flow alike all along it (flat horizontal rolls); uneven pieces break it into tongues.
@@ -69,7 +62,8 @@ def setup(scene):
         x = WALL[0] - 0.5 * WALL_SIZE[0] + (n + 0.5) * length
         piece = scene_kit.fuel_source(f"Fuel{n}", bpy.ops.mesh.primitive_cube_add,
                                       (x, WALL[1], WALL[2]), (length, *WALL_SIZE[1:]))
-        SOURCES.append(piece)
+        scene_kit.flicker(piece, speed=0.8, fuel_share=0.5, frames=BAKE_FRAMES,
+                          key_every=PUFF_KEYS, seed=n)
     domains = []
     for name, vorticity in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, BAKE_FRAMES, NODES_PER_FRAME,
@@ -82,7 +76,7 @@ def setup(scene):
 
 def main():
     _scene, keeper, _fire, _out = scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
-                                                              TARGETS, SHOW, GRAPH, feed)
+                                                              TARGETS, SHOW, GRAPH)
     flowgraph = scene_kit.addon_module("flowgraph")
     folder = scene_kit.addon_module("snapshot").cache_folder_of(keeper)
     transition_strip.walk_summary(flowgraph.read_walk(flowgraph.walk_path(folder)), TAG)
