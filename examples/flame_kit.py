@@ -14,22 +14,30 @@ import os
 import time
 
 import bpy
-import numpy as np
 
 import scene_kit
 
 
-def flame_source(name, add_primitive, location, profile, flames, source_radius, **primitive):
+def flame_source(name, add_primitive, location, preset, flames, source_radius, **primitive):
     """A mesh primitive (e.g. bpy.ops.mesh.primitive_cylinder_add with its keywords) at
-    `location` made a Flame Source (plume.role_set) with `profile`, `flames` flames of source
-    radius r = `source_radius` (m); the mesh itself is left visible (it is the wick, torch or log)."""
+    `location` made a Flame Source (plume.role_set) starting from `preset` (Flame Source ›
+    Preset: 'CANDLE', 'TORCH', 'CAMPFIRE', 'DRAGON'; it sets the source and the scene's Flames
+    settings), then `flames` flames of source radius r = `source_radius` (m); the mesh itself is
+    left visible (it is the wick, torch or log)."""
     add_primitive(location=location, **primitive)
     ob = bpy.context.active_object
     ob.name = name
     bpy.ops.plume.role_set(role='FLAME_SOURCE')
+    bpy.ops.plume.flame_preset(preset=preset)
     fl = ob.plume.flame
-    fl.profile, fl.flames, fl.radius = profile, flames, source_radius
+    fl.flames, fl.radius = flames, source_radius
     return ob
+
+
+#: Emission strength of a glowing solid (pitch, embers): Auto Exposure sets the examples' film
+#: exposure 2-4 stops up (the flames drawn at Flame Brightness 0.125), so an ember of strength 1
+#: would read white; at 1/16 it glows at about its colour.
+EMBER_STRENGTH = 1.0 / 16.0
 
 
 def solid(ob, color, roughness=0.6, emission=None, name=None):
@@ -42,7 +50,7 @@ def solid(ob, color, roughness=0.6, emission=None, name=None):
     bsdf.inputs["Roughness"].default_value = roughness
     if emission is not None:
         scene_kit.compat().principled_emission_color(bsdf).default_value = (*emission, 1.0)
-        bsdf.inputs["Emission Strength"].default_value = 1.0
+        bsdf.inputs["Emission Strength"].default_value = EMBER_STRENGTH
     ob.data.materials.clear()
     ob.data.materials.append(mat)
     return mat
@@ -118,61 +126,36 @@ def _has_denoiser():
         return False
 
 
-#: The metering of the examples: the candle example's light (its flame and the short pieces of its
-#: tip: 0.025 W over a fire 3.9 cm across) exposed +2 stops.
-#: Every flame's light is physical (Light Unit's default), and eq. 5 grows as r^7: a torch is
-#: ~10^4 candles, a dragon's breath ~10^10. A photographer exposes for the light falling on
-#: what the flames light, ~P / D² at the fire's size D from them; so do the examples.
-METER_IRRADIANCE, METER_EXPOSURE = 0.025 / 0.039 ** 2, 2.0
-
-
-def metered_exposure(scene, frames, offset=0.0):
-    """The exposure (stops) metering the flames' light over `frames`: P the mean total power
-    of the flame lights (E × Light Unit), D the fire's size — the mean flame length (3 × light
-    radius), or for many flames twice the RMS distance of their lights from their centroid if
-    larger — so that P / D² reads as the candle's, plus `offset` stops of taste. Prints it."""
-    folder = scene_kit.addon_module("snapshot").flames_cache_folder(scene)
-    unit = scene.plume_flames.light_unit
-    powers, sizes = [], []
-    for frame in frames:
-        d = np.load(os.path.join(folder, f"spines_{frame:04d}.npz"))
-        if len(d["light_energy"]) == 0:
-            continue
-        powers.append(float(np.sum(d["light_energy"])) * unit)
-        centres = np.asarray(d["light_centres"], np.float64)
-        spread = 2.0 * math.sqrt(float(np.mean(np.sum((centres - centres.mean(axis=0)) ** 2,
-                                                       axis=1))))
-        sizes.append(max(3.0 * float(np.mean(d["light_radii"])), spread))
-    p, size = (float(np.mean(powers)), float(np.mean(sizes))) if powers else (0.0, 1.0)
-    stops = METER_EXPOSURE + math.log2(METER_IRRADIANCE / max(p / size ** 2, 1e-30)) + offset
-    print(f"light: {p:.4g} W ({p * 683 / (4 * math.pi):.4g} cd), fire {size * 100:.1f} cm "
-          f"across: exposure {stops:+.1f} stops", flush=True)
-    return stops
+#: Flame Brightness of the examples: the visible flames 3 stops under the light they cast. A room
+#: lit only by its flames is 5-8 stops darker than the flames themselves (as in a photograph of
+#: a candle); exposed so the flames' cores keep their colour (Auto Exposure), the room would be
+#: black. Drawing the flames 3 stops dimmer than their light lets Auto Exposure raise the
+#: exposure by those 3 stops: the room reads and the cores stay coloured.
+FLAME_BRIGHTNESS = 0.125
 
 
 def flame_look(scene, tag, out_dir, width=640, height=360, samples=64,
-               world=(0.0015, 0.0015, 0.002), exposure=0.0):
-    """Cycles on a near-black world (the flames and their lights light the scene), Filmic so
-    bright flame cores keep their colour, `exposure` stops (flame_example meters it), the
-    denoiser where the Blender has one (Debian's 3.4.1 has none)."""
+               world=(0.0015, 0.0015, 0.002), flame_brightness=FLAME_BRIGHTNESS):
+    """Cycles on a near-black world (the flames and their lights light the scene), the
+    Blender's own colour management (AgX in 4.x/5.x, Filmic in 3.4.1: untouched), the denoiser
+    where the Blender has one (Debian's 3.4.1 has none), Flame Brightness
+    `flame_brightness`."""
     scene_kit.cycles(scene, width, height, samples, os.path.join(out_dir, tag + "_"))
     if _has_denoiser():
         scene.cycles.use_denoising = True
         scene.cycles.denoiser = 'OPENIMAGEDENOISE'
     scene_kit.plain_world(scene, world)
-    scene.view_settings.view_transform = 'Filmic'
-    scene.cycles.film_exposure = 2.0 ** exposure
     scene.cycles.volume_bounces = 0  # the flames emit; scattering in them is not worth its cost
-    # no fireflies from the bright, small flames (the clamp scaled with the exposure)
-    scene.cycles.sample_clamp_indirect = 1.0 / 2.0 ** max(exposure, 0.0)
     scene.cycles.volume_step_rate = 2.0  # steps of two voxels through the soft flames
+    scene.plume_flames.emission = flame_brightness
 
 
-def flame_example(tag, usage, default_frames, setup, show, exposure_offset=0.0, **look):
+def flame_example(tag, usage, default_frames, setup, show, **look):
     """A flames example from the command line: OUT_DIR [FRAMES]. setup(scene, frames) builds the
     scene (Flame Sources, settings, camera); `look`: keywords of flame_look. Then the .blend is
-    saved to OUT_DIR/TAG.blend, Bake Flames runs, the exposure is metered on the flames' light
-    (metered_exposure, + exposure_offset), the frames at fractions `show` of the shot are
+    saved to OUT_DIR/TAG.blend, Bake Flames runs, Auto Exposure (plume.flames_auto_exposure, as
+    an artist presses it once after the bake) sets the film exposure, the frames at fractions
+    `show` of the shot are
     rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are printed.
     Returns (scene, flames per frame)."""
     out_dir, frames = scene_kit.parse_args(usage, default_frames)
@@ -182,10 +165,15 @@ def flame_example(tag, usage, default_frames, setup, show, exposure_offset=0.0, 
     scene.frame_start, scene.frame_end = 1, frames
     scene_kit.save_blend(out_dir, tag)
     bake_s, flames, particles = bake_flames(scene, tag)
-    # Cycles' film exposure scales the render itself, before the denoiser: a dragon's 10⁹ W
-    # would overflow OpenImageDenoise's half floats (it turns the flames green).
-    scene.cycles.film_exposure = 2.0 ** metered_exposure(
-        scene, scene_kit.shown_frames(show, frames), exposure_offset)
+    # Auto Exposure sets Cycles' film exposure, which scales the render itself before the
+    # denoiser (a colour-management exposure would leave a dragon's 10⁹ W to overflow
+    # OpenImageDenoise's half floats: it turns the flames green).
+    assert bpy.ops.plume.flames_auto_exposure() == {'FINISHED'}
+    stops = math.log2(scene.cycles.film_exposure)
+    print(f"{tag}: Auto Exposure {stops:+.1f} stops (film exposure "
+          f"{scene.cycles.film_exposure:.3g})", flush=True)
+    # no fireflies from the bright, small flames (the clamp scaled with the exposure)
+    scene.cycles.sample_clamp_indirect = 1.0 / max(scene.cycles.film_exposure, 1.0)
     bpy.ops.wm.save_mainfile()
     t0 = time.perf_counter()
     seconds, paths = scene_kit.render_frames_timed(

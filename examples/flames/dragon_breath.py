@@ -43,7 +43,7 @@ def head():
     flame_kit.solid(bpy.context.active_object, (0.04, 0.07, 0.04), roughness=0.4,
                     name="Scales")
     mouth = flame_kit.flame_source("Mouth", bpy.ops.mesh.primitive_uv_sphere_add, MOUTH,
-                                   'TORCH', 5, 0.08, radius=0.06, segments=16, ring_count=8)
+                                   'DRAGON', 5, 0.08, radius=0.06, segments=16, ring_count=8)
     flame_kit.solid(mouth, (0.02, 0.01, 0.01), emission=(0.8, 0.2, 0.02), name="Throat")
     return mouth
 
@@ -66,8 +66,7 @@ def setup(scene, frames):
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64,
-                            exposure_offset=-3.5)  # the flames' cores, not their glow
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":

@@ -65,8 +65,7 @@ def setup(scene, frames):
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64,
-                            exposure_offset=-3.0)  # the flames' cores, not their glow
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
 
 
 if __name__ == "__main__":
