@@ -297,6 +297,52 @@ def cost_matrix(native, states: List[State], s: FlowGraphSettings,
     return np.ascontiguousarray(np.asarray(job.cost)[np.ix_(keep, keep)]), counts, params
 
 
+def same_moment(rows, cols, counts, gap):
+    """Which candidates (rows, cols: graph nodes) join groups of two different states seeded at
+    the same moment of their bakes, at most max(1, gap) node steps apart (the Min Node Gap that
+    makes two groups of one state "close", §4.3). Each state's nodes begin after the same
+    start-up, so equal steps are equal times of the bakes."""
+    offsets = np.concatenate([[0], np.cumsum(counts)])
+    state = np.repeat(np.arange(len(counts)), counts)
+    rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
+    sr, sc = state[rows], state[cols]
+    return (sr != sc) & (np.abs((rows - offsets[sr]) - (cols - offsets[sc])) <= max(1, gap))
+
+
+def threshold(native, cost, counts, params):
+    """ε of eq. 11 and the range [a, b] it is taken in: (ε, a, b, same-moment candidates).
+    The candidates are the native block minima (§4.3). a and b are the smallest and largest
+    cost of the candidates that are not same_moment() hops between states: states driven by
+    the same source animation (one box, Source and feed; other wind, turbulence or burn rate)
+    resemble each other at equal times all along their bakes, so such hops cost a fraction of
+    any similarity of the fire with itself (0.2-0.6 against 1.2-1.7 for the fire wall's two
+    states, measured), and as a they would put ε = (2a + b)/3 below nearly every other
+    candidate: no loop would be kept and no walk could go on. They are still candidates and are
+    kept when below ε (a change of state at the same moment of the feed, the smoothest there
+    is). ε is (2a + b)/3, or params' explicit ε (checked against every candidate's range by
+    the native selection). ValueError from the native selection (bad params, explicit ε)."""
+    t = native.select_transitions(cost, counts, params)
+    costs = np.asarray(t["cost"], np.float64)
+    moment = same_moment(t["row"], t["col"], counts, params.min_node_gap)
+    own = costs[~moment] if np.any(~moment) else costs
+    if len(own) == 0:
+        return float("nan"), float("nan"), float("nan"), 0
+    a, b = float(own.min()), float(own.max())
+    eps = (float(params.epsilon) if params.epsilon_mode == native.EpsilonMode.EXPLICIT
+           else (2.0 * a + b) / 3.0)
+    return eps, a, b, int(moment.sum())
+
+
+def graph_of(native, cost, counts, params, eps):
+    """FlowGraph.build with ε = eps (explicit), the other params as given."""
+    p = native.FlowGraphParams()
+    p.block_size, p.min_node_gap = params.block_size, params.min_node_gap
+    p.alpha, p.beta, p.threads = params.alpha, params.beta, params.threads
+    if math.isfinite(eps):
+        p.epsilon_mode, p.epsilon = native.EpsilonMode.EXPLICIT, float(eps)
+    return native.FlowGraph.build(cost, counts, p)
+
+
 def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
                 progress: Optional[Callable[[float], None]] = None,
                 on_job: Optional[Callable[[object], None]] = None):
@@ -308,15 +354,18 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
     cost, counts, params = cost_matrix(native, states, s, on_job)
     alpha, beta = params.alpha, params.beta
     try:
-        graph = native.FlowGraph.build(cost, counts, params)
+        eps, a, b, moments = threshold(native, cost, counts, params)
+        graph = graph_of(native, cost, counts, params, eps)
     except ValueError as e:
         raise BakeError(f"Plume: flow graph: {e}{_candidate_range(native, cost, counts, params)}"
                         ) from None
     image = native.cost_matrix_image(cost, graph, size=min(512, max(64, len(cost))))
     t = graph.transitions()
-    summary = {"alpha": float(alpha), "beta": float(beta), "a": float(t["a"]),
-               "b": float(t["b"]), "epsilon": float(t["epsilon"]),
-               "candidates": int(len(t["kept"])), "kept": int(np.sum(t["kept"])),
+    kept = np.asarray(t["kept"], bool)
+    moment = same_moment(t["row"], t["col"], counts, params.min_node_gap)
+    summary = {"alpha": float(alpha), "beta": float(beta), "a": a, "b": b, "epsilon": eps,
+               "candidates": int(len(kept)), "kept": int(np.sum(kept)),
+               "same_moment": moments, "same_moment_kept": int(np.sum(kept & moment)),
                "pruned": [int(v) for v in graph.pruned_per_state],
                "nodes": [int(v) for v in counts],
                "startup": [int(st.first_group) for st in states]}
@@ -326,6 +375,7 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
                    state_names=np.asarray([st.name for st in states]),
                    state_folders=np.asarray([st.folder for st in states]),
                    first_groups=np.asarray([st.first_group for st in states], np.int64),
+                   threshold=np.asarray([eps, a, b], np.float64),
                    settings=np.asarray([s.block_size, s.min_node_gap, s.epsilon, alpha, beta],
                                        np.float64))
     files.write_bytes(image_path(out_folder), png_rgb(np.asarray(image)))
@@ -374,6 +424,8 @@ def load_graph(native, folder, owner):
             # Graphs built before the start-up was left out begin at group 0.
             first = ([int(v) for v in data["first_groups"]] if "first_groups" in data.files
                      else [0] * len(counts))
+            # The ε the graph was built with (threshold()); older graphs: the native rule.
+            used = float(data["threshold"][0]) if "threshold" in data.files else None
     except (OSError, KeyError, ValueError) as e:
         raise BakeError(f"Plume: {owner}: flow graph {path} cannot be read ({e}): build it "
                         "again") from None
@@ -387,7 +439,8 @@ def load_graph(native, folder, owner):
                           auto_weights=False, alpha=alpha, beta=beta)
     params = _params(native, s, alpha, beta)
     try:
-        graph = native.FlowGraph.build(cost, counts, params)
+        graph = (native.FlowGraph.build(cost, counts, params) if used is None
+                 else graph_of(native, cost, counts, params, used))
     except ValueError as e:
         raise BakeError(f"Plume: {owner}: {e}") from None
     return graph, states

@@ -79,8 +79,9 @@ class FlowGraphJob(JobRunner):
         g.state_names = ", ".join(f"{i}: {st.name}" for i, st in enumerate(states))
         g.summary = (f"{sum(s['nodes'])} nodes ({max(s['startup'])} start-up groups per state "
                      f"left out), {s['kept']} of {s['candidates']} transitions "
-                     f"(ε = {s['epsilon']:.3g} in [{s['a']:.3g}, {s['b']:.3g}]), pruned "
-                     f"{sum(s['pruned'])}")
+                     f"(ε = {s['epsilon']:.3g} in [{s['a']:.3g}, {s['b']:.3g}]; "
+                     f"{s['same_moment_kept']} of them between states at the same moment), "
+                     f"pruned {sum(s['pruned'])}")
         show_cost_image(domain, self.folder)
         return 'INFO', (f"Plume: flow graph of {len(states)} states: {g.summary} "
                         f"({time.perf_counter() - self.t0:.1f} s)")
