@@ -58,7 +58,8 @@ NODES_PER_FRAME = 3            # Δt_n = 1/72 s: the fast gale's particle sheets
 LIFETIME = 0.6                 # t_max, s: L = 43; the flame has cooled or left the box by then
 BAKE_FRAMES = 100              # 4.2 s per state (> 2 t_max), 259 nodes: more than 8 blocks of B
 #: Build Flow Graph (§4.3) with the paper's settings: blocks of B = 32 (the add-on's default),
-#: 777 nodes, 25 blocks per side (the paper's 868 nodes in B = 32 give 28), ε = (2a + b)/3 (the
+#: 648 nodes (each state's first 43 groups, its start-up, left out), 21 blocks per side (the
+#: paper's 868 nodes in B = 32 give 28), ε = (2a + b)/3 (the
 #: default). Transitions between groups at least 16 node steps (5 frames) apart, so no loop
 #: replays the same few groups at a visible rhythm.
 GRAPH = dict(block_size=32, min_node_gap=16)

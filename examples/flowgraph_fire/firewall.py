@@ -45,7 +45,8 @@ NODES_PER_FRAME = 3            # Δt_n = 1/72 s
 LIFETIME = 0.5                 # t_max, s: L = 36
 BAKE_FRAMES = 128              # 5.3 s per state (> 2 t_max), 350 nodes: 11 blocks of B
 COOLING = 20.0                 # c: half the campfire's, for taller flames along the wall
-#: Build Flow Graph as in campfire.py: B = 32, ε = (2a + b)/3 (700 nodes: 22 blocks per side).
+#: Build Flow Graph as in campfire.py: B = 32, ε = (2a + b)/3 (628 nodes after the states'
+#: start-ups: 20 blocks per side).
 GRAPH = dict(block_size=32, min_node_gap=16)
 DEFAULT_FRAMES = 400
 #: (name, vorticity confinement ε); names sort in state order.
