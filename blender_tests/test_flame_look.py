@@ -8,7 +8,7 @@ renders read back as linear EXR:
   m = |v_c| r², computed here from the baked spines, projected as eq. 6 does
   (E / 4π((h/2)² + l²)), against the ratio of the rendered totals;
 - colour (§5.1) and light (§5.2): a candle over a white floor lights it warm (R/B >= 1.5) and the
-  base of its flame has blue-dominant pixels; the calibrated Light Unit gives the candle about a
+  base of its flame is mostly blue-dominant pixels; the calibrated Light Unit gives the candle about a
   candle's luminous intensity (1 cd = 4π/683 W in Blender's units);
 - bad input: a Colour Image that is empty, missing or not RGB, a Light Unit <= 0 give an error
   naming the setting and change nothing.
@@ -165,8 +165,13 @@ class FlameLookTest(unittest.TestCase):
               f"{int(lit.sum())}")
         self.assertGreater(b, 0.0)
         self.assertGreaterEqual(r / b, 1.5)
-        # Measured 29 (5.3.0) and 30 (3.4.1) blue-dominant pixels: 20 leaves a third for noise.
-        self.assertGreater(int(blue.sum()), 20)
+        # The base is the bottom sixth of the flame's lit rows, so its pixel count follows the
+        # flame's height at that frame, which its separated tip (fading and thinning since issue
+        # 30) changes: a share is what the colour of the base is. Measured 19 of 35 (54 %,
+        # 3.4.1), 26 of 44 (59 %, 4.5) and 43 of 64 (67 %, 5.3.0) blue-dominant pixels (before: 29-30 of ~235 pixels
+        # counted on a taller flame); 40 % leaves a quarter of the lower one for noise.
+        self.assertGreater(int(blue.sum()), 10)
+        self.assertGreater(int(blue.sum()) / max(int(lit.sum()), 1), 0.4)
 
     def test_light_unit_gives_a_candle_one_candela(self):
         """The calibration of Light Unit's default (flame_settings.LIGHT_UNIT): the candle

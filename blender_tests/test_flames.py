@@ -163,10 +163,12 @@ class FlamesTest(unittest.TestCase):
         """Bake Flames cancelled after two frames (from its progress report, as Esc does in the
         UI): like a smoke bake it keeps and builds the frames it finished, and no partial file.
         The cancel reaches the child while it computes the next frame, which it finishes (a
-        unit of work): two or three frames."""
+        unit of work): two or three frames. The torch: its frames take ~0.1 s, longer than the
+        cancel's round trip (the candle's first frames, a few small flames since the Candle
+        defaults, take a few ms: four frames finished before the cancel landed)."""
         from plume.operators.flames import FlamesJob, PLUME_OT_flames_bake
         folder = os.path.join(self.tmp, "cancelled")
-        flame_scene(folder)
+        flame_scene(folder, flames=5, profile='TORCH')
         job = FlamesJob()
         self.assertEqual(run_cancelled(PLUME_OT_flames_bake, job, after=2), {'FINISHED'})
         self.assertTrue(job.result.cancelled)
