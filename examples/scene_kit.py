@@ -410,14 +410,20 @@ def hide_bakes(domains):
             vo.hide_render = True
 
 
-def lit_share(path, level=0.05):
-    """Share of the pixels of PNG `path` brighter than `level` in some channel."""
+def png_pixels(path):
+    """RGB pixels (h, w, 3) of an image file, read through Blender (rows bottom first)."""
     import numpy as np
     img = bpy.data.images.load(path, check_existing=False)
-    px = np.empty(img.size[0] * img.size[1] * 4, dtype=np.float32)
+    w, h = img.size
+    px = np.empty(w * h * 4, dtype=np.float32)
     img.pixels.foreach_get(px)
     bpy.data.images.remove(img)
-    return float((px.reshape(-1, 4)[:, :3].max(axis=1) > level).mean())
+    return px.reshape(h, w, 4)[..., :3]
+
+
+def lit_share(path, level=0.05):
+    """Share of the pixels of PNG `path` brighter than `level` in some channel."""
+    return float((png_pixels(path).max(axis=2) > level).mean())
 
 
 def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):

@@ -179,7 +179,7 @@ def main():
             bpy.ops.render.render(write_still=True)
             seconds = time.perf_counter() - t0
             paths.append(scene.render.filepath)
-            m = fire_look.measure(render_pixels(scene.render.filepath))
+            m = fire_look.measure(scene_kit.png_pixels(scene.render.filepath))
             looks.append((tag, f, m, seconds))
     scene_kit.strip(paths, os.path.join(out, "fire_vs_mantaflow.png"), columns=2)
     crop_strip(paths, os.path.join(out, "fire_vs_mantaflow_crop.png"))
@@ -191,17 +191,6 @@ def main():
         print(f"{tag} frame {f} (render {seconds:.0f} s): {fire_look.text(m)}")
     # Free the Mantaflow domain while Python runs (the bpy module aborts freeing it at exit).
     bpy.ops.wm.read_homefile(use_factory_startup=True)
-
-
-def render_pixels(path):
-    """RGB pixels (h, w, 3) of a PNG, read through Blender."""
-    import numpy as np
-    img = bpy.data.images.load(path, check_existing=False)
-    w, h = img.size
-    px = np.empty(w * h * 4, dtype=np.float32)
-    img.pixels.foreach_get(px)
-    bpy.data.images.remove(img)
-    return px.reshape(h, w, 4)[..., :3]
 
 
 if __name__ == "__main__":
