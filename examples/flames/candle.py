@@ -57,7 +57,9 @@ def setup(scene, frames):
 
 
 def main():
-    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64)
+    # The manual's headline strip: 1280 x 720.
+    flame_kit.flame_example(TAG, USAGE, DEFAULT_FRAMES, setup, SHOW, samples=64, width=1280,
+                            height=720)
 
 
 if __name__ == "__main__":
