@@ -120,14 +120,7 @@ def strip(paths, out_path, gap=4, columns=None):
     """Puts equally sized PNGs side by side (dark gap between them) into one PNG; with
     `columns`, in rows of that many images (the first row on top)."""
     import numpy as np
-    images = []
-    for p in paths:
-        img = bpy.data.images.load(p, check_existing=False)
-        w, h = img.size
-        px = np.empty(w * h * 4, dtype=np.float32)
-        img.pixels.foreach_get(px)
-        images.append(px.reshape(h, w, 4))  # Blender's rows run bottom to top
-        bpy.data.images.remove(img)
+    images = [png_pixels(p, alpha=True) for p in paths]  # Blender's rows run bottom to top
     columns = columns or len(images)
     rows = (len(images) + columns - 1) // columns
     ch, cw = max(i.shape[0] for i in images), max(i.shape[1] for i in images)
@@ -410,15 +403,17 @@ def hide_bakes(domains):
             vo.hide_render = True
 
 
-def png_pixels(path):
-    """RGB pixels (h, w, 3) of an image file, read through Blender (rows bottom first)."""
+def png_pixels(path, alpha=False):
+    """RGB (h, w, 3), or with `alpha` RGBA (h, w, 4), pixels of an image file, read through
+    Blender (rows bottom first)."""
     import numpy as np
     img = bpy.data.images.load(path, check_existing=False)
     w, h = img.size
     px = np.empty(w * h * 4, dtype=np.float32)
     img.pixels.foreach_get(px)
     bpy.data.images.remove(img)
-    return px.reshape(h, w, 4)[..., :3]
+    px = px.reshape(h, w, 4)
+    return px if alpha else px[..., :3]
 
 
 def lit_share(path, level=0.05):

@@ -130,16 +130,12 @@ def bake_plume(dom):
 
 def crop_strip(paths, out_path):
     """The middle half (in x) of each PNG, in rows of two, into one PNG."""
-    import numpy as np
     crops = []
     for p in paths:
-        img = bpy.data.images.load(p, check_existing=False)
-        w, h = img.size
-        px = np.empty(w * h * 4, dtype=np.float32)
-        img.pixels.foreach_get(px)
-        bpy.data.images.remove(img)
+        px = scene_kit.png_pixels(p, alpha=True)
+        h, w = px.shape[:2]
         q = out_path[:-4] + "_" + os.path.basename(p)
-        part = px.reshape(h, w, 4)[:, w // 4:w - w // 4].copy()
+        part = px[:, w // 4:w - w // 4].copy()
         tmp = bpy.data.images.new("plume_crop", part.shape[1], h, alpha=True)
         tmp.pixels.foreach_set(part.ravel())
         tmp.filepath_raw, tmp.file_format = q, 'PNG'
