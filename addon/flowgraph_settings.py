@@ -1,5 +1,7 @@
 """Flow-graph fire settings, no ``bpy`` (graph_fire_synthesis.txt): Build Flow Graph's (§4.3) and
-Synthesize Fire's (§5), and their validation (BakeError naming the setting)."""
+Synthesize Fire's (§5), their validation (BakeError naming the setting), and what the graph's
+settings come to on given data: the start-up left out, the threshold ε of eq. 11, the velocity
+of the Turbulence fields a synthesis feels."""
 
 import math
 from dataclasses import dataclass, field
@@ -133,3 +135,85 @@ def validate_synthesis(s: SynthesisSettings, state_count, owner):
     if not (lo <= s.group_cache_mb <= hi):
         raise BakeError(f"Plume: {owner}: group_cache must be in [{lo}, {hi}] MB "
                         f"(got {s.group_cache_mb})")
+
+
+def startup_groups(s: FlowGraphSettings, layout):
+    """The groups left out at the start of every state (FlowGraphSettings.startup_groups): the
+    pathlines' lifetime L in node steps by default. A bake starts from still air with no fire:
+    the groups seeded during its first t_max rise into a flow that is not yet the fire's (its
+    first particles have not yet died, the flame is still growing). Bakes that start alike
+    (the same domain, Source and feed, whatever their other settings) give nearly the same such
+    groups, so without this their block minima are hops between the states' first moments,
+    far cheaper than any candidate of the burning fire: a = min of the candidates falls, ε =
+    (2a + b)/3 with it, and almost no transition is kept (measured in
+    examples/flowgraph_fire/README.md)."""
+    return int(layout.samples) if s.startup_groups < 0 else int(s.startup_groups)
+
+
+def same_moment(rows, cols, counts, gap):
+    """Which candidates (rows, cols: graph nodes) join groups of two different states seeded at
+    the same moment of their bakes, at most max(1, gap) node steps apart (the Min Node Gap that
+    makes two groups of one state "close", §4.3). Each state's nodes begin after the same
+    start-up, so equal steps are equal times of the bakes."""
+    offsets = np.concatenate([[0], np.cumsum(counts)])
+    state = np.repeat(np.arange(len(counts)), counts)
+    rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
+    sr, sc = state[rows], state[cols]
+    return (sr != sc) & (np.abs((rows - offsets[sr]) - (cols - offsets[sc])) <= max(1, gap))
+
+
+def threshold(native, cost, counts, params):
+    """ε of eq. 11 and the range [a, b] it is taken in: (ε, a, b, same-moment candidates).
+    The candidates are the native block minima (§4.3). a and b are the smallest and largest
+    cost of the candidates that are not same_moment() hops between states: states driven by
+    the same source animation (one box, Source and feed; other wind, turbulence or burn rate)
+    resemble each other at equal times all along their bakes, so such hops cost a fraction of
+    any similarity of the fire with itself (0.2-0.6 against 1.2-1.7 for the fire wall's two
+    states, measured), and as a they would put ε = (2a + b)/3 below nearly every other
+    candidate: no loop would be kept and no walk could go on. They are still candidates and are
+    kept when below ε (a change of state at the same moment of the feed, the smoothest there
+    is). ε is (2a + b)/3, or params' explicit ε (checked against every candidate's range by
+    the native selection). ValueError from the native selection (bad params, explicit ε)."""
+    t = native.select_transitions(cost, counts, params)
+    costs = np.asarray(t["cost"], np.float64)
+    moment = same_moment(t["row"], t["col"], counts, params.min_node_gap)
+    own = costs[~moment] if np.any(~moment) else costs
+    if len(own) == 0:
+        return float("nan"), float("nan"), float("nan"), 0
+    a, b = float(own.min()), float(own.max())
+    eps = (float(params.epsilon) if params.epsilon_mode == native.EpsilonMode.EXPLICIT
+           else (2.0 * a + b) / 3.0)
+    return eps, a, b, int(moment.sum())
+
+
+#: Fourier modes of the turbulence velocity (enough for an irregular, smooth field).
+TURBULENCE_MODES = 12
+
+
+def turbulence_velocity(resolution, cell_size, origin, fields, t):
+    """Cell-centred velocity (nx, ny, nz, 3) float32 of Turbulence force fields (§5.2's u_ext
+    "for deforming the fire"): for each field, the curl of a random vector potential made of
+    TURBULENCE_MODES plane waves of wavelength `size` (so the flow is divergence-free: each
+    mode's velocity (k × a) cos(k·x + φ + ωt) is orthogonal to its k), seeded by the field's seed,
+    drifting in time with ω = 2π / (size / strength), scaled to an RMS speed of `strength` m/s.
+    Blender's own turbulence noise is not reachable from Python: this is Plume's reading of the
+    field's Strength, Size and Seed."""
+    n = tuple(int(v) for v in resolution)
+    axes = [origin[a] + (np.arange(n[a], dtype=np.float64) + 0.5) * cell_size for a in range(3)]
+    x = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
+    u = np.zeros(n + (3,), np.float64)
+    for strength, size, seed in fields:
+        if strength == 0.0 or size <= 0.0:
+            continue
+        rng = np.random.default_rng(int(seed))
+        k = rng.normal(size=(TURBULENCE_MODES, 3))
+        k *= (2.0 * np.pi / size) / np.linalg.norm(k, axis=1, keepdims=True)
+        a = rng.normal(size=(TURBULENCE_MODES, 3))
+        phase = rng.uniform(0.0, 2.0 * np.pi, TURBULENCE_MODES)
+        omega = 2.0 * np.pi * abs(strength) / size
+        amp = np.cross(k, a)
+        amp *= abs(strength) * np.sqrt(2.0 / TURBULENCE_MODES) / np.linalg.norm(amp, axis=1,
+                                                                                 keepdims=True)
+        for m in range(TURBULENCE_MODES):
+            u += np.cos(x @ k[m] + phase[m] + omega * t)[..., None] * amp[m]
+    return u.astype(np.float32)
