@@ -45,16 +45,6 @@ USAGE = ("usage: blender -b --factory-startup --python "
 KINDS = ("transition", "after", "within")
 
 
-def pixels(path):
-    """Display RGB (h, w, 3) in [0, 1] of a PNG (Blender's rows, bottom first)."""
-    img = bpy.data.images.load(path, check_existing=False)
-    w, h = img.size
-    px = np.empty(w * h * 4, dtype=np.float32)
-    img.pixels.foreach_get(px)
-    bpy.data.images.remove(img)
-    return px.reshape(h, w, 4)[..., :3]
-
-
 def change(a, b):
     """Mean absolute difference of two display images, in 8-bit levels."""
     return float(np.abs(a - b).mean() * 255.0)
@@ -83,7 +73,7 @@ def stats(d):
 def cropped(paths, out, margin=4):
     """Copies of the PNGs `paths` cut to the box of pixels lit (scene_kit.lit_share's level) in
     any of them, grown by `margin`; returns their paths (OUT/crop_<name>)."""
-    images = [pixels(p) for p in paths]
+    images = [scene_kit.png_pixels(p) for p in paths]
     lit = np.any([im.max(axis=2) > 0.05 for im in images], axis=0)
     rows, cols = np.flatnonzero(lit.any(axis=1)), np.flatnonzero(lit.any(axis=0))
     if len(rows) == 0:
@@ -136,7 +126,7 @@ def main():
     paths = [pattern % f for f in range(first, last + 1)]
     print(f"smoothness: rendered frames {first}-{last} at {scene.render.resolution_x}x"
           f"{scene.render.resolution_y}, {samples} samples, {seconds:.2f} s/frame", flush=True)
-    images = [pixels(p) for p in paths]
+    images = [scene_kit.png_pixels(p) for p in paths]
     frames = np.arange(first + 1, last + 1)
     d = np.asarray([change(images[i - 1], images[i]) for i in range(1, len(images))])
     kinds, jump_frames = frame_kinds(walk, frames, hold_frames)
@@ -144,7 +134,7 @@ def main():
     scene.cycles.seed = 1
     noise_path = scene_kit.render_frames(scene, [first], os.path.join(out, "noise_%04d.png"))[0]
     scene.cycles.seed = 0
-    noise = change(images[0], pixels(noise_path))
+    noise = change(images[0], scene_kit.png_pixels(noise_path))
     np.savez(os.path.join(out, "smoothness.npz"), frames=frames, change=d, kinds=kinds,
              jump_frames=jump_frames, noise=noise)
     lit = np.mean([scene_kit.lit_share(p) for p in paths[::max(1, len(paths) // 20)]])
