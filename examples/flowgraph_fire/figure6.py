@@ -5,7 +5,9 @@ block size B (§4.3) shape a synthesized fire's walk, on a real flow graph.
 
 GRAPH_NPZ is the flowgraph.npz Build Flow Graph wrote (e.g. the campfire example's, in
 OUT_DIR/plume_cache/State0 Calm/ after examples/flowgraph_fire/campfire.py); it holds the cost
-matrix, so graphs of other block sizes are built from the same costs (ε = (2a + b)/3 each).
+matrix, so graphs of other block sizes are built from the same costs (ε = (2a + b)/3 each, a and b
+over the candidates that are not hops between states at the same moment, as Build Flow Graph
+takes them: flowgraph.threshold, written out here to run without Blender).
 NATIVE_DIR holds _native*.so (default: build/native of this repository).
 
 For B in {1, 8, 32} and the strategies of §5.1 — random (p = 1/d), temporal bias γ = 0.875
@@ -35,6 +37,21 @@ def load_native(path):
     sys.path.insert(0, path)
     import _native  # noqa: E402
     return _native
+
+
+def epsilon(native, cost, counts, params):
+    """ε = (2a + b)/3, a and b over the block candidates that do not join two states' groups at
+    most max(1, min node gap) steps apart (flowgraph_settings.same_moment and threshold)."""
+    t = native.select_transitions(cost, counts, params)
+    offsets = np.concatenate([[0], np.cumsum(counts)])
+    state = np.repeat(np.arange(len(counts)), counts)
+    rows, cols = np.asarray(t["row"], np.int64), np.asarray(t["col"], np.int64)
+    sr, sc = state[rows], state[cols]
+    moment = (sr != sc) & (np.abs((rows - offsets[sr]) - (cols - offsets[sc]))
+                           <= max(1, params.min_node_gap))
+    costs = np.asarray(t["cost"])
+    own = costs[~moment] if np.any(~moment) else costs
+    return (2.0 * own.min() + own.max()) / 3.0
 
 
 def read_graph_file(path):
@@ -84,6 +101,8 @@ def main():
         p = native.FlowGraphParams()
         p.block_size, p.min_node_gap, p.alpha, p.beta = block, gap, alpha, beta
         try:
+            p.epsilon_mode, p.epsilon = native.EpsilonMode.EXPLICIT, float(
+                epsilon(native, cost, counts, p))
             graph = native.FlowGraph.build(cost, counts, p)
         except ValueError as e:
             print(f"B = {block}: {e}")
