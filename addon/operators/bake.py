@@ -10,7 +10,7 @@ import os
 
 import bpy
 
-from .. import bake_runner, cache, cache_state
+from .. import bake_runner, cache, cache_state, fuel_warning
 from ..native import _native
 from ..build import volume
 from ..jobs.operator import JobOperator
@@ -32,7 +32,7 @@ class BakeJob(JobRunner):
     title = "Bake"
     kind = "bake"
     keeps_partial = True  # complete frames stay and resume
-    #: bake_runner.unburnt_fuel() of the snapshot: Fuel with Combustion off, said in the report
+    #: fuel_warning.unburnt_fuel() of the snapshot: Fuel with Combustion off, said in the report
     unburnt_fuel = ()
 
     def prepare(self, context):
@@ -43,7 +43,7 @@ class BakeJob(JobRunner):
         self.objects = (snap.domain_name,)
         if snap.mantaflow is None:
             bake_runner.check_input(snap, _native)
-        self.unburnt_fuel = bake_runner.unburnt_fuel(snap)  # a warning: the bake runs
+        self.unburnt_fuel = fuel_warning.unburnt_fuel(snap)  # a warning: the bake runs
         self.claim(domain_key(snap.domain_name))
         self.lock_folder(snap.cache_folder, f"cache_directory '{snap.cache_directory}'")
         self.snapshot, self.folder = snap, snap.cache_folder

@@ -28,7 +28,7 @@ def is_gas_domain(ob):
 #: physical (f = ε Δx (N × ω), Δx in metres), so a smoke's 0.2 leaves a fire a laminar cone: on
 #: a 0.3 m burner at 64 cells ε 0.2-2 gave a smooth cone, 4-10 the flickering tongues of a fire
 #: (Mantaflow gets them from its Flame Vorticity, 0.5 in its grid units); 6 is the fire's
-#: default (issue 30).
+#: default.
 SMOKE_VORTICITY = 0.2
 FIRE_VORTICITY = 6.0
 

@@ -4,7 +4,7 @@ Mantaflow's): role buttons, then the settings of the object's role."""
 import bpy
 
 from .. import streak_count
-from ..bake_runner import fuel_without_combustion
+from ..fuel_warning import fuel_without_combustion
 from ..native import _native
 from ..operators.bake import is_baking, is_busy
 from .. import cache_state
@@ -350,7 +350,7 @@ class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
 
 
 def source_fuel_warning(scene, ob):
-    """bake_runner.fuel_without_combustion() of Source `ob`: its Fuel and the domains of the
+    """fuel_warning.fuel_without_combustion() of Source `ob`: its Fuel and the domains of the
     scene it feeds (every Plume domain simulating with Plume, as the bake's snapshot takes
     every Source of the scene)."""
     domains = [(o.name, o.plume.domain.combustion) for o in scene.objects
