@@ -255,7 +255,8 @@ void FlameShaper::shape(const std::vector<Flame>& flames, double time, const Fla
       spine.motionAt(std::clamp(p.z / aspect, 0.0, 1.0), &velocity, &age);
       // §5.1: the image on the profile's side view (u across the widest diameter, v from base
       // to tip; the glow outside takes the nearest edge's colour), else a blackbody.
-      const double v = 1.0 - share * std::exp(-age * cooling) * (1.0 - p.z / aspect);
+      const double cooled = cooling > 0.0 ? std::exp(-age * cooling) : 1.0;  // attached: no exp
+      const double v = 1.0 - share * cooled * (1.0 - p.z / aspect);
       const glm::vec3 color = image && image->width > 0 ? image->sample(0.5 + 0.5 * p.x, v)
                                                         : (*mBlackbody)(s.density);
       p += mFlow.displacement(p, time - age, flame.radius);
