@@ -59,13 +59,14 @@ class SolverSettings:
     pressure_tolerance: float = 1e-4
     max_pressure_iterations: int = 200
     combustion: bool = False
-    burn_rate: float = 6.0
+    burn_rate: float = 1.5
     soot_yield: float = 0.5
     heat_yield: float = 4.0
     conductivity: float = 0.0
     cooling_rate: float = 8.0
     max_temperature: float = 4.0
     expansion: float = 3.0
+    flame_vorticity: float = 24.0
     seed: int = 0
     threads: int = 0
 
@@ -79,6 +80,9 @@ class SourceParams:
     fuel: float = 0.0
     velocity: Tuple[float, float, float] = (0.0, 0.0, 0.0)
     motion_factor: float = 1.0
+    fuel_noise: float = 0.8
+    fuel_noise_scale: float = 0.08
+    fuel_noise_rate: float = 3.0
     #: §3.2 / Figure 10: the source's point sources emit particles (not a solver setting).
     emit_particles: bool = True
 
@@ -496,4 +500,7 @@ def to_native_source(source, native):
     s.fuel = source.fuel
     s.velocity = tuple(source.velocity)
     s.motion_factor = source.motion_factor
+    s.fuel_noise = source.fuel_noise
+    s.fuel_noise_scale = source.fuel_noise_scale
+    s.fuel_noise_rate = source.fuel_noise_rate
     return s

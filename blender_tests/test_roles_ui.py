@@ -27,11 +27,11 @@ DOMAIN_PROPS = (
     "alpha", "beta", "ambient_temperature", "wind", "wind_strength", "vorticity",
     "density_dissipation", "pressure_tolerance", "max_pressure_iterations", "burn_rate",
     "soot_yield", "heat_yield",
-    "conductivity", "cooling_rate", "max_temperature", "expansion", "threads",
+    "conductivity", "cooling_rate", "max_temperature", "expansion", "flame_vorticity", "threads",
     "boundary_neg_x", "boundary_pos_x", "boundary_neg_y", "boundary_pos_y", "boundary_neg_z",
     "boundary_pos_z", "volume_object")
-SOURCE_PROPS = ("density", "temperature", "fuel", "velocity", "motion_factor", "point_sources",
-                "candidate_group")
+SOURCE_PROPS = ("density", "temperature", "fuel", "fuel_noise", "fuel_noise_scale",
+                "fuel_noise_rate", "velocity", "motion_factor", "point_sources", "candidate_group")
 
 PANELS = ("PHYSICS_PT_plume", "PHYSICS_PT_plume_settings", "PHYSICS_PT_plume_forces",
           "PHYSICS_PT_plume_advection", "PHYSICS_PT_plume_pressure", "PHYSICS_PT_plume_boundaries",

@@ -13,6 +13,17 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
                                description="T - T_amb set in the source's cells each step")
     fuel: FloatProperty(name="Fuel", default=0.0, soft_min=0.0, soft_max=10.0,
                         description="F set in the source's cells (combustion domains only)")
+    fuel_noise: FloatProperty(
+        name="Flicker", default=0.8, min=0.0, max=1.0, subtype='FACTOR',
+        description="Thins the fuel in drifting patches, so the fire leaves the source as "
+                    "separate, flickering tongues instead of one even sheet (0: even fuel; 1: "
+                    "the patches take all of it)")
+    fuel_noise_scale: FloatProperty(
+        name="Flicker Size", default=0.08, min=1e-4, soft_min=0.005, soft_max=1.0, unit='LENGTH',
+        description="Size of the flicker's patches: about the width of one tongue of flame")
+    fuel_noise_rate: FloatProperty(
+        name="Flicker Speed", default=3.0, min=0.0, soft_max=20.0,
+        description="How many times a second the flicker's patches change")
     velocity: FloatVectorProperty(
         name="Initial Velocity", size=3, default=(0.0, 0.0, 0.0), subtype='VELOCITY', unit='VELOCITY',
         description="Velocity given to the air in the source's cells, m/s (smoke_surfaces.txt §3.2)")

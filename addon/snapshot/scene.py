@@ -100,6 +100,9 @@ def source_params(s):
     return SourceParams(density=float(s.density), temperature=float(s.temperature),
                         fuel=float(s.fuel), velocity=tuple(float(v) for v in s.velocity),
                         motion_factor=float(s.motion_factor),
+                        fuel_noise=float(s.fuel_noise),
+                        fuel_noise_scale=float(s.fuel_noise_scale),
+                        fuel_noise_rate=float(s.fuel_noise_rate),
                         emit_particles=bool(s.emit_particles))
 
 

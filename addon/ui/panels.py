@@ -152,7 +152,7 @@ class PHYSICS_PT_plume_combustion(PlumeDomainPanel, bpy.types.Panel):
         d = context.object.plume.domain
         layout.active = d.combustion
         for name in ("burn_rate", "soot_yield", "heat_yield", "conductivity", "cooling_rate",
-                     "max_temperature", "expansion"):
+                     "max_temperature", "expansion", "flame_vorticity"):
             layout.prop(d, name)
         # Pathline groups for flow-graph fire (graph_fire_synthesis.txt §4.2).
         layout.prop(d, "pathlines")
@@ -375,6 +375,11 @@ class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
         layout.prop(s, "density")
         layout.prop(s, "temperature")
         layout.prop(s, "fuel")
+        col = layout.column(align=True)
+        col.active = s.fuel > 0.0
+        col.prop(s, "fuel_noise")
+        col.prop(s, "fuel_noise_scale", text="Size")
+        col.prop(s, "fuel_noise_rate", text="Speed")
         warning = source_fuel_warning(context.scene, context.object)
         if warning:
             col = layout.column(align=True)

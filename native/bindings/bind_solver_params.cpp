@@ -132,6 +132,8 @@ void bindParams(py::module_& m) {
   field(c, "cooling_rate", &SmokeParams::coolingRate, "c: cooling c ((T - T_0)/(T_max - T_0))^4 per s.");
   field(c, "max_temperature", &SmokeParams::maxTemperature, "T_max.");
   field(c, "expansion", &SmokeParams::expansion, "φ: divergence per unit fuel burnt per s (eq. 1).");
+  field(c, "flame_vorticity", &SmokeParams::flameVorticity,
+        "ε_f: vorticity confinement added where fuel burns, ε + ε_f min(F, 1).");
   field(c, "seed", &SmokeParams::seed, "Seed of every random choice.");
   field(c, "threads", &SmokeParams::threads, "Worker threads; 0 = all cores.");
   c.def("validate", &SmokeParams::validate,
@@ -160,6 +162,17 @@ void bindSourceSettings(py::module_& m) {
       "Initial velocity, m/s (smoke_surfaces §3.2).");
   c.def_readwrite("motion_factor", &SourceSettings::motionFactor,
                   "Share of the source object's own motion added to its velocity.");
+  c.def_property(
+      "fuel_noise", [](const SourceSettings& s) { return s.fuelNoise.amount; },
+      [](SourceSettings& s, float v) { s.fuelNoise.amount = v; },
+      "Flicker a in [0, 1]: share of the fuel its patches may take away.");
+  c.def_property(
+      "fuel_noise_scale", [](const SourceSettings& s) { return s.fuelNoise.scale; },
+      [](SourceSettings& s, float v) { s.fuelNoise.scale = v; }, "Size λ of the noise's patches, m.");
+  c.def_property(
+      "fuel_noise_rate", [](const SourceSettings& s) { return s.fuelNoise.rate; },
+      [](SourceSettings& s, float v) { s.fuelNoise.rate = v; },
+      "Patches renewed per second (the flicker's speed).");
   c.def("validate", &SourceSettings::validate, "Raises ValueError naming a bad setting.");
 }
 

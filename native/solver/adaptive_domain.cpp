@@ -107,6 +107,7 @@ void AdaptiveDomain::step(SmokeSolver& full, float dt) {
     setEmitters(full);
     copyIn(full);
   }
+  mInner->mTime = full.mTime;  // the sources' noise follows the full solver's clock
   mInner->step(dt);
 }
 

@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 #include "solver/pressure.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace plume {
@@ -84,10 +85,11 @@ void addWind(MacGrid3& velocity, const VectorGrid& field, const FlagGrid* types,
     });
 }
 
-void addVorticityConfinement(MacGrid3& velocity, const FlagGrid* types, float epsilon,
-                             float cellSize, float dt, VectorGrid& omega, VectorGrid& force,
-                             ScalarGrid& magnitude) {
-  if (epsilon == 0.f) return;
+void addVorticityConfinement(MacGrid3& velocity, const FlagGrid* types,
+                             const Confinement& strength, float cellSize, float dt,
+                             VectorGrid& omega, VectorGrid& force, ScalarGrid& magnitude) {
+  if (!strength.any()) return;
+  const float* fuel = strength.fuel && strength.flameEpsilon != 0.f ? strength.fuel->data() : nullptr;
   const glm::ivec3 n = velocity.cells();
   const float inv2h = 0.5f / cellSize;
   const std::size_t slice = std::size_t(n.x) * n.y;
@@ -115,7 +117,7 @@ void addVorticityConfinement(MacGrid3& velocity, const FlagGrid* types, float ep
       }
     }
   });
-  // f = ε Δx (N × ω), N the normalised gradient of |ω|.
+  // f = ε Δx (N × ω), N the normalised gradient of |ω|, ε = ε + ε_f min(F, 1) per cell.
   parallelFor(0, n.z, [&](int k) {
     const float* m = magnitude.data();
     for (int j = 0; j < n.y; ++j) {
@@ -135,6 +137,8 @@ void addVorticityConfinement(MacGrid3& velocity, const FlagGrid* types, float ep
           continue;
         }
         grad /= len;
+        const float epsilon =
+            strength.epsilon + (fuel ? strength.flameEpsilon * std::min(fuel[c], 1.f) : 0.f);
         force[c] = epsilon * cellSize * glm::cross(grad, omega[c]);
       }
     }

@@ -20,11 +20,21 @@ void addBuoyancy(MacGrid3& velocity, const ScalarGrid& density, const ScalarGrid
 void addWind(MacGrid3& velocity, const VectorGrid& field, const FlagGrid* cellTypes,
              const SmokeParams& params, float dt);
 
+/// Strength of vorticity confinement per cell: ε + ε_f min(F, 1), the uniform ε (Fedkiw 2001
+/// eq. 11) plus Flame Vorticity ε_f where fuel F burns (Mantaflow's flame_vorticity, which adds
+/// ε_f F to its uniform strength): a fire curls where it burns while its smoke stays smooth.
+struct Confinement {
+  float epsilon = 0.f;             ///< ε, everywhere
+  float flameEpsilon = 0.f;        ///< ε_f, per unit of fuel (up to 1)
+  const ScalarGrid* fuel = nullptr;  ///< F; nullptr or ε_f = 0: uniform ε only
+  bool any() const { return epsilon != 0.f || (fuel && flameEpsilon != 0.f); }
+};
+
 /// Vorticity confinement: ω = ∇ × u, N = ∇|ω| / |∇|ω||, f = ε Δx (N × ω) (Fedkiw 2001 eq. 11),
-/// computed at cell centres and averaged to faces. `omega`, `force` and `magnitude` (|ω|) are
-/// scratch grids sized like the cells.
-void addVorticityConfinement(MacGrid3& velocity, const FlagGrid* cellTypes, float epsilon,
-                             float cellSize, float dt, VectorGrid& omega, VectorGrid& force,
-                             ScalarGrid& magnitude);
+/// with ε per cell from `strength`, computed at cell centres and averaged to faces. `omega`,
+/// `force` and `magnitude` (|ω|) are scratch grids sized like the cells.
+void addVorticityConfinement(MacGrid3& velocity, const FlagGrid* cellTypes,
+                             const Confinement& strength, float cellSize, float dt,
+                             VectorGrid& omega, VectorGrid& force, ScalarGrid& magnitude);
 
 }  // namespace plume

@@ -61,6 +61,7 @@ const std::vector<SettingRange>& smokeSettingRanges() {
       {"conductivity", 0.0, 1e4},
       {"cooling_rate", 0.0, 1e6},
       {"expansion", 0.0, 1e4},
+      {"flame_vorticity", 0.0, 1e3},
       {"threads", 0, 1024},  // 0 = all cores
       {"adaptive_margin", 0, 64},  // cells
       {"adaptive_threshold", 1e-6, 1.0},
@@ -107,6 +108,7 @@ void SmokeParams::validate() const {
   if (combustion && !(maxTemperature > ambientTemperature))
     fail("max_temperature", "greater than ambient_temperature", maxTemperature);
   checkRange("expansion", expansion);
+  checkRange("flame_vorticity", flameVorticity);
   checkCount("threads", threads, " (0 = all cores)");
   checkCount("adaptive_margin", adaptiveMargin, " cells");
   checkRange("adaptive_threshold", adaptiveThreshold);

@@ -93,6 +93,9 @@ struct SmokeParams {
   float coolingRate = 1.f;      ///< c: cooling, c ((T - T_0)/(T_max - T_0))^4 per second
   float maxTemperature = 4.f;   ///< T_max
   float expansion = 1.f;        ///< φ: divergence per unit of fuel burnt per second (eq. 1)
+  /// ε_f: vorticity confinement added where fuel burns, ε + ε_f min(F, 1) (forces.h; Mantaflow's
+  /// Flame Vorticity): the flames curl, the smoke above them stays smooth.
+  float flameVorticity = 0.f;
 
   // --- Run ---
   std::uint64_t seed = 0;

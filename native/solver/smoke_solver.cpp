@@ -37,6 +37,15 @@ void SourceSettings::validate() const {
   checkFinite("fuel", fuel);
   checkFinite("motion_factor", motionFactor);
   for (int a = 0; a < 3; ++a) checkFinite("velocity", velocity[a]);
+  if (!(fuelNoise.amount >= 0.f && fuelNoise.amount <= 1.f))
+    throw std::invalid_argument("fuel_noise must be in [0, 1] (got " +
+                                std::to_string(fuelNoise.amount) + ")");
+  if (!(fuelNoise.scale > 0.f && fuelNoise.scale <= 1e3f))
+    throw std::invalid_argument("fuel_noise_scale must be in (0, 1000] m (got " +
+                                std::to_string(fuelNoise.scale) + ")");
+  if (!(fuelNoise.rate >= 0.f && fuelNoise.rate <= 1e3f))
+    throw std::invalid_argument("fuel_noise_rate must be in [0, 1000] per second (got " +
+                                std::to_string(fuelNoise.rate) + ")");
   if (density < 0.f)
     throw std::invalid_argument("density must be >= 0 (got " + std::to_string(density) + ")");
   if (fuel < 0.f)
@@ -197,6 +206,7 @@ bool SmokeSolver::advanceFrame(StepObserver* observer) {
     if (observer) observer->beforeStep(*this);
     if (box) {
       box->step(*this, dt);
+      mTime += dt;  // the box's solver ran the step on this clock
       mStats = box->lastStats();
       if (observer) box->syncBack(*this);
     } else {
@@ -211,6 +221,7 @@ bool SmokeSolver::advanceFrame(StepObserver* observer) {
   stats.maxSpeed = maxSpeed();
   mStats = stats;
   ++mFrame;
+  mTime = double(mFrame) * double(mParams.frameDt);  // no drift from summed steps
   return true;
 }
 
@@ -228,6 +239,7 @@ void SmokeSolver::step(float dt) {
   mStats.pressureIterations = 0;
   mStats.pressureResidual = 0.f;
   for (const auto& stage : kStages) (this->*stage.second)(dt);
+  mTime += dt;
 }
 
 void SmokeSolver::applySources(float dt) {
@@ -237,15 +249,25 @@ void SmokeSolver::applySources(float dt) {
     emitPoints(mPointEmitters, gridFrame(), mParams.ambientTemperature,
                mHasSolids ? &mCellTypes : nullptr, dt, mDensity, mTemperature, mVelocity);
   }
-  for (const Source& src : mSources) {
+  for (std::size_t index = 0; index < mSources.size(); ++index) {
+    const Source& src = mSources[index];
     const SourceSettings& s = src.settings;
-    const float temperature = mParams.ambientTemperature + s.temperature;
+    const bool noisy = mParams.combustion && s.fuelNoise.amount > 0.f;
     for (std::size_t m = 0; m < src.cells.cells.size(); ++m) {
       const std::uint32_t c = src.cells.cells[m];
+      // The flicker thins the fuel in patches (1 - a n, source_noise.h).
+      float thin = 1.f;
+      if (noisy) {
+        const glm::ivec3 ijk(int(c % std::uint32_t(n.x)), int((c / std::uint32_t(n.x)) % std::uint32_t(n.y)),
+                             int(c / (std::uint32_t(n.x) * std::uint32_t(n.y))));
+        const glm::vec3 p = mParams.origin + (glm::vec3(ijk) + 0.5f) * mParams.cellSize;
+        thin = sourceNoiseFactor(p, mTime, s.fuelNoise, mParams.seed, index);
+      }
       // Sources keep their cells at least as dense / hot / fuelled as they are set to.
       mDensity[c] = std::max(mDensity[c], s.density);
-      if (s.temperature != 0.f) mTemperature[c] = std::max(mTemperature[c], temperature);
-      if (mParams.combustion) mFuel[c] = std::max(mFuel[c], s.fuel);
+      if (s.temperature != 0.f)
+        mTemperature[c] = std::max(mTemperature[c], mParams.ambientTemperature + s.temperature);
+      if (mParams.combustion) mFuel[c] = std::max(mFuel[c], thin * s.fuel);
       glm::vec3 v = s.velocity;
       if (!src.cells.velocity.empty()) v += s.motionFactor * src.cells.velocity[m];
       if (v == glm::vec3(0.f)) continue;  // a still source leaves the flow alone
@@ -265,8 +287,14 @@ void SmokeSolver::addForces(float dt) {
   const FlagGrid* types = mHasSolids ? &mCellTypes : nullptr;
   addBuoyancy(mVelocity, mDensity, mTemperature, types, mParams, dt);
   addWind(mVelocity, mWindField, types, mParams, dt);
-  addVorticityConfinement(mVelocity, types, mParams.vorticity, mParams.cellSize, dt, mVorticity,
-                          mForce, mVorticityMagnitude);
+  Confinement confinement;
+  confinement.epsilon = mParams.vorticity;
+  if (mParams.combustion) {
+    confinement.flameEpsilon = mParams.flameVorticity;
+    confinement.fuel = &mFuel;
+  }
+  addVorticityConfinement(mVelocity, types, confinement, mParams.cellSize, dt, mVorticity, mForce,
+                          mVorticityMagnitude);
 }
 
 void SmokeSolver::advect(float dt) {

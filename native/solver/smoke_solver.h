@@ -11,6 +11,7 @@
 #include "solver/point_emitters.h"
 #include "solver/pressure.h"
 #include "solver/smoke_params.h"
+#include "solver/source_noise.h"
 
 #include <atomic>
 #include <memory>
@@ -26,6 +27,7 @@ struct SourceSettings {
   float fuel = 0.f;         ///< F set in source cells (combustion)
   glm::vec3 velocity{0.f};  ///< initial velocity, m/s (smoke_surfaces.txt §3.2)
   float motionFactor = 1.f; ///< share of the source object's own motion added to its velocity
+  SourceNoise fuelNoise;    ///< flicker: patches of thinner fuel (source_noise.h)
   void validate() const;
 };
 
@@ -98,7 +100,11 @@ class SmokeSolver {
 
   // --- State ---
   int frame() const { return mFrame; }
-  void setFrame(int frame) { mFrame = frame; }
+  /// Sets the frame, and the clock of the sources' noise to its start.
+  void setFrame(int frame) {
+    mFrame = frame;
+    mTime = double(frame) * double(mParams.frameDt);
+  }
   const StepStats& lastStats() const { return mStats; }
 
   MacGrid3& velocity() { return mVelocity; }
@@ -164,6 +170,7 @@ class SmokeSolver {
   PressureSolver mPressureSolver;
   std::atomic<bool> mCancel{false};
   int mFrame = 0;
+  double mTime = 0.0;  ///< seconds since frame 0 at the start of the next step (source noise)
   StepStats mStats;
   std::unique_ptr<AdaptiveDomain> mAdaptive;  ///< params().adaptiveDomain: the box's solver
 };
