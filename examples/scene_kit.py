@@ -302,7 +302,7 @@ def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
     return src
 
 
-def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
+def flicker(src, speed, fuel_share, frames, key_every=4, seed=0, along_x=True):
     """Keys a fuel Source's feed with smooth noise over frames 1 .. frames + 1: a key every
     `key_every` frames with a random horizontal velocity within ±`speed` m/s and fuel within
     ±`fuel_share` of itself, drawn independently by a generator seeded with `seed`, Bézier in
@@ -310,18 +310,23 @@ def flicker(src, speed, fuel_share, frames, key_every=4, seed=0):
     no group of pathlines recurs by construction and every transition the flow graph finds is a
     similarity of the fire itself (§4.3). Every state of a graph is baked from the same keys:
     Build Flow Graph leaves out each bake's start-up (flowgraph.startup_groups), the only
-    stretch where states fed alike look alike. Keys half a puff apart put the feed's energy near the
-    puffing rate of a fire (~1.5/√D Hz for a pool fire of diameter D m): give `key_every` half
-    the puff period in frames. A log pile does not burn evenly: the uneven feed breaks the
-    symmetry of the flame, which then flickers as a fire does."""
+    stretch where states fed alike look alike. Keys half a puff apart put the feed's energy near
+    the puffing rate of a fire (~1.5/√D Hz for a pool fire of diameter D m): give `key_every`
+    half the puff period in frames. With `along_x` False the velocity has no x part (a piece of
+    a line along x then never pushes its flames into its neighbours'). A log pile does not burn
+    evenly: the uneven feed breaks the symmetry of the flame, which then flickers as a fire
+    does."""
     import random
     rng = random.Random(seed)
     s = src.plume.source
     fuel = s.fuel
     for frame in range(1, frames + 2, key_every):
         first = frame == 1
-        s.velocity = (0.0, 0.0, 0.0) if first else (rng.uniform(-speed, speed),
-                                                    rng.uniform(-speed, speed), 0.0)
+        if first:
+            s.velocity = (0.0, 0.0, 0.0)
+        else:
+            vx, vy = rng.uniform(-speed, speed), rng.uniform(-speed, speed)
+            s.velocity = (vx if along_x else 0.0, vy, 0.0)
         s.fuel = fuel if first else fuel * (1.0 + rng.uniform(-fuel_share, fuel_share))
         for name in ("velocity", "fuel"):
             src.keyframe_insert("plume.source." + name, frame=frame)
@@ -421,7 +426,29 @@ def lit_share(path, level=0.05):
     return float((png_pixels(path).max(axis=2) > level).mean())
 
 
-def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
+#: Emission strength of the synthesized fire's material in the flow-graph examples (Plume Fire's
+#: "Emission Strength" = this × b², the add-on's default 10): the splatted particles average
+#: their temperatures, so the synthesized fire burns cooler than the solver's grid and at 10 read
+#: dim brown under AgX; at 25 its core reads orange-yellow (campfire at 64 cells, AgX: the lit
+#: share at 320 x 180 from 11.6% to 12.2%, the brightest pixels from 0.76 to 0.92). The material
+#: is the artist's to change: this sets a value of it, nothing else.
+FLOWGRAPH_FIRE_EMISSION = 25.0
+
+
+def set_fire_emission(fire, strength):
+    """Sets the emission strength factor of `fire`'s Plume Fire material (the Math node feeding
+    the Principled Volume's Emission Strength) to `strength`; returns the old value."""
+    nt = fire.data.materials[0].node_tree
+    for link in nt.links:
+        if link.to_socket.name == "Emission Strength" and link.from_node.type == 'MATH':
+            old = link.from_node.inputs[1].default_value
+            link.from_node.inputs[1].default_value = strength
+            return old
+    raise RuntimeError(f"no emission strength node in {fire.data.materials[0].name!r}")
+
+
+def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph,
+                      emission=FLOWGRAPH_FIRE_EMISSION):
     """A flow-graph fire example from the command line: OUT_DIR [FRAMES]. setup(scene) builds
     the scene (fuel Sources, keyed once: every state is baked from the same feed; camera) and
     returns the state domains in name order; the look is a 640 x 360 Cycles render on a black
@@ -432,6 +459,7 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
     (fraction of the shot, state) pairs `targets`, FRAMES frames are synthesized, the
     cost-matrix picture is copied to OUT_DIR/TAG_cost.png, the frames at fractions `show` are
     rendered to OUT_DIR/TAG_####.png and OUT_DIR/TAG_strip.png, and the times are printed.
+    The fire material's emission strength is set to `emission` (FLOWGRAPH_FIRE_EMISSION).
     Returns (scene, state 0's domain, the fire Volume object, OUT_DIR)."""
     import shutil
     out_dir, frames = parse_args(usage, default_frames)
@@ -454,6 +482,7 @@ def flowgraph_example(tag, usage, default_frames, setup, targets, show, graph):
           f"{synth_s / frames * 1e3:.0f} ms/frame, VDB writing included) -> '{fire.name}'",
           flush=True)
     hide_bakes(domains)
+    set_fire_emission(fire, emission)
     bpy.ops.wm.save_mainfile()
     folder = addon_module("snapshot").cache_folder_of(keeper)
     shutil.copyfile(addon_module("flowgraph").image_path(folder),
