@@ -8,8 +8,8 @@ states, in name order: "State0 Calm" (no wind), "State1 Breeze" and "State2 Gale
 pulled towards a wind along +x). One fuel Source, a round burner on the floor under four logs,
 feeds all of them; its feed flickers with smooth noise that never repeats (random velocity and
 fuel keyed every 4 frames, half a puff at the puffing rate of a fire that size, ~3 Hz), the same
-keys for every state. Each state is a fire bake of 100 frames with Record Pathlines on: every
-node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the burner and
+keys for every state; cooling c = 20 (half fire_domain's) for taller flames. Each state is a
+fire bake of 100 frames with Record Pathlines on: every node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the burner and
 followed for t_max (§4.2). Build Flow Graph joins the three states into one graph with the
 paper's settings (transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B
 = 32, ε = (2a+b)/3, dead ends and traps pruned; the cost matrix is drawn like Figure 4; each
@@ -17,8 +17,9 @@ bake's first t_max, its start-up from still air, left out), and
 Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake),
 steered by keyed target states: calm, then gale from a quarter of the shot, then breeze from 60%
 on. Every frame the live particles are rasterized into a VDB (density, temperature, flame) that
-a Volume object with Plume's fire material plays. Then one transition the walk took is shown:
-five synthesized frames around it above the same frames of the destination state played straight
+a Volume object with Plume's fire material plays (emission strength raised to
+scene_kit.FLOWGRAPH_FIRE_EMISSION), seen by a camera framed on the fire. Then one transition
+the walk took is shown: five synthesized frames around it above the same frames of the destination state played straight
 (transition_strip.py).
 
 Writes OUT_DIR/campfire.blend, the caches in OUT_DIR/plume_cache (the graph and the synthesized
@@ -71,6 +72,7 @@ STATES = (("State0 Calm", 0.0, 0.0), ("State1 Breeze", 0.5, 2.0), ("State2 Gale"
 TARGETS = ((0.0, 0), (0.25, 2), (0.6, 1))
 SHOW = (0.2, 0.45, 0.55, 0.9)  # rendered frames: calm, gale, gale, breeze
 LOG_COLOR = (0.012, 0.006, 0.003)
+COOLING = 20.0                 # c: half fire_domain's 40, so the flames stand taller and hotter
 PUFF_KEYS = 4                  # frames between the feed's keys: half a puff at ~3 Hz, 1.5/√D for
                                # D = 0.24 m (the noise has no period)
 
@@ -84,7 +86,8 @@ def make_states(frames_baked):
     for name, speed, strength in STATES:
         dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, frames_baked,
                                     NODES_PER_FRAME, LIFETIME)
-        dom.plume.domain.wind, dom.plume.domain.wind_strength = (speed, 0.0, 0.0), strength
+        d = dom.plume.domain
+        d.wind, d.wind_strength, d.cooling_rate = (speed, 0.0, 0.0), strength, COOLING
         domains.append(dom)
     return domains
 
@@ -104,7 +107,9 @@ def logs():
 def setup(scene):
     domains = make_states(BAKE_FRAMES)
     logs()
-    scene_kit.camera(scene, (0.0, -3.2, 0.5), (90.0, 0.0, 0.0), lens=50.0)
+    # Framed on the fire: 2.4 m in front of it (1.7 x 0.96 m in view), a little downwind of the
+    # burner so that the gale's leaning flame stays in the picture.
+    scene_kit.camera(scene, (-0.3, -2.4, 0.45), lens=50.0, target=(-0.3, 0.0, 0.42))
     return domains
 
 
