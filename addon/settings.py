@@ -61,10 +61,10 @@ class SolverSettings:
     combustion: bool = False
     burn_rate: float = 1.5
     soot_yield: float = 0.5
-    heat_yield: float = 4.0
+    heat_yield: float = 6.0
     conductivity: float = 0.0
     cooling_rate: float = 8.0
-    max_temperature: float = 4.0
+    max_temperature: float = 3.0
     expansion: float = 3.0
     flame_vorticity: float = 24.0
     seed: int = 0

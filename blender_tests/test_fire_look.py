@@ -56,9 +56,14 @@ HUE_RANGE = (20.0, 50.0)
 WHITE_MAX = 0.05
 #: 3.8-4.3% measured.
 LIT_MIN = 0.025
-#: The flame's top (topmost row with ROW_MIN_LIT lit pixels) is below this height in the domain
-#: (the old uniform tube reached the top, z = 1); 0.61-0.67 measured.
-FLAME_TOP_MAX = 0.75
+#: The flame's top (topmost row with ROW_MIN_LIT lit pixels) is below this height in the domain:
+#: the old uniform tube reached the top, z = 1. Measured 0.61-0.67 with burn rate 6 and no Flame
+#: Vorticity or Flicker (the bound was 0.75 then); today's defaults (burn rate 1.5, Flame
+#: Vorticity 24, Flicker 0.8) give a taller fire whose tongues reach 0.70-0.82 in 4.5 (a 0.3 m
+#: burner's fire in Mantaflow is about four burners tall, examples/smoke/fire_vs_mantaflow.py),
+#: so the bound is now 0.9: still below the tube's 1.0, and test_base_brighter_than_tips checks
+#: that the flame tapers.
+FLAME_TOP_MAX = 0.9
 #: Share of the flame's pixels (lit in either frame) lit in only one of two rendered frames, at
 #: least: 0.069-0.094 measured; the old defaults' steady column 0.035 (edge noise).
 FLICKER_MIN = 0.05

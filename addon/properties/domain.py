@@ -173,14 +173,14 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                              description="r: fuel burnt per second, dF/dt = -r F (eq. 3)")
     soot_yield: FloatProperty(name="Soot Yield (k_S)", default=0.5, soft_min=0.0, soft_max=5.0,
                               description="k_S: soot made per unit of fuel burnt (eq. 4)")
-    heat_yield: FloatProperty(name="Heat Yield (k_T)", default=4.0, soft_min=0.0, soft_max=20.0,
+    heat_yield: FloatProperty(name="Heat Yield (k_T)", default=6.0, soft_min=0.0, soft_max=20.0,
                               description="k_T: heat made per unit of fuel burnt (eq. 5)")
     conductivity: FloatProperty(name="Conductivity (κ)", default=0.0, soft_min=0.0, soft_max=1.0,
                                 description="κ: thermal conductivity (heat diffusion), m²/s (eq. 5)")
     cooling_rate: FloatProperty(
         name="Cooling (c)", default=8.0, soft_min=0.0, soft_max=10.0,
         description="c: cooling c ((T - T_0)/(T_max - T_0))^4 per second (eq. 5)")
-    max_temperature: FloatProperty(name="Max Temperature (T_max)", default=4.0, soft_min=0.0,
+    max_temperature: FloatProperty(name="Max Temperature (T_max)", default=3.0, soft_min=0.0,
                                    soft_max=20.0, description="T_max: temperature of the hottest flame (eq. 5)")
     expansion: FloatProperty(
         name="Expansion (φ)", default=3.0, soft_min=0.0, soft_max=10.0,

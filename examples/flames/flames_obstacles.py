@@ -42,10 +42,13 @@ BALL_RADIUS = 0.14
 def wind_domain(frames):
     """The 40³ domain over the burner, the ball as an Obstacle and a hot Source disc; baked
     here. Returns the domain."""
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=BALL_RADIUS, location=BALL, segments=24,
-                                         ring_count=12)
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=BALL_RADIUS, location=BALL, segments=48,
+                                         ring_count=24)
     ball = bpy.context.active_object
     ball.name = "Ball"
+    # Smooth shading: the flat faces of a glossy ball each mirror one patch of flame, a
+    # chequer of squares on the metal.
+    bpy.ops.object.shade_smooth()
     bpy.ops.plume.role_set(role='OBSTACLE')
     flame_kit.solid(ball, (0.2, 0.2, 0.21), roughness=0.3, name="Metal")
     bpy.ops.mesh.primitive_cylinder_add(radius=0.16, depth=0.08, location=(0.0, 0.0, 0.08))
