@@ -47,11 +47,11 @@ def fire_state(name, cache_dir, wind=(0.0, 0.0, 0.0), size=2.0):
     d = dom.plume.domain
     d.combustion = True
     # The combustion these states and the thresholds below were measured with (the fire's
-    # defaults have changed since: burn rate 1.5, cooling 8, expansion 3, vorticity 6 once
-    # Combustion is on, Flame Vorticity 24): the tests here are about the graph and the
+    # defaults have changed since: burn rate 1.5, cooling 8, expansion 3, heat yield 6, T_max 3,
+    # vorticity 6 once Combustion is on, Flame Vorticity 24): the tests here are about the graph and the
     # synthesis, not the combustion.
     d.burn_rate, d.cooling_rate, d.expansion, d.vorticity = 4.0, 1.0, 1.0, 0.2
-    d.flame_vorticity = 0.0
+    d.heat_yield, d.max_temperature, d.flame_vorticity = 4.0, 4.0, 0.0
     d.pathlines = True
     d.pathline_nodes_per_frame = 2
     d.pathline_lifetime = 0.5  # 24 samples: a 40-frame bake completes 58 groups
