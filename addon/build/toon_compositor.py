@@ -1,18 +1,27 @@
 """Depth-difference outlines in Blender's compositor (cartoon_smoke.txt §2.2, after Deussen &
-Strothotte 2000): the node group "Plume Depth Differences" draws a pixel in the outline colour
-when any of its four one-sided depth differences divided by the pixel size exceeds γ:
+Strothotte 2000): the node group "Plume Depth Differences" finds a pixel on the outline when any
+of its four one-sided depth differences divided by the pixel size exceeds γ:
 
     |z(i+1,j) - z(i,j)| / Δx > γ  or  |z(i,j) - z(i-1,j)| / Δx > γ  or
     |z(i,j+1) - z(i,j)| / Δy > γ  or  |z(i,j) - z(i,j-1)| / Δy > γ,
 
 the same test as _native.depth_differences (neighbours outside the image are skipped; with
-Ignore Background, pixels with depth >= Far are never outlined). Each neighbour is the Depth
-translated by one pixel. The pixels a translation uncovers read outside the image: Blender 3.4's
-Render Layers Depth answers 10e10 there (RenderLayersDepthProg; the background is 1e10), other
-compositors answer 0; no rendered depth is either, so 0 < neighbour < OUTSIDE_DEPTH skips them.
-Also: scene wiring with the Z pass, and the optional Freestyle style."""
+Ignore Background, pixels with depth >= Far are never outlined): the group's Outline output.
 
-import bpy
+The line drawn has a weight: Outline Width pixels at 1080 lines, scaled by the image height
+(a driver keeps "Image Height" at the render's lines), so a 4K render looks like 1080p. The same
+test with neighbours k pixels away (k in OFFSETS) marks the pixels at most k pixels from a depth
+edge, on both sides; with half the line width h, a pixel first marked at offset k_i is covered
+clamp((h - k_(i-1)) / (k_i - k_(i-1)), 0, 1): the line's edge is soft (a fractional pixel, or a
+ramp over the wider offsets), and the line's area is its width (the Line output). Optional
+thinning with distance multiplies h by (D / max(z, D))^a, z the nearest depth the pixel's
+neighbours see (so the background side of a far silhouette thins too).
+
+Each neighbour is the Depth translated by k pixels. The pixels a translation uncovers read
+outside the image: Blender 3.4's Render Layers Depth answers 10e10 there (RenderLayersDepthProg;
+the background is 1e10), other compositors answer 0; no rendered depth is either, so
+0 < neighbour < OUTSIDE_DEPTH skips them. Also: scene wiring with the Z pass, and the optional
+Freestyle style."""
 
 from . import datablocks
 from .. import blender_compat as compat
@@ -24,6 +33,11 @@ LINESET = "Plume Toon"
 #: Depth read outside the image (10e10 in Blender 3.4) is above this; Cycles' background (1e10)
 #: and every surface depth are below it.
 OUTSIDE_DEPTH = 5.0e10
+#: Image height at which Outline Width is in pixels.
+REFERENCE_LINES = 1080.0
+#: Neighbour distances (px) of the line's bands: exact fractional edges up to a 4 px half width,
+#: a 2 px soft ramp beyond, up to 8 px (a 16 px line: Outline Width 8 at 1080p, 4 at 4K).
+OFFSETS = (1, 2, 3, 4, 6, 8)
 
 #: Group inputs: (name, socket type, default).
 INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
@@ -33,12 +47,55 @@ INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
           ("Ignore Background", 'NodeSocketFloat', 0.0),
           ("Far", 'NodeSocketFloat', 1.0e9),
           ("Pixel Width", 'NodeSocketFloat', 1.0),
-          ("Pixel Height", 'NodeSocketFloat', 1.0))
+          ("Pixel Height", 'NodeSocketFloat', 1.0),
+          ("Outline Width", 'NodeSocketFloat', 2.0),
+          ("Image Height", 'NodeSocketFloat', REFERENCE_LINES),
+          ("Thinning", 'NodeSocketFloat', 0.0),
+          ("Thinning Distance", 'NodeSocketFloat', 5.0))
+
+
+def _offset_bands(ng, gin, math, k, x):
+    """For neighbours k pixels away: (1 where a depth difference exceeds γ, the nearest depth
+    among the pixel and its inside neighbours)."""
+    N, L = ng.nodes.new, ng.links.new
+    z = gin.outputs["Depth"]
+    conditions, nearest = [], z
+    for n, (dx, dy, size) in enumerate(((k, 0, "Pixel Width"), (-k, 0, "Pixel Width"),
+                                        (0, k, "Pixel Height"), (0, -k, "Pixel Height"))):
+        y = 900 - n * 450
+        t = compat.compositor_translate(ng, dx, dy)
+        t.location = (x, y)
+        L(z, t.inputs["Image"])
+        sep = N('CompositorNodeSeparateColor')  # the neighbour's depth exactly (no colour->BW)
+        sep.location = (x + 150, y)
+        L(t.outputs["Image"], sep.inputs["Image"])
+        # 0 * z + neighbour: the neighbour on z's pixel grid. 4.2-4.5's compositor translates by
+        # moving an image's domain and computes a math node on its first input's domain, so z
+        # must come first for the shifted depth to be resampled onto z's pixels (uncovered ones
+        # read 0); 3.4 and 5.0 shift the pixels themselves, and there this is the identity.
+        neighbour = math('ADD', math('MULTIPLY', z, 0.0, x + 150, y - 120), sep.outputs["Red"],
+                         x + 300, y - 120)
+        diff = math('ABSOLUTE', math('SUBTRACT', z, neighbour, x + 300, y), None, x + 450, y)
+        over = math('GREATER_THAN', math('DIVIDE', diff, gin.outputs[size], x + 600, y),
+                    gin.outputs["Gamma"], x + 750, y)
+        inside = math('MULTIPLY', math('GREATER_THAN', neighbour, 0.0, x + 450, y - 120),
+                      math('LESS_THAN', neighbour, OUTSIDE_DEPTH, x + 450, y - 240),
+                      x + 600, y - 120)
+        conditions.append(math('MULTIPLY', over, inside, x + 900, y))
+        # The neighbour where inside, else z: z + inside * (neighbour - z).
+        seen = math('ADD', z, math('MULTIPLY', inside, math('SUBTRACT', neighbour, z, x + 600,
+                                                                  y - 240), x + 750, y - 240),
+                    x + 900, y - 240)
+        nearest = math('MINIMUM', nearest, seen, x + 1050, y - 240)
+    any_ = math('MAXIMUM', math('MAXIMUM', conditions[0], conditions[1], x + 1050, 700),
+                math('MAXIMUM', conditions[2], conditions[3], x + 1050, 200), x + 1200, 450)
+    return any_, nearest
 
 
 def depth_group():
-    """The compositor node group (rebuilt in place when it exists). Outputs: Image (outline
-    pixels in Outline Color, others from Image) and Outline (1 on outline pixels, else 0)."""
+    """The compositor node group (rebuilt in place when it exists). Outputs: Image (the line in
+    Outline Color over Image), Outline (1 on the pixels §2.2's test outlines, else 0) and Line
+    (the line's coverage, 0-1, of its width at this image height)."""
     ng = datablocks.empty_node_group(GROUP, 'CompositorNodeTree')
     new = compat.group_socket_new
     sockets = {name: new(ng, 'INPUT', kind, name) for name, kind, _ in INPUTS}
@@ -48,59 +105,86 @@ def depth_group():
     sockets["Ignore Background"].min_value, sockets["Ignore Background"].max_value = 0.0, 1.0
     new(ng, 'OUTPUT', 'NodeSocketColor', "Image")
     new(ng, 'OUTPUT', 'NodeSocketFloat', "Outline")
+    new(ng, 'OUTPUT', 'NodeSocketFloat', "Line")
     N, L = ng.nodes.new, ng.links.new
     gin, gout = N('NodeGroupInput'), N('NodeGroupOutput')
-    gin.location, gout.location = (-1200, 0), (1100, 0)
     z = gin.outputs["Depth"]
 
-    def math(op, a, b, x, y):
-        return link_math(ng, op, a, b, (x, y), kind=compat.COMPOSITOR_MATH)
+    def math(op, a, b, x, y, clamp=False):
+        out = link_math(ng, op, a, b, (x, y), kind=compat.COMPOSITOR_MATH)
+        out.node.use_clamp = clamp
+        return out
 
-    conditions = []
-    for n, (dx, dy, size) in enumerate(((1, 0, "Pixel Width"), (-1, 0, "Pixel Width"),
-                                        (0, 1, "Pixel Height"), (0, -1, "Pixel Height"))):
-        y = 600 - n * 300
-        t = compat.compositor_translate(ng, dx, dy)
-        t.location = (-1000, y)
-        L(z, t.inputs["Image"])
-        sep = N('CompositorNodeSeparateColor')  # the neighbour's depth exactly (no colour->BW)
-        sep.location = (-850, y)
-        L(t.outputs["Image"], sep.inputs["Image"])
-        # 0 * z + neighbour: the neighbour on z's pixel grid. 4.2-4.5's compositor translates by
-        # moving an image's domain and computes a math node on its first input's domain, so z
-        # must come first for the shifted depth to be resampled onto z's pixels (uncovered ones
-        # read 0); 3.4 and 5.0 shift the pixels themselves, and there this is the identity.
-        neighbour = math('ADD', math('MULTIPLY', z, 0.0, -850, y - 120), sep.outputs["Red"],
-                         -700, y - 120)
-        diff = math('ABSOLUTE', math('SUBTRACT', z, neighbour, -700, y), None, -550, y)
-        over = math('GREATER_THAN', math('DIVIDE', diff, gin.outputs[size], -400, y),
-                    gin.outputs["Gamma"], -250, y)
-        inside = math('MULTIPLY', math('GREATER_THAN', neighbour, 0.0, -550, y - 120),
-                      math('LESS_THAN', neighbour, OUTSIDE_DEPTH, -550, y - 240), -400, y - 120)
-        conditions.append(math('MULTIPLY', over, inside, -100, y))
-    any_ = math('MAXIMUM', math('MAXIMUM', conditions[0], conditions[1], 50, 450),
-                math('MAXIMUM', conditions[2], conditions[3], 50, 0), 200, 250)
+    # Half the line width in pixels of this image: width * lines / 1080 / 2.
+    half = math('MULTIPLY', gin.outputs["Outline Width"],
+                math('DIVIDE', gin.outputs["Image Height"], 2.0 * REFERENCE_LINES, -1000, -1400),
+                -850, -1400)
+    line, outline, previous = None, None, 0
+    for i, k in enumerate(OFFSETS):
+        x = i * 1800
+        marked, nearest = _offset_bands(ng, gin, math, k, x)
+        if k == 1:
+            outline = marked
+        # Thinning: h * (D / max(z_near, D))^a.
+        d = gin.outputs["Thinning Distance"]
+        thin = math('POWER', math('DIVIDE', d, math('MAXIMUM', nearest, d, x + 1200, -1400),
+                                  x + 1350, -1400), gin.outputs["Thinning"], x + 1500, -1400)
+        h = math('MULTIPLY', half, thin, x + 1650, -1400)
+        cover = math('DIVIDE', math('SUBTRACT', h, float(previous), x + 1350, -1200),
+                     float(k - previous), x + 1500, -1200, clamp=True)
+        band = math('MULTIPLY', marked, cover, x + 1650, -1200)
+        line = band if line is None else math('MAXIMUM', line, band, x + 1800, -1200)
+        previous = k
+    x = len(OFFSETS) * 1800
+    gin.location, gout.location = (-1300, 0), (x + 900, 0)
     # Ignore Background: background = depth not < Far; keep = 1 - ignore * background.
-    background = math('SUBTRACT', 1.0, math('LESS_THAN', z, gin.outputs["Far"], 50, -300),
-                      200, -300)
+    background = math('SUBTRACT', 1.0, math('LESS_THAN', z, gin.outputs["Far"], x, -300),
+                      x + 150, -300)
     keep = math('SUBTRACT', 1.0, math('MULTIPLY', gin.outputs["Ignore Background"], background,
-                                      350, -300), 500, -300)
-    outline = math('MULTIPLY', any_, keep, 650, 100)
+                                      x + 300, -300), x + 450, -300)
+    outline = math('MULTIPLY', outline, keep, x + 600, 100)
+    line = math('MULTIPLY', line, keep, x + 600, -100)
     mix, fac, a, b, mixed = compat.compositor_mix(ng)
-    mix.location = (850, 100)
-    L(outline, fac)
+    mix.location = (x + 750, 0)
+    L(line, fac)
     L(gin.outputs["Image"], a)
     L(gin.outputs["Outline Color"], b)
     L(mixed, gout.inputs["Image"])
     L(outline, gout.inputs["Outline"])
+    L(line, gout.inputs["Line"])
     return ng
 
 
 def set_outline(node, settings):
-    """The group node's γ, outline colour and background switch from the toon settings."""
+    """The group node's γ, outline colour, background switch, line width and thinning from the
+    toon settings."""
     node.inputs["Gamma"].default_value = float(settings.depth_threshold)
     node.inputs["Outline Color"].default_value = tuple(settings.outline_color)
     node.inputs["Ignore Background"].default_value = 1.0 if settings.ignore_background else 0.0
+    node.inputs["Outline Width"].default_value = float(settings.outline_width)
+    node.inputs["Thinning"].default_value = float(settings.outline_thinning)
+    node.inputs["Thinning Distance"].default_value = float(settings.outline_thinning_distance)
+
+
+def drive_image_height(node, scene):
+    """Keeps the group node's Image Height at the render's lines (resolution Y times the
+    percentage), also when they change after the build, with a driver (a simple expression:
+    evaluated without Python, so it works with scripts not trusted)."""
+    socket = node.inputs["Image Height"]
+    r = scene.render
+    socket.default_value = r.resolution_y * r.resolution_percentage / 100.0
+    tree = node.id_data
+    path = socket.path_from_id("default_value")
+    tree.driver_remove(path)
+    driver = tree.driver_add(path).driver
+    driver.type = 'SCRIPTED'
+    for name, prop in (("h", "render.resolution_y"), ("p", "render.resolution_percentage")):
+        var = driver.variables.new()
+        var.name, var.type = name, 'SINGLE_PROP'
+        var.targets[0].id_type = 'SCENE'
+        var.targets[0].id = scene
+        var.targets[0].data_path = prop
+    driver.expression = "h * p / 100"
 
 
 def scene_node(scene):
@@ -131,6 +215,7 @@ def wire_scene(scene, view_layer, settings, far):
     node.location = (rl.location.x + 300, rl.location.y)
     comp.location = (node.location.x + 300, node.location.y)
     set_outline(node, settings)
+    drive_image_height(node, scene)
     node.inputs["Far"].default_value = float(far)
     nt.links.new(rl.outputs["Image"], node.inputs["Image"])
     nt.links.new(rl.outputs["Depth"], node.inputs["Depth"])

@@ -116,6 +116,24 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
         update=_look_changed)
     outline_color: _color("Outline Colour", (0.0, 0.0, 0.0, 1.0),
                           "Silhouette colour of the outline pixels (§2.2: e.g. black)")
+    outline_width: FloatProperty(
+        name="Outline Width", default=2.0, soft_min=0.0, soft_max=8.0, precision=2,
+        subtype='PIXEL',
+        description="Weight of the outline in pixels of a 1080-line picture. The line keeps its "
+                    "weight relative to the picture: twice as many pixels at 4K, half at 540 "
+                    "lines. Edges are soft, never a one-pixel staircase; 0 draws no line",
+        update=_look_changed)
+    outline_thinning: FloatProperty(
+        name="Thin With Distance", default=0.0, soft_min=0.0, soft_max=1.0, subtype='FACTOR',
+        description="Makes the outline of far smoke thinner: 0 keeps one weight everywhere, 1 "
+                    "thins it as the smoke itself shrinks with distance (half as thick twice as "
+                    "far)",
+        update=_look_changed)
+    outline_thinning_distance: FloatProperty(
+        name="Full Width Within", default=5.0, soft_min=0.01, soft_max=100.0, subtype='DISTANCE',
+        description="Smoke this close to the camera or closer keeps the full outline width; "
+                    "farther smoke gets thinner lines when Thin With Distance is above 0",
+        update=_look_changed)
     ignore_background: BoolProperty(
         name="Ignore Background", default=False,
         description="Never outline background pixels: the silhouette is drawn on the smoke side "

@@ -290,6 +290,11 @@ class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
         col = layout.column(heading="Outlines")
         col.prop(t, "depth_threshold")
         col.prop(t, "outline_color")
+        col.prop(t, "outline_width")
+        col.prop(t, "outline_thinning")
+        sub = col.column()
+        sub.active = t.outline_thinning > 0.0
+        sub.prop(t, "outline_thinning_distance")
         col.prop(t, "ignore_background")
         col.prop(t, "use_freestyle")
         row = layout.row()
