@@ -42,8 +42,9 @@ def build_scene(cache_dir, camera=True):
     t.size_low, t.size_high = 0.08, 0.2
     t.max_size_change = 0.5
     t.depth_threshold = GAMMA
-    # 9 px at 1080 lines is 2 px at 240: the line covers the band of §2.2's test in full.
-    t.outline_width = 9.0
+    # 14 px at 1080 lines is 3.1 px at 240: the line covers the band of §2.2's test in full
+    # (its soft edge lies on the next pixels out, which the interior check leaves out).
+    t.outline_width = 14.0
     t.stencil = 'PUFFY'
     t.ramp_color_low, t.ramp_color_high = LOW, HIGH
     scn = bpy.context.scene

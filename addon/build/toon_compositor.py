@@ -11,11 +11,14 @@ Ignore Background, pixels with depth >= Far are never outlined): the group's Out
 The line drawn has a weight: Outline Width pixels at 1080 lines, scaled by the image height
 (a driver keeps "Image Height" at the render's lines), so a 4K render looks like 1080p. The same
 test with neighbours k pixels away (k in OFFSETS) marks the pixels at most k pixels from a depth
-edge, on both sides; with half the line width h, a pixel first marked at offset k_i is covered
-clamp((h - k_(i-1)) / (k_i - k_(i-1)), 0, 1): the line's edge is soft (a fractional pixel, or a
-ramp over the wider offsets), and the line's area is its width (the Line output). Optional
-thinning with distance multiplies h by (D / max(z, D))^a, z the nearest depth the pixel's
-neighbours see (so the background side of a far silhouette thins too).
+edge, on both sides. With h half the line width, the pixels first marked at offset k_i (the
+ring k_(i-1) < distance <= k_i, n = k_i - k_(i-1) pixels wide) are covered
+clamp((h - (k_(i-1) + k_i) / 2) / (n + 1) + 1/2, 0, 1): the line's edge ramps over n + 1 pixels
+(two where the rings are one pixel wide: 0.75 / 0.25 at a whole h), so it is soft at any
+width, and the line's area stays its width (the first ring: at most h, so a line under a pixel
+wide is a lighter one-pixel line). Optional thinning with distance multiplies h by
+(D / max(z_near, D))^a, z_near the nearest depth the pixel's neighbours see (so the background
+side of a far silhouette thins too).
 
 Each neighbour is the Depth translated by k pixels. The pixels a translation uncovers read
 outside the image: Blender 3.4's Render Layers Depth answers 10e10 there (RenderLayersDepthProg;
@@ -35,9 +38,10 @@ LINESET = "Plume Toon"
 OUTSIDE_DEPTH = 5.0e10
 #: Image height at which Outline Width is in pixels.
 REFERENCE_LINES = 1080.0
-#: Neighbour distances (px) of the line's bands: exact fractional edges up to a 4 px half width,
-#: a 2 px soft ramp beyond, up to 8 px (a 16 px line: Outline Width 8 at 1080p, 4 at 4K).
-OFFSETS = (1, 2, 3, 4, 6, 8)
+#: Neighbour distances (px) of the line's rings: a 2 px soft edge up to a 2 px half width (a 4 px
+#: line: Outline Width 2 at 4K), wider ramps beyond, up to 8 px (a 16 px line: Outline Width 8
+#: at 1080p, 4 at 4K). Each offset costs ~50 compositor nodes, the bulk of the group's time.
+OFFSETS = (1, 2, 4, 8)
 
 #: Group inputs: (name, socket type, default).
 INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
@@ -54,14 +58,24 @@ INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
           ("Thinning Distance", 'NodeSocketFloat', 5.0))
 
 
-def _offset_bands(ng, gin, math, k, x):
-    """For neighbours k pixels away: (1 where a depth difference exceeds γ, the nearest depth
-    among the pixel and its inside neighbours)."""
+def _compare(ng, a, b, epsilon, location):
+    """1 where |a - b| <= epsilon, else 0 (the Math node's Compare)."""
+    m = ng.nodes.new(compat.COMPOSITOR_MATH)
+    m.operation, m.location = 'COMPARE', location
+    for i, v in enumerate((a, b, epsilon)):
+        ng.links.new(v, m.inputs[i])
+    return m.outputs[0]
+
+
+def _offset_bands(ng, gin, limits, math, k, x):
+    """For neighbours k pixels away: (1 where a depth difference exceeds γ times the pixel
+    size, the nearest depth among the pixel and its neighbours; outside the image 10e10 in 3.4,
+    harmless, or 0 elsewhere, which leaves the lines there at full width)."""
     N, L = ng.nodes.new, ng.links.new
     z = gin.outputs["Depth"]
     conditions, nearest = [], z
-    for n, (dx, dy, size) in enumerate(((k, 0, "Pixel Width"), (-k, 0, "Pixel Width"),
-                                        (0, k, "Pixel Height"), (0, -k, "Pixel Height"))):
+    for n, (dx, dy, limit) in enumerate(((k, 0, limits[0]), (-k, 0, limits[0]),
+                                         (0, k, limits[1]), (0, -k, limits[1]))):
         y = 900 - n * 450
         t = compat.compositor_translate(ng, dx, dy)
         t.location = (x, y)
@@ -75,20 +89,14 @@ def _offset_bands(ng, gin, math, k, x):
         # read 0); 3.4 and 5.0 shift the pixels themselves, and there this is the identity.
         neighbour = math('ADD', math('MULTIPLY', z, 0.0, x + 150, y - 120), sep.outputs["Red"],
                          x + 300, y - 120)
-        diff = math('ABSOLUTE', math('SUBTRACT', z, neighbour, x + 300, y), None, x + 450, y)
-        over = math('GREATER_THAN', math('DIVIDE', diff, gin.outputs[size], x + 600, y),
-                    gin.outputs["Gamma"], x + 750, y)
+        near = _compare(ng, z, neighbour, limit, (x + 450, y))  # |z - neighbour| <= γ Δ
         inside = math('MULTIPLY', math('GREATER_THAN', neighbour, 0.0, x + 450, y - 120),
                       math('LESS_THAN', neighbour, OUTSIDE_DEPTH, x + 450, y - 240),
                       x + 600, y - 120)
-        conditions.append(math('MULTIPLY', over, inside, x + 900, y))
-        # The neighbour where inside, else z: z + inside * (neighbour - z).
-        seen = math('ADD', z, math('MULTIPLY', inside, math('SUBTRACT', neighbour, z, x + 600,
-                                                                  y - 240), x + 750, y - 240),
-                    x + 900, y - 240)
-        nearest = math('MINIMUM', nearest, seen, x + 1050, y - 240)
-    any_ = math('MAXIMUM', math('MAXIMUM', conditions[0], conditions[1], x + 1050, 700),
-                math('MAXIMUM', conditions[2], conditions[3], x + 1050, 200), x + 1200, 450)
+        conditions.append(math('GREATER_THAN', inside, near, x + 750, y))  # inside, not near
+        nearest = math('MINIMUM', nearest, neighbour, x + 750, y - 240)
+    any_ = math('MAXIMUM', math('MAXIMUM', conditions[0], conditions[1], x + 900, 700),
+                math('MAXIMUM', conditions[2], conditions[3], x + 900, 200), x + 1050, 450)
     return any_, nearest
 
 
@@ -115,27 +123,34 @@ def depth_group():
         out.node.use_clamp = clamp
         return out
 
+    # γ times the pixel size: a depth difference above it is an edge.
+    limits = [math('MULTIPLY', gin.outputs["Gamma"], gin.outputs[size], -1000, y)
+              for size, y in (("Pixel Width", -1100), ("Pixel Height", -1250))]
     # Half the line width in pixels of this image: width * lines / 1080 / 2.
     half = math('MULTIPLY', gin.outputs["Outline Width"],
                 math('DIVIDE', gin.outputs["Image Height"], 2.0 * REFERENCE_LINES, -1000, -1400),
                 -850, -1400)
+    d = gin.outputs["Thinning Distance"]
     line, outline, previous = None, None, 0
     for i, k in enumerate(OFFSETS):
-        x = i * 1800
-        marked, nearest = _offset_bands(ng, gin, math, k, x)
+        x = i * 1500
+        marked, nearest = _offset_bands(ng, gin, limits, math, k, x)
         if k == 1:
             outline = marked
         # Thinning: h * (D / max(z_near, D))^a.
-        d = gin.outputs["Thinning Distance"]
-        thin = math('POWER', math('DIVIDE', d, math('MAXIMUM', nearest, d, x + 1200, -1400),
-                                  x + 1350, -1400), gin.outputs["Thinning"], x + 1500, -1400)
-        h = math('MULTIPLY', half, thin, x + 1650, -1400)
-        cover = math('DIVIDE', math('SUBTRACT', h, float(previous), x + 1350, -1200),
-                     float(k - previous), x + 1500, -1200, clamp=True)
-        band = math('MULTIPLY', marked, cover, x + 1650, -1200)
-        line = band if line is None else math('MAXIMUM', line, band, x + 1800, -1200)
+        thin = math('POWER', math('DIVIDE', d, math('MAXIMUM', nearest, d, x + 900, -1400),
+                                  x + 1050, -1400), gin.outputs["Thinning"], x + 1200, -1400)
+        h = math('MULTIPLY', half, thin, x + 1350, -1400)
+        ramp = k - previous + 1.0
+        cover = math('ADD', math('DIVIDE', math('SUBTRACT', h, (previous + k) / 2.0, x + 900,
+                                                -1200), ramp, x + 1050, -1200), 0.5,
+                     x + 1200, -1200, clamp=True)
+        if k == 1:
+            cover = math('MINIMUM', cover, h, x + 1350, -1100)
+        band = math('MULTIPLY', marked, cover, x + 1350, -1200)
+        line = band if line is None else math('MAXIMUM', line, band, x + 1500, -1200)
         previous = k
-    x = len(OFFSETS) * 1800
+    x = len(OFFSETS) * 1500
     gin.location, gout.location = (-1300, 0), (x + 900, 0)
     # Ignore Background: background = depth not < Far; keep = 1 - ignore * background.
     background = math('SUBTRACT', 1.0, math('LESS_THAN', z, gin.outputs["Far"], x, -300),
