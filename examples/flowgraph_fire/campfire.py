@@ -6,21 +6,21 @@ graph_fire_synthesis.txt (Table 1, Figure 1).
 Three fire domains on the same 2 x 1 x 1 m box at 128 x 64 x 64 (Table 1's grid) are the three
 states, in name order: "State0 Calm" (no wind), "State1 Breeze" and "State2 Gale" (the air is
 pulled towards a wind along +x). One fuel Source, a round burner on the floor under four logs,
-feeds all of them; its feed flickers with smooth noise that never repeats (random velocity and
-fuel keyed every 4 frames, half a puff at the puffing rate of a fire that size, ~3 Hz), the same
-keys for every state; cooling c = 20 (half fire_domain's) for taller flames. Each state is a
-fire bake of 100 frames with Record Pathlines on: every node step (a third of a frame) a group of pathlines is seeded at Δx/2 spacing in the burner and
-followed for t_max (§4.2). Build Flow Graph joins the three states into one graph with the
-paper's settings (transition costs of eqs. 9-10 over the pathlines' whole lifetime, blocks of B
-= 32, ε = (2a+b)/3, dead ends and traps pruned; the cost matrix is drawn like Figure 4; each
-bake's first t_max, its start-up from still air, left out), and
-Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake),
-steered by keyed target states: calm, then gale from a quarter of the shot, then breeze from 60%
-on. Every frame the live particles are rasterized into a VDB (density, temperature, flame) that
-a Volume object with Plume's fire material plays (emission strength raised to
-scene_kit.FLOWGRAPH_FIRE_EMISSION), seen by a camera framed on the fire. Then one transition
-the walk took is shown: five synthesized frames around it above the same frames of the destination state played straight
-(transition_strip.py).
+feeds all of them; its feed flickers with smooth noise that never repeats (random velocity and fuel
+keyed every 4 frames, half a puff at the puffing rate of a fire that size, ~3 Hz), the same keys
+for every state; cooling c = 20 (half fire_domain's) for taller flames. Each state is a fire bake
+of 100 frames with Record Pathlines on: every node step (a third of a frame) a group of pathlines
+is seeded at Δx/2 spacing in the burner and followed for t_max (§4.2). Build Flow Graph joins the
+three states into one graph with the paper's settings (transition costs of eqs. 9-10 over the
+pathlines' whole lifetime, blocks of B = 32, ε = (2a+b)/3, dead ends and traps pruned; the cost
+matrix is drawn like Figure 4; each bake's first t_max, its start-up from still air, left out), and
+Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than any bake), steered
+by keyed target states: calm, then gale from a quarter of the shot, then breeze from 60% on. Every
+frame the live particles are rasterized into a VDB (density, temperature, flame) that a Volume
+object with Plume's fire material plays (emission strength raised to
+scene_kit.FLOWGRAPH_FIRE_EMISSION), seen by a camera framed on the fire. Then one transition the
+walk took is shown: five synthesized frames around it above the same frames of the destination
+state played straight (transition_strip.py).
 
 Writes OUT_DIR/campfire.blend, the caches in OUT_DIR/plume_cache (the graph and the synthesized
 fire/fire_####.vdb and the walk fire/walk.npz with state 0), campfire_cost.png (the cost
