@@ -52,7 +52,7 @@ INPUTS = (("Image", 'NodeSocketColor', (0.0, 0.0, 0.0, 1.0)),
           ("Far", 'NodeSocketFloat', 1.0e9),
           ("Pixel Width", 'NodeSocketFloat', 1.0),
           ("Pixel Height", 'NodeSocketFloat', 1.0),
-          ("Outline Width", 'NodeSocketFloat', 2.0),
+          ("Outline Width", 'NodeSocketFloat', 3.0),
           ("Image Height", 'NodeSocketFloat', REFERENCE_LINES),
           ("Thinning", 'NodeSocketFloat', 0.0),
           ("Thinning Distance", 'NodeSocketFloat', 5.0))

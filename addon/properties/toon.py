@@ -117,7 +117,7 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
     outline_color: _color("Outline Colour", (0.0, 0.0, 0.0, 1.0),
                           "Silhouette colour of the outline pixels (§2.2: e.g. black)")
     outline_width: FloatProperty(
-        name="Outline Width", default=2.0, soft_min=0.0, soft_max=8.0, precision=2,
+        name="Outline Width", default=3.0, soft_min=0.0, soft_max=8.0, precision=2,
         subtype='PIXEL',
         description="Weight of the outline in pixels of a 1080-line picture. The line keeps its "
                     "weight relative to the picture: twice as many pixels at 4K, half at 540 "
