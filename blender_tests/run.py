@@ -55,6 +55,7 @@ SUBSET = [
     "test_bake.py",            # solver: bake, Volume sequence, VDB grids, render, free, resume
     "test_streak_surfaces.py",  # streak surfaces: streak bake, Build Surfaces, render is sheets
     "test_toon_smoke.py",      # toon smoke: Build Toon Smoke, render's outline = _native's
+    "test_toon_outline_width.py",  # toon outline width scales with the render, soft edges
     "test_flowgraph_fire.py",  # flow-graph fire: 2 states, Flow Graph, Synthesize Fire, render
     "test_flames.py",          # structural flames: Bake Flames, grids, spines, lights, render
     "test_flame_presets.py",   # flames' look per Blender's own view transform, presets, stops
