@@ -289,6 +289,17 @@ def fire_domain(name, box, location, resolution, frames, nodes_per_frame, lifeti
     return dom
 
 
+def fire_states(states, box, location, resolution, frames, nodes_per_frame, lifetime, cooling):
+    """One fire_domain per (name, vorticity confinement ε) of `states`, all on the same box with
+    cooling c = `cooling`: the states of a flow graph, in name order. Returns the domains."""
+    domains = []
+    for name, vorticity in states:
+        dom = fire_domain(name, box, location, resolution, frames, nodes_per_frame, lifetime)
+        dom.plume.domain.vorticity, dom.plume.domain.cooling_rate = vorticity, cooling
+        domains.append(dom)
+    return domains
+
+
 def fuel_source(name, add_primitive, location, dims, fuel=1.0, temperature=1.0):
     """A mesh primitive (e.g. bpy.ops.mesh.primitive_cylinder_add; 2 m across by default) scaled
     to `dims` (m) at `location`, made a Plume Source of fuel (the fuel-injection region Ω where

@@ -90,12 +90,8 @@ def setup(scene, frames):
     # Sway across the edge only: velocity along it would bunch the flames into blobs.
     scene_kit.flicker(fuel, speed=0.3, fuel_share=0.4, frames=BAKE_FRAMES, key_every=4,
                       along_x=False)
-    domains = []
-    for name, vorticity in STATES:
-        dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, BAKE_FRAMES, NODES_PER_FRAME,
-                                    LIFETIME)
-        dom.plume.domain.vorticity, dom.plume.domain.cooling_rate = vorticity, COOLING
-        domains.append(dom)
+    domains = scene_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
+                                    NODES_PER_FRAME, LIFETIME, COOLING)
     g = domains[0].plume.domain.flowgraph
     g.fire_source = blade(frames)
     g.transition_hold = 'LIFETIME'

@@ -61,12 +61,8 @@ def setup(scene):
     burner = scene_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
                                    BURNER_SIZE)
     scene_kit.flicker(burner, speed=0.4, fuel_share=0.4, frames=BAKE_FRAMES, key_every=PUFF_KEYS)
-    domains = []
-    for name, vorticity in STATES:
-        dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, BAKE_FRAMES, NODES_PER_FRAME,
-                                    LIFETIME)
-        dom.plume.domain.vorticity, dom.plume.domain.cooling_rate = vorticity, COOLING
-        domains.append(dom)
+    domains = scene_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
+                                    NODES_PER_FRAME, LIFETIME, COOLING)
     # Framed on the flames: 1.15 m away, the lowest 0.63 m of the box in view (the flames
     # reach 0.4-0.5 m; the smoke above them fades out).
     scene_kit.camera(scene, (0.0, -1.15, 0.32), lens=35.0, target=(0.0, 0.0, 0.3))
@@ -74,11 +70,7 @@ def setup(scene):
 
 
 def main():
-    _scene, keeper, _fire, _out = scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
-                                                              TARGETS, SHOW, GRAPH)
-    flowgraph = scene_kit.addon_module("flowgraph")
-    folder = scene_kit.addon_module("snapshot").cache_folder_of(keeper)
-    transition_strip.walk_summary(flowgraph.read_walk(flowgraph.walk_path(folder)), TAG)
+    transition_strip.example_with_walk(TAG, USAGE, DEFAULT_FRAMES, setup, TARGETS, SHOW, GRAPH)
 
 
 if __name__ == "__main__":

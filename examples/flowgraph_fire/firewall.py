@@ -74,23 +74,15 @@ def setup(scene):
                                       (x1 - x0, *WALL_SIZE[1:]))
         scene_kit.flicker(piece, speed=SWAY, fuel_share=0.4, frames=BAKE_FRAMES,
                           key_every=PUFF_KEYS, seed=n, along_x=False)
-    domains = []
-    for name, vorticity in STATES:
-        dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, BAKE_FRAMES, NODES_PER_FRAME,
-                                    LIFETIME)
-        dom.plume.domain.vorticity, dom.plume.domain.cooling_rate = vorticity, COOLING
-        domains.append(dom)
+    domains = scene_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
+                                    NODES_PER_FRAME, LIFETIME, COOLING)
     # Square to the wall, slightly above it: the 1.6 m line spans about 85% of the width.
     scene_kit.camera(scene, (0.0, -1.85, 0.45), lens=35.0, target=(0.0, 0.0, 0.33))
     return domains
 
 
 def main():
-    _scene, keeper, _fire, _out = scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
-                                                              TARGETS, SHOW, GRAPH)
-    flowgraph = scene_kit.addon_module("flowgraph")
-    folder = scene_kit.addon_module("snapshot").cache_folder_of(keeper)
-    transition_strip.walk_summary(flowgraph.read_walk(flowgraph.walk_path(folder)), TAG)
+    transition_strip.example_with_walk(TAG, USAGE, DEFAULT_FRAMES, setup, TARGETS, SHOW, GRAPH)
 
 
 if __name__ == "__main__":

@@ -80,6 +80,15 @@ def walk_summary(walk, tag):
     return len(jumps)
 
 
+def example_with_walk(tag, usage, default_frames, setup, targets, show, graph):
+    """scene_kit.flowgraph_example, then the transitions its walk took (walk_summary)."""
+    _scene, keeper, _fire, _out = scene_kit.flowgraph_example(tag, usage, default_frames, setup,
+                                                              targets, show, graph)
+    flowgraph = scene_kit.addon_module("flowgraph")
+    folder = scene_kit.addon_module("snapshot").cache_folder_of(keeper)
+    walk_summary(flowgraph.read_walk(flowgraph.walk_path(folder)), tag)
+
+
 def transition_strip(scene, keeper, fire, out_dir, tag, frames_shown=5):
     """Picks a transition of the synthesis kept with `keeper` (its fire/walk.npz), renders the
     synthesized frames around it and the straight run beneath them, and writes
