@@ -331,6 +331,33 @@ class SheetTurnTest(unittest.TestCase):
         np.testing.assert_allclose(points_of(self.ob)[self.K, :3] - self.cps[0][self.K, :3], MOVE,
                                    atol=1e-5)
 
+    def test_motion_blur_subframes_blend_the_frames(self):
+        """Between frames (Cycles' motion blur sets the scene at sub-frames of its shutter) the
+        sheet is the blend of the two cached frames around it, with its edit turned along, and
+        writing it there is not taken for a hand edit."""
+        scn = bpy.context.scene
+        scn.frame_set(1, subframe=0.25)
+        np.testing.assert_allclose(points_of(self.ob), 0.75 * self.cps[0] + 0.25 * self.cps[1],
+                                   atol=1e-6)
+        scn.frame_set(2)
+        self.assertNotIn(EDITS, self.ob)  # the blended points were not captured as an edit
+        np.testing.assert_allclose(points_of(self.ob), self.cps[1], atol=1e-6)
+        scn.frame_set(1)
+        sp = self.ob.data.splines[0]
+        x, y, z, w = sp.points[self.K].co
+        sp.points[self.K].co = (x + MOVE[0], y + MOVE[1], z + MOVE[2], w)
+        scn.frame_set(1, subframe=0.5)
+        want = 0.5 * self.cps[0] + 0.5 * self.cps[1]
+        want[self.K, :3] += 0.5 * MOVE + 0.5 * (self.TURN @ MOVE)
+        np.testing.assert_allclose(points_of(self.ob), want, atol=1e-5)
+        scn.frame_set(1)  # back on the frame: the edit once, not folded in twice
+        np.testing.assert_allclose(points_of(self.ob)[self.K, :3] - self.cps[0][self.K, :3], MOVE,
+                                   atol=1e-5)
+        scn.frame_set(5, subframe=0.5)  # past the cache: its last frame, unblended
+        want = self.cps[1].copy()
+        want[self.K, :3] += self.TURN @ MOVE
+        np.testing.assert_allclose(points_of(self.ob), want, atol=1e-5)
+
     def test_world_space_edits_of_older_files_are_migrated(self):
         world = np.zeros((self.NU * self.NV, 3))
         world[self.K] = MOVE

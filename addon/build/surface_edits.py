@@ -33,6 +33,10 @@ EDITS_KEY = "plume_surface_edits_local"
 LEGACY_EDITS_KEY = "plume_surface_edits"
 #: Index into the control-point cache of the frame whose points were last written.
 FRAME_KEY = "plume_surface_frame"
+#: Share (0..1) of the way to the next cached frame the written points are at: motion blur
+#: evaluates the scene between frames (Cycles' shutter), and the handler writes the sheet there
+#: as the blend of the two frames around it. Absent: on the frame itself.
+SUBFRAME_KEY = "plume_surface_subframe"
 #: Set by "Bake to keyframes": the points are F-curves now, the handler leaves them alone.
 BAKED_KEY = "plume_surface_baked"
 #: A point moved by more than this (world units) since it was written counts as edited.
@@ -141,6 +145,19 @@ def current_points(ob):
     return co.reshape(-1, 4)
 
 
+def blended_points(ob, cps, index, t):
+    """edited_points between cache frames `index` and `index` + 1, a share t of the way (the
+    last frame stays put)."""
+    co = edited_points(ob, cps, index)
+    if t <= 0.0 or index + 1 >= len(cps):
+        return co
+    return (1.0 - t) * co + t * edited_points(ob, cps, index + 1)
+
+
+def written_subframe(ob):
+    return float(ob.get(SUBFRAME_KEY, 0.0))
+
+
 def written_index(ob, cps, frame_index=None):
     """The cache index the points belong to (FRAME_KEY, else `frame_index`), clamped."""
     i = ob.get(FRAME_KEY, frame_index)
@@ -155,21 +172,30 @@ def capture(ob, cps, frame_index=None):
     if i is None:
         return 0
     cur = current_points(ob)[:, :3]
-    moved = np.abs(cur - edited_points(ob, cps, i)[:, :3]).max(axis=1) > TOLERANCE
+    written = blended_points(ob, cps, i, written_subframe(ob))[:, :3]
+    moved = np.abs(cur - written).max(axis=1) > TOLERANCE
     if not moved.any():
         return 0
     off = offsets(ob)
     off = np.zeros((len(cur), 3)) if off is None else off.copy()
-    world = cur[moved].astype(np.float64) - cps[i][moved, :3]
+    # An edit counts from the frame the points were written for, moved back to the frame itself
+    # when they were written between frames (by motion blur's sub-frames).
+    world = (cur[moved] - written[moved]).astype(np.float64) + (
+        edited_points(ob, cps, i)[moved, :3] - cps[i][moved, :3])
     off[moved] = np.einsum("nkj,nj->nk", local_frames(ob, cps, i)[moved], world)
     set_offsets(ob, off)
     return int(moved.sum())
 
 
-def write(ob, cps, index):
-    """Writes cache(index) + offsets into the spline and remembers `index`."""
-    ob.data.splines[0].points.foreach_set("co", edited_points(ob, cps, index).ravel())
+def write(ob, cps, index, t=0.0):
+    """Writes cache(index) + offsets, blended a share t towards the next frame's, into the
+    spline and remembers `index` and t."""
+    ob.data.splines[0].points.foreach_set("co", blended_points(ob, cps, index, t).ravel())
     ob[FRAME_KEY] = int(index)
+    if t > 0.0:
+        ob[SUBFRAME_KEY] = float(t)
+    elif SUBFRAME_KEY in ob:
+        del ob[SUBFRAME_KEY]
     ob.data.update_tag()
 
 

@@ -73,7 +73,8 @@ def cache_of(ob):
 def update_object(ob, frame):
     """Sets the surface's control points of `frame` (clamped to the baked range) plus the hand
     edits (surface_edits.py), capturing first any edit made since the last update. True if set.
-    Baked surfaces (keyframes) and surfaces in edit mode are left alone."""
+    A frame between two frames (motion blur's sub-frames) blends the two around it. Baked
+    surfaces (keyframes) and surfaces in edit mode are left alone."""
     if ob.get(surface_edits.BAKED_KEY) or ob.mode == 'EDIT':
         return False
     hit = cache_of(ob)
@@ -81,8 +82,9 @@ def update_object(ob, frame):
         return False
     frame_start, cps = hit
     surface_edits.capture(ob, cps)
-    i = min(max(frame - frame_start, 0), len(cps) - 1)
-    surface_edits.write(ob, cps, i)
+    at = min(max(frame - frame_start, 0.0), float(len(cps) - 1))
+    i = int(math.floor(at))
+    surface_edits.write(ob, cps, i, at - i)
     return True
 
 
@@ -97,7 +99,8 @@ def update_all(frame):
 
 @bpy.app.handlers.persistent
 def frame_change_pre(scene, *_args):
-    update_all(scene.frame_current)
+    # frame_current + frame_subframe: Cycles' motion blur sets the scene between frames.
+    update_all(scene.frame_current + scene.frame_subframe)
 
 
 def register():
