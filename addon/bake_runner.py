@@ -25,8 +25,8 @@ from .point_sources import domain_point_sources, emits_during
 #: small grids, every ~5 s at 128³ (75 MB in ~0.25 s), never more than ~5% of the bake time
 #: (at 10, 128³ bakes spent 10-15% of their time in checkpoints).
 CHECKPOINT_COST_RATIO = 20.0
-from .settings import (BakeError, to_native_params, to_native_source,
-                       validate_pathlines, validate_python_side, validate_source,
+from .native_params import to_native_params, to_native_source
+from .settings import (BakeError, validate_pathlines, validate_python_side, validate_source,
                        validate_streaks)
 
 

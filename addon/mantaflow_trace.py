@@ -25,7 +25,8 @@ from . import cache
 from .bake_runner import BakeResult, BakeRunner
 from .mantaflow_cache import TIME_UNITS_PER_SECOND, check_source
 from .point_sources import domain_point_sources, emits_during
-from .settings import BakeError, to_native_params, validate_python_side, validate_streaks
+from .native_params import to_native_params
+from .settings import BakeError, validate_python_side, validate_streaks
 
 
 def voxel_settings(solver, plan):

@@ -472,35 +472,3 @@ def candidate_groups(emitters, counts=None):
             next_split += _group_count(e)
     return groups
 
-
-def to_native_params(solver, native):
-    """SolverSettings -> validated ``native.SmokeParams``; ValueError (naming the setting) if bad."""
-    p = native.SmokeParams()
-    for f in dataclasses.fields(solver):
-        value = getattr(solver, f.name)
-        if f.name == "boundaries":
-            value = [getattr(native.Boundary, b) for b in value]
-        elif f.name == "advection":
-            value = getattr(native.Advection, value)
-        elif f.name == "interpolation":
-            value = getattr(native.Interpolation, value)
-        elif f.name == "trace":
-            value = getattr(native.Trace, value)
-        elif isinstance(value, list):
-            value = tuple(value)
-        setattr(p, f.name, value)
-    p.validate()
-    return p
-
-
-def to_native_source(source, native):
-    s = native.SourceSettings()
-    s.density = source.density
-    s.temperature = source.temperature
-    s.fuel = source.fuel
-    s.velocity = tuple(source.velocity)
-    s.motion_factor = source.motion_factor
-    s.fuel_noise = source.fuel_noise
-    s.fuel_noise_scale = source.fuel_noise_scale
-    s.fuel_noise_rate = source.fuel_noise_rate
-    return s

@@ -8,7 +8,8 @@ import numpy as np
 from mathutils import Vector
 
 from . import point_rim, point_sources
-from .settings import domain_grid, to_native_params
+from .native_params import to_native_params
+from .settings import domain_grid
 from .snapshot import solver_settings
 
 #: domain name -> (key of what the count depends on, (kept, placed)).

@@ -48,9 +48,9 @@ ROW_MIN_LIT = 3
 #   4.5.15 AgX        29.9 / 29.6 / 29.4   0%   3.7 / 3.9 / 3.5  0.82 / 0.70 / 0.79  0.408, 0.428
 #   5.0.1 AgX         29.9 / 29.5 / 29.5   0%   3.7 / 3.8 / 3.4  0.82 / 0.70 / 0.79  0.420, 0.429
 #   5.3.0 AgX         29.9 / 29.5 / 29.5   0%   3.6 / 3.8 / 3.4  0.82 / 0.69 / 0.79  0.414, 0.434
-# With burn rate 6, T_max 4, no Flame Vorticity or Flicker (the first defaults of issue 30): hue
+# With burn rate 6, T_max 4, no Flame Vorticity or Flicker (the first ramp-material defaults): hue
 # 30.4-37.2, lit 3.8-4.3%, flame top 0.61-0.67, outline changed 0.069-0.094. The combustion
-# defaults before issue 30 (burn rate 4, cooling 1, expansion 1, vorticity 0.2) with this
+# defaults before the colour ramp (burn rate 4, cooling 1, expansion 1, vorticity 0.2) with this
 # material, in 4.5: flame top z 1.0 (the domain's top: a tube), outline changed 0.035, 0.036
 # (sampling noise at the soft edge); with the old material (emission 40 x flame) the tube was
 # lit to the top too, hue 27.0.

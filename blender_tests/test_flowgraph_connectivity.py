@@ -54,7 +54,7 @@ BEFORE_KEPT_SHARE_MAX = 0.10
 
 
 def flicker(src, seed=7, key_every=4, speed=1.0, fuel_share=0.4):
-    """The Source's feed keyed with smooth noise (scene_kit.flicker): random horizontal velocity
+    """The Source's feed keyed with smooth noise (flowgraph_kit.flicker): random horizontal velocity
     within ±speed and fuel within ±fuel_share every key_every frames."""
     rng = random.Random(seed)
     s = src.plume.source

@@ -81,7 +81,7 @@ def key_source(src, keys):
 
 def source_cells_ijk(dom):
     """(i, j, k) of the cells the bake's Source fills (native.source_cells on its snapshot)."""
-    from plume.settings import to_native_params
+    from plume.native_params import to_native_params
     from plume.snapshot import take_snapshot
     nat = native()
     select_only(dom)

@@ -18,7 +18,7 @@ Synthesize Fire walks it for FRAMES frames (default 600 = 25 s, far longer than 
 by keyed target states: calm, then gale from a quarter of the shot, then breeze from 60% on. Every
 frame the live particles are rasterized into a VDB (density, temperature, flame) that a Volume
 object with Plume's fire material plays (emission strength raised to
-scene_kit.FLOWGRAPH_FIRE_EMISSION), seen by a camera framed on the fire. Then one transition the
+flowgraph_kit.FLOWGRAPH_FIRE_EMISSION), seen by a camera framed on the fire. Then one transition the
 walk took is shown: five synthesized frames around it above the same frames of the destination
 state played straight (transition_strip.py).
 
@@ -42,6 +42,7 @@ import bpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
+import flowgraph_kit  # noqa: E402
 import scene_kit  # noqa: E402
 import transition_strip  # noqa: E402
 
@@ -78,13 +79,13 @@ PUFF_KEYS = 4                  # frames between the feed's keys: half a puff at 
 
 
 def make_states(frames_baked):
-    burner = scene_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
+    burner = flowgraph_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
                                    BURNER_SIZE)
     # One feed for all three states: the noise keyed once.
-    scene_kit.flicker(burner, speed=1.0, fuel_share=0.4, frames=frames_baked, key_every=PUFF_KEYS)
+    flowgraph_kit.flicker(burner, speed=1.0, fuel_share=0.4, frames=frames_baked, key_every=PUFF_KEYS)
     domains = []
     for name, speed, strength in STATES:
-        dom = scene_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, frames_baked,
+        dom = flowgraph_kit.fire_domain(name, BOX, CENTRE, RESOLUTION, frames_baked,
                                     NODES_PER_FRAME, LIFETIME)
         d = dom.plume.domain
         d.wind, d.wind_strength, d.cooling_rate = (speed, 0.0, 0.0), strength, COOLING
@@ -114,7 +115,7 @@ def setup(scene):
 
 
 def main():
-    scene, keeper, fire, out_dir = scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
+    scene, keeper, fire, out_dir = flowgraph_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, setup,
                                                                TARGETS, SHOW, GRAPH)
     print(f"{TAG}: transition strip -> "
           f"{transition_strip.transition_strip(scene, keeper, fire, out_dir, TAG)}", flush=True)

@@ -14,7 +14,7 @@ instant (its pose relative to the first frame, evaluated at the node step's subf
 particles rise in world space, so the swing leaves a trail of fire in the air behind the edge, and
 the flames stand upright whatever the blade's angle. The camera is framed on the blade and its
 flames; a dim sun lights the blade's flat; the fire material's emission strength is
-scene_kit.FLOWGRAPH_FIRE_EMISSION. The walk holds the simulation's time line after each transition
+flowgraph_kit.FLOWGRAPH_FIRE_EMISSION. The walk holds the simulation's time line after each transition
 until the old particles are gone (Transition Hold = Lifetime) and drifts from the low to the high
 state halfway.
 
@@ -31,6 +31,7 @@ import bpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
+import flowgraph_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 TAG = "fire_blade"
@@ -85,12 +86,12 @@ def blade(frames):
 
 
 def setup(scene, frames):
-    fuel = scene_kit.fuel_source("BladeFuel", bpy.ops.mesh.primitive_cube_add, FUEL_AT,
+    fuel = flowgraph_kit.fuel_source("BladeFuel", bpy.ops.mesh.primitive_cube_add, FUEL_AT,
                                  FUEL_SIZE)
     # Sway across the edge only: velocity along it would bunch the flames into blobs.
-    scene_kit.flicker(fuel, speed=0.3, fuel_share=0.4, frames=BAKE_FRAMES, key_every=4,
+    flowgraph_kit.flicker(fuel, speed=0.3, fuel_share=0.4, frames=BAKE_FRAMES, key_every=4,
                       along_x=False)
-    domains = scene_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
+    domains = flowgraph_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
                                     NODES_PER_FRAME, LIFETIME, COOLING)
     g = domains[0].plume.domain.flowgraph
     g.fire_source = blade(frames)
@@ -104,7 +105,7 @@ def setup(scene, frames):
 
 def main():
     _, frames = scene_kit.parse_args(USAGE, DEFAULT_FRAMES)
-    scene_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, lambda scene: setup(scene, frames),
+    flowgraph_kit.flowgraph_example(TAG, USAGE, DEFAULT_FRAMES, lambda scene: setup(scene, frames),
                                 TARGETS, SHOW, GRAPH)
 
 

@@ -15,7 +15,7 @@ Graph joins them with the paper's settings (B = 32, ε = (2a+b)/3, dead ends and
 cost matrix like Figure 4) and Synthesize Fire walks the graph for FRAMES frames (default 300),
 keyed to start in the low state, go to the medium one at a third of the shot and to the high
 one at two thirds (§5.1). The camera is framed on the plume; the fire material's emission
-strength is scene_kit.FLOWGRAPH_FIRE_EMISSION.
+strength is flowgraph_kit.FLOWGRAPH_FIRE_EMISSION.
 
 Writes OUT_DIR/fire_plume.blend, the caches in OUT_DIR/plume_cache, fire_plume_cost.png,
 fire_plume_####.png for a few frames and fire_plume_strip.png (the manual's images); prints the
@@ -30,6 +30,7 @@ import bpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
+import flowgraph_kit  # noqa: E402
 import scene_kit  # noqa: E402
 import transition_strip  # noqa: E402
 
@@ -58,10 +59,10 @@ SHOW = (0.25, 0.5, 0.75, 0.95)  # rendered frames: low, medium, high, high
 
 
 def setup(scene):
-    burner = scene_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
+    burner = flowgraph_kit.fuel_source("Burner", bpy.ops.mesh.primitive_cylinder_add, BURNER,
                                    BURNER_SIZE)
-    scene_kit.flicker(burner, speed=0.4, fuel_share=0.4, frames=BAKE_FRAMES, key_every=PUFF_KEYS)
-    domains = scene_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
+    flowgraph_kit.flicker(burner, speed=0.4, fuel_share=0.4, frames=BAKE_FRAMES, key_every=PUFF_KEYS)
+    domains = flowgraph_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
                                     NODES_PER_FRAME, LIFETIME, COOLING)
     # Framed on the flames: 1.15 m away, the lowest 0.63 m of the box in view (the flames
     # reach 0.4-0.5 m; the smoke above them fades out).

@@ -15,7 +15,7 @@ Graph joins them with the paper's settings (B = 32, ε = (2a+b)/3, dead ends and
 cost matrix like Figure 4) and Synthesize Fire walks the graph for FRAMES frames (default 400),
 keyed to stay in the low state for the first 40% of the shot and then steered into the high one
 (§5.1). The camera looks square at the wall, which fills most of the picture's width; the
-fire material's emission strength is scene_kit.FLOWGRAPH_FIRE_EMISSION.
+fire material's emission strength is flowgraph_kit.FLOWGRAPH_FIRE_EMISSION.
 
 Writes OUT_DIR/firewall.blend, the caches in OUT_DIR/plume_cache, firewall_cost.png,
 firewall_####.png for a few frames and firewall_strip.png (the manual's images); prints the
@@ -30,6 +30,7 @@ import bpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
+import flowgraph_kit  # noqa: E402
 import scene_kit  # noqa: E402
 import transition_strip  # noqa: E402
 
@@ -69,12 +70,12 @@ def setup(scene):
     for n in range(SEGMENTS):
         x0 = max(WALL[0] - 0.5 * WALL_SIZE[0], WALL[0] - 0.5 * WALL_SIZE[0] + (n - 0.5) * spacing)
         x1 = min(WALL[0] + 0.5 * WALL_SIZE[0], x0 + 2.0 * spacing)
-        piece = scene_kit.fuel_source(f"Fuel{n:02d}", bpy.ops.mesh.primitive_cube_add,
+        piece = flowgraph_kit.fuel_source(f"Fuel{n:02d}", bpy.ops.mesh.primitive_cube_add,
                                       (0.5 * (x0 + x1), WALL[1], WALL[2]),
                                       (x1 - x0, *WALL_SIZE[1:]))
-        scene_kit.flicker(piece, speed=SWAY, fuel_share=0.4, frames=BAKE_FRAMES,
+        flowgraph_kit.flicker(piece, speed=SWAY, fuel_share=0.4, frames=BAKE_FRAMES,
                           key_every=PUFF_KEYS, seed=n, along_x=False)
-    domains = scene_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
+    domains = flowgraph_kit.fire_states(STATES, BOX, CENTRE, RESOLUTION, BAKE_FRAMES,
                                     NODES_PER_FRAME, LIFETIME, COOLING)
     # Square to the wall, slightly above it: the 1.6 m line spans about 85% of the width.
     scene_kit.camera(scene, (0.0, -1.85, 0.45), lens=35.0, target=(0.0, 0.0, 0.33))

@@ -26,6 +26,7 @@ import bpy
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import campfire  # noqa: E402
+import flowgraph_kit  # noqa: E402
 import scene_kit  # noqa: E402
 
 USAGE = ("usage: blender -b --factory-startup --python "
@@ -51,7 +52,7 @@ def synthesis_runs(keeper, runs, group_cache_mb):
         g.group_cache = group_cache_mb
         frames = g.frame_end - g.frame_start + 1
         for _ in range(runs):
-            scene_kit.synthesize_fire(keeper, g.frame_end, "speed")
+            flowgraph_kit.synthesize_fire(keeper, g.frame_end, "speed")
     finally:
         flowgraph.SynthesisRunner.run = run
     return [(r.step_seconds / frames, r.write_seconds / frames, r.group_reads / frames)

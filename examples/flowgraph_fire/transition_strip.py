@@ -1,5 +1,5 @@
 """A strip across one transition of a synthesized fire, above the same frames of a straight
-simulation (run inside Blender after scene_kit.flowgraph_example).
+simulation (run inside Blender after flowgraph_kit.flowgraph_example).
 
 The top row is the synthesis: `frames` frames centred on the frame in which the walk took a
 transition (node i of one state -> node j + 1, §4.3: the successor of the group j similar to
@@ -19,6 +19,7 @@ import os
 import bpy
 import numpy as np
 
+import flowgraph_kit
 import scene_kit
 
 
@@ -81,8 +82,8 @@ def walk_summary(walk, tag):
 
 
 def example_with_walk(tag, usage, default_frames, setup, targets, show, graph):
-    """scene_kit.flowgraph_example, then the transitions its walk took (walk_summary)."""
-    _scene, keeper, _fire, _out = scene_kit.flowgraph_example(tag, usage, default_frames, setup,
+    """flowgraph_kit.flowgraph_example, then the transitions its walk took (walk_summary)."""
+    _scene, keeper, _fire, _out = flowgraph_kit.flowgraph_example(tag, usage, default_frames, setup,
                                                               targets, show, graph)
     flowgraph = scene_kit.addon_module("flowgraph")
     folder = scene_kit.addon_module("snapshot").cache_folder_of(keeper)
