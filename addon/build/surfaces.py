@@ -232,8 +232,27 @@ def write_sheet_images(folder, index, frame_start, images):
     return cache.sheet_path(folder, index, frame_start)
 
 
+def lit_film(nt, color, location):
+    """A thin film of smoke lit by the scene: half diffuse reflection (the side facing a lamp),
+    half diffuse transmission (the light glowing through from behind). Returns its mix node."""
+    diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.location = (location[0] - 200, location[1])
+    translucent = nt.nodes.new("ShaderNodeBsdfTranslucent")
+    translucent.location = (location[0] - 200, location[1] - 150)
+    for node in (diffuse, translucent):
+        node.inputs["Color"].default_value = color
+    film = nt.nodes.new("ShaderNodeMixShader")
+    film.label = "Lit Film"
+    film.location = location
+    film.inputs["Fac"].default_value = 0.5
+    nt.links.new(diffuse.outputs[0], film.inputs[1])
+    nt.links.new(translucent.outputs[0], film.inputs[2])
+    return film
+
+
 def sheet_material(name, image_path, width, height, frame_start, frames, settings):
-    """p = d × e^(−|n·v|) (or 1 − |n·v|), Transparent mixed with Emission by p (§3.4)."""
+    """p = d × e^(−|n·v|) (or 1 − |n·v|), Transparent mixed by p with Emission (§3.4), or with
+    Lit shading with a thin lit film (lit_film)."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     compat.set_transparency(mat, 'BLEND')
@@ -303,10 +322,13 @@ def sheet_material(name, image_path, width, height, frame_start, frames, setting
 
     tr = N("ShaderNodeBsdfTransparent")
     tr.location = (100, 150)
-    em = N("ShaderNodeEmission")
-    em.location = (100, -50)
-    em.inputs["Color"].default_value = tuple(settings["color"])
-    em.inputs["Strength"].default_value = float(settings["brightness"])
+    if settings.get("shading") == 'LIT':
+        em = lit_film(nt, tuple(settings["color"]), (100, -50))
+    else:
+        em = N("ShaderNodeEmission")
+        em.location = (100, -50)
+        em.inputs["Color"].default_value = tuple(settings["color"])
+        em.inputs["Strength"].default_value = float(settings["brightness"])
     mix = N("ShaderNodeMixShader")
     mix.location = (300, 50)
     L(p, mix.inputs["Fac"])

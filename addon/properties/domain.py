@@ -274,6 +274,16 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         items=(('EXP', "e^(-|n·v|)", "p = d e^(-|n·v|), the paper's choice (§3.4)"),
                ('LINEAR', "1 - |n·v|", "p = d (1 - |n·v|), the simple attenuation of §3.4")),
         description="How the angle between normal n and view v shapes the opacity p (§3.4)")
+    sheet_shading: EnumProperty(
+        name="Shading", default='EMISSION',
+        items=(('EMISSION', "Emission",
+                "The paper's model: the sheets glow with their colour and Brightness whatever "
+                "the lights, so the smoke reads the same in any scene"),
+               ('LIT', "Lit",
+                "The sheets take their light from the scene's lamps and world, as a thin "
+                "translucent film: bright on the side facing a lamp, glowing through on the "
+                "other, casting soft shadows; Brightness is not used")),
+        description="Where the smoke sheets' light comes from (Build Surfaces again to apply)")
     sheet_color: FloatVectorProperty(
         name="Sheet Color", size=4, subtype='COLOR', default=(0.85, 0.85, 0.9, 1.0), min=0.0,
         max=1.0, description="Colour of the smoke sheets")

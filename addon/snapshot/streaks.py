@@ -20,4 +20,4 @@ def sheet_settings(d):
                             f"got {k})")
     return {"k_u": int(d.density_k_u), "k_v": int(d.density_k_v), "falloff": d.sheet_falloff,
             "color": tuple(d.sheet_color), "brightness": float(d.sheet_brightness),
-            "opacity": float(d.sheet_opacity)}
+            "opacity": float(d.sheet_opacity), "shading": d.sheet_shading}

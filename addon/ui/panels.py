@@ -237,8 +237,11 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
         sub.prop(d, "density_k_u")
         sub.prop(d, "density_k_v")
         col.prop(d, "sheet_falloff")
+        col.prop(d, "sheet_shading")
         col.prop(d, "sheet_color")
-        col.prop(d, "sheet_brightness")
+        sub = col.column()
+        sub.active = d.sheet_shading == 'EMISSION'
+        sub.prop(d, "sheet_brightness")
         col.prop(d, "sheet_opacity")
         row = col.row()
         row.enabled = not is_busy(ob)
