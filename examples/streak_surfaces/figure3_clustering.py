@@ -12,6 +12,9 @@ Source Mesh, baked and built three ways, the same frame rendered each time:
 The paper: (a) "too opaque and thick", (b) better but "unpredictable depending on the user
 skill", (c) a consistent semi-transparent look.
 
+Each surface is drawn in its own colour (SURFACE_COLORS, in build order), so the panels show how
+the streaklines were grouped: one colour in (a), four quadrants in (b), the clusters in (c).
+
 Writes OUT_DIR/figure3.blend, figure3_{a,b,c}.png and figure3_strip.png (the manual's image), and
 prints the surfaces and times of each. Needs the Plume add-on installed (README).
 """
@@ -33,6 +36,18 @@ DEFAULT_FRAMES = 120
 VERTEX_SOURCES = 16
 HAND_GROUPS = 4   # Figure 3(b): "manually selected four surfaces"
 NO_CLUSTERING = 1e9  # h0 above every h: one surface per candidate group
+#: Sheet colours of the surfaces in build order (linear RGB): well apart in hue, equally light.
+SURFACE_COLORS = ((0.85, 0.85, 0.9), (0.9, 0.35, 0.25), (0.3, 0.75, 0.35), (0.3, 0.45, 0.95),
+                  (0.9, 0.75, 0.2), (0.75, 0.3, 0.85), (0.25, 0.8, 0.85), (0.95, 0.55, 0.7))
+
+
+def tint_by_surface(surfaces):
+    """Gives each surface's sheet material the next colour of SURFACE_COLORS (the Emission
+    node's colour: the sheet colour Build Surfaces set from the domain's Sheet Color)."""
+    for i, ob in enumerate(sorted(surfaces, key=lambda o: o.name)):
+        mat = ob.active_material
+        emission = next(n for n in mat.node_tree.nodes if n.type == 'EMISSION')
+        emission.inputs["Color"].default_value = (*SURFACE_COLORS[i % len(SURFACE_COLORS)], 1.0)
 
 
 def quadrant_groups(points_obj, groups):
@@ -90,6 +105,7 @@ def main():
         surfaces = build(dom, tag, h0)
         if tag == "a" and len(surfaces) != 1 or tag == "b" and len(surfaces) != HAND_GROUPS:
             sys.exit(f"figure3 {tag}: {len(surfaces)} surfaces built")
+        tint_by_surface(surfaces)
         paths[tag] = scene_kit.render_frames(
             scene, [shown], os.path.join(out_dir, f"figure3_{tag}_%04d.png"))[0]
     bpy.ops.wm.save_mainfile()
