@@ -252,7 +252,7 @@ void SmokeSolver::applySources(float dt) {
   for (std::size_t index = 0; index < mSources.size(); ++index) {
     const Source& src = mSources[index];
     const SourceSettings& s = src.settings;
-    const bool noisy = mParams.combustion && s.fuelNoise.amount > 0.f;
+    const bool noisy = mParams.combustion && s.fuel > 0.f && s.fuelNoise.amount > 0.f;
     for (std::size_t m = 0; m < src.cells.cells.size(); ++m) {
       const std::uint32_t c = src.cells.cells[m];
       // The flicker thins the fuel in patches (1 - a n, source_noise.h).
