@@ -56,6 +56,9 @@ class SolverSettings:
     wind_strength: float = 0.0
     vorticity: float = 0.2
     density_dissipation: float = 0.0
+    turbulence: float = 2.0
+    turbulence_scale: float = 0.4
+    turbulence_rate: float = 0.5
     pressure_tolerance: float = 1e-4
     max_pressure_iterations: int = 200
     combustion: bool = False
@@ -83,6 +86,9 @@ class SourceParams:
     fuel_noise: float = 0.8
     fuel_noise_scale: float = 0.08
     fuel_noise_rate: float = 3.0
+    smoke_noise: float = 0.5
+    smoke_noise_scale: float = 0.08
+    smoke_noise_rate: float = 2.0
     #: §3.2 / Figure 10: the source's point sources emit particles (not a solver setting).
     emit_particles: bool = True
 

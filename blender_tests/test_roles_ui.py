@@ -31,7 +31,8 @@ DOMAIN_PROPS = (
     "boundary_neg_x", "boundary_pos_x", "boundary_neg_y", "boundary_pos_y", "boundary_neg_z",
     "boundary_pos_z", "volume_object")
 SOURCE_PROPS = ("density", "temperature", "fuel", "fuel_noise", "fuel_noise_scale",
-                "fuel_noise_rate", "velocity", "motion_factor", "point_sources", "candidate_group")
+                "fuel_noise_rate", "smoke_noise", "smoke_noise_scale",
+                "smoke_noise_rate", "velocity", "motion_factor", "point_sources", "candidate_group")
 
 PANELS = ("PHYSICS_PT_plume", "PHYSICS_PT_plume_settings", "PHYSICS_PT_plume_forces",
           "PHYSICS_PT_plume_advection", "PHYSICS_PT_plume_pressure", "PHYSICS_PT_plume_boundaries",

@@ -30,16 +30,22 @@ def is_gas_domain(ob):
 #: fire's default. Flame Vorticity adds more where the fuel burns, and the Source's Flicker breaks
 #: the burner's symmetry (examples/smoke/fire_vs_mantaflow.py).
 SMOKE_VORTICITY = 0.2
+#: Turbulence of a smoke domain, m/s²: enough to fold a 2 m domain's plume into sheets.
+SMOKE_TURBULENCE = 2.0
 FIRE_VORTICITY = 6.0
 
 
 def _combustion_changed(settings, context):
-    """Turning Combustion on swaps the smoke's default vorticity for the fire's (off: back),
-    unless the artist set their own."""
+    """Turning Combustion on swaps the smoke's default vorticity and turbulence for the fire's
+    (off: back), unless the artist set their own."""
     if settings.combustion and abs(settings.vorticity - SMOKE_VORTICITY) < 1e-6:
         settings.vorticity = FIRE_VORTICITY
     elif not settings.combustion and abs(settings.vorticity - FIRE_VORTICITY) < 1e-6:
         settings.vorticity = SMOKE_VORTICITY
+    if settings.combustion and abs(settings.turbulence - SMOKE_TURBULENCE) < 1e-6:
+        settings.turbulence = 0.0
+    elif not settings.combustion and settings.turbulence == 0.0:
+        settings.turbulence = SMOKE_TURBULENCE
 
 
 def _boundary(side, default='OPEN'):
@@ -117,6 +123,19 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     wind_strength: FloatProperty(
         name="Wind Strength", default=0.0, soft_min=0.0, soft_max=10.0,
         description="k_w: f_wind = k_w (u_wind - u), 1/s")
+    turbulence: FloatProperty(
+        name="Turbulence", default=SMOKE_TURBULENCE, min=0.0, soft_max=20.0, unit='ACCELERATION',
+        description="Strength of a slowly drifting swirl in the air, as a room's draughts give "
+                    "real smoke: an even plume leans, folds and curls instead of rising as a "
+                    "straight column (0: still air). "
+                    f"{SMOKE_TURBULENCE:g} for smoke, 0 once Combustion is turned on (a fire "
+                    "stirs its own air: Flame Vorticity)")
+    turbulence_scale: FloatProperty(
+        name="Turbulence Size", default=0.4, min=1e-4, soft_min=0.01, soft_max=5.0,
+        unit='LENGTH', description="Size of the turbulence's swirls")
+    turbulence_rate: FloatProperty(
+        name="Turbulence Speed", default=0.5, min=0.0, soft_max=10.0,
+        description="How many times a second the turbulence's swirls change")
     density_dissipation: FloatProperty(
         name="Dissipation", default=0.0, soft_min=0.0, soft_max=1.0,
         description="Fraction of the smoke density lost per second")
@@ -168,7 +187,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     combustion: BoolProperty(name="Combustion", default=False, update=_combustion_changed,
                              description="Burn fuel into heat and soot: the domain becomes a fire "
                                          f"simulation (Vorticity {SMOKE_VORTICITY:g} becomes "
-                                         f"{FIRE_VORTICITY:g})")
+                                         f"{FIRE_VORTICITY:g}, Turbulence {SMOKE_TURBULENCE:g} becomes 0)")
     burn_rate: FloatProperty(name="Burn Rate (r)", default=1.5, soft_min=0.0, soft_max=20.0,
                              description="r: fuel burnt per second, dF/dt = -r F (eq. 3)")
     soot_yield: FloatProperty(name="Soot Yield (k_S)", default=0.5, soft_min=0.0, soft_max=5.0,

@@ -6,6 +6,10 @@ from bpy.props import PointerProperty
 
 from ..ranges import text
 
+#: Breakup of a new Source: uneven puffs, so streak sheets and smoke fold from the start.
+SMOKE_BREAKUP = 0.5
+
+
 class PlumeSourceSettings(bpy.types.PropertyGroup):
     density: FloatProperty(name="Density", default=1.0, soft_min=0.0, soft_max=10.0,
                            description="ρ set in the source's cells each step")
@@ -24,6 +28,18 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
     fuel_noise_rate: FloatProperty(
         name="Flicker Speed", default=3.0, min=0.0, soft_max=20.0,
         description="How many times a second the flicker's patches change")
+    smoke_noise: FloatProperty(
+        name="Breakup", default=SMOKE_BREAKUP, min=0.0, max=1.0, subtype='FACTOR',
+        description="Thins the smoke and heat the source gives off in drifting patches, so the "
+                    "plume rises in uneven puffs that shear, fold and curl instead of as one "
+                    "even column (0: even smoke; 1: the patches take all of it). A source that burns "
+                    "fuel in a Combustion domain uses Flicker instead")
+    smoke_noise_scale: FloatProperty(
+        name="Breakup Size", default=0.08, min=1e-4, soft_min=0.005, soft_max=1.0, unit='LENGTH',
+        description="Size of the breakup's patches: about the width of one puff")
+    smoke_noise_rate: FloatProperty(
+        name="Breakup Speed", default=2.0, min=0.0, soft_max=20.0,
+        description="How many times a second the breakup's patches change")
     velocity: FloatVectorProperty(
         name="Initial Velocity", size=3, default=(0.0, 0.0, 0.0), subtype='VELOCITY', unit='VELOCITY',
         description="Velocity given to the air in the source's cells, m/s (smoke_surfaces.txt §3.2)")

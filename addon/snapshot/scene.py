@@ -103,6 +103,9 @@ def source_params(s):
                         fuel_noise=float(s.fuel_noise),
                         fuel_noise_scale=float(s.fuel_noise_scale),
                         fuel_noise_rate=float(s.fuel_noise_rate),
+                        smoke_noise=float(s.smoke_noise),
+                        smoke_noise_scale=float(s.smoke_noise_scale),
+                        smoke_noise_rate=float(s.smoke_noise_rate),
                         emit_particles=bool(s.emit_particles))
 
 

@@ -97,6 +97,10 @@ class PHYSICS_PT_plume_forces(PlumeDomainPanel, bpy.types.Panel):
         layout.prop(d, "vorticity")
         layout.prop(d, "wind")
         layout.prop(d, "wind_strength")
+        col = layout.column(align=True)
+        col.prop(d, "turbulence")
+        col.prop(d, "turbulence_scale", text="Size")
+        col.prop(d, "turbulence_rate", text="Speed")
         layout.prop(d, "density_dissipation")
 
 
@@ -382,6 +386,11 @@ class PHYSICS_PT_plume_source(PlumePanel, bpy.types.Panel):
         s = context.object.plume.source
         layout.prop(s, "density")
         layout.prop(s, "temperature")
+        col = layout.column(align=True)
+        col.active = s.fuel <= 0.0  # a fuel source uses Flicker (below)
+        col.prop(s, "smoke_noise")
+        col.prop(s, "smoke_noise_scale", text="Size")
+        col.prop(s, "smoke_noise_rate", text="Speed")
         layout.prop(s, "fuel")
         col = layout.column(align=True)
         col.active = s.fuel > 0.0

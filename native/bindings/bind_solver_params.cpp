@@ -122,6 +122,9 @@ void bindParams(py::module_& m) {
   field(c, "wind_strength", &SmokeParams::windStrength, "k_w: f_wind = k_w (u_wind - u), 1/s.");
   field(c, "vorticity", &SmokeParams::vorticity, "ε: vorticity confinement (Fedkiw 2001 eq. 11).");
   field(c, "density_dissipation", &SmokeParams::densityDissipation, "Fraction of ρ lost per second.");
+  field(c, "turbulence", &SmokeParams::turbulence, "A: strength of the turbulence force, m/s².");
+  field(c, "turbulence_scale", &SmokeParams::turbulenceScale, "λ: size of the turbulence's swirls, m.");
+  field(c, "turbulence_rate", &SmokeParams::turbulenceRate, "Turbulence pattern renewals per second.");
   field(c, "pressure_tolerance", &SmokeParams::pressureTolerance, "MGPCG stop at |r|/|b| below this.");
   field(c, "max_pressure_iterations", &SmokeParams::maxPressureIterations, "MGPCG iteration cap.");
   field(c, "combustion", &SmokeParams::combustion, "Burn fuel (graph_fire_synthesis eqs. 1-5).");
@@ -173,6 +176,17 @@ void bindSourceSettings(py::module_& m) {
       "fuel_noise_rate", [](const SourceSettings& s) { return s.fuelNoise.rate; },
       [](SourceSettings& s, float v) { s.fuelNoise.rate = v; },
       "Patches renewed per second (the flicker's speed).");
+  c.def_property(
+      "smoke_noise", [](const SourceSettings& s) { return s.smokeNoise.amount; },
+      [](SourceSettings& s, float v) { s.smokeNoise.amount = v; },
+      "Breakup a in [0, 1]: share of the smoke and heat its patches may take away.");
+  c.def_property(
+      "smoke_noise_scale", [](const SourceSettings& s) { return s.smokeNoise.scale; },
+      [](SourceSettings& s, float v) { s.smokeNoise.scale = v; }, "Size λ of the breakup's patches, m.");
+  c.def_property(
+      "smoke_noise_rate", [](const SourceSettings& s) { return s.smokeNoise.rate; },
+      [](SourceSettings& s, float v) { s.smokeNoise.rate = v; },
+      "Breakup patches renewed per second.");
   c.def("validate", &SourceSettings::validate, "Raises ValueError naming a bad setting.");
 }
 

@@ -53,6 +53,9 @@ const std::vector<SettingRange>& smokeSettingRanges() {
       {"wind_strength", 0.0, 1e4},
       {"vorticity", 0.0, 1e3},
       {"density_dissipation", 0.0, 1e3},
+      {"turbulence", 0.0, 1e3},
+      {"turbulence_scale", 1e-4, 1e3},
+      {"turbulence_rate", 0.0, 1e3},
       {"pressure_tolerance", 1e-8, 0.5},
       {"max_pressure_iterations", 1, 100000},
       {"burn_rate", 0.0, 1e4},
@@ -97,6 +100,9 @@ void SmokeParams::validate() const {
   checkRange("wind_strength", windStrength);
   checkRange("vorticity", vorticity);
   checkRange("density_dissipation", densityDissipation);
+  checkRange("turbulence", turbulence);
+  checkRange("turbulence_scale", turbulenceScale);
+  checkRange("turbulence_rate", turbulenceRate);
   checkRange("pressure_tolerance", pressureTolerance);
   checkCount("max_pressure_iterations", maxPressureIterations);
   checkRange("burn_rate", burnRate);

@@ -79,6 +79,10 @@ struct SmokeParams {
   float windStrength = 0.f;   ///< k_w: f_wind = k_w (u_wind - u), 1/s
   float vorticity = 0.2f;     ///< ε: vorticity confinement strength (Fedkiw 2001 eq. 11)
   float densityDissipation = 0.f;  ///< fraction of density lost per second
+  /// Turbulence (turbulence.h): A, m/s², strength of the drifting random force; 0 = off.
+  float turbulence = 0.f;
+  float turbulenceScale = 0.3f;  ///< λ, metres: size of the turbulence's swirls
+  float turbulenceRate = 0.5f;   ///< times a second the turbulence's pattern renews
 
   // --- Pressure projection ---
   float pressureTolerance = 1e-4f;  ///< relative residual |r|/|b| at which MGPCG stops

@@ -6,6 +6,7 @@
 #include "solver/forces.h"
 #include "solver/inflow.h"
 #include "solver/mass_conservation.h"
+#include "solver/turbulence.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +16,9 @@
 
 namespace plume {
 namespace {
+
+/// Breakup's noise streams start here, apart from Flicker's (one stream per source index).
+constexpr std::uint64_t kBreakupStream = 0x5EED0000ull;
 
 void checkFinite(const char* name, float v) {
   if (!std::isfinite(v))
@@ -29,6 +33,19 @@ void checkCells(const CellSet& set, std::size_t count, const char* what) {
     if (c >= count) throw std::invalid_argument(std::string(what) + ": cell index out of range");
 }
 
+/// `name` in [0, 1], `name`_scale in (0, 1000] m, `name`_rate in [0, 1000] per second.
+void checkNoise(const std::string& name, const SourceNoise& noise) {
+  if (!(noise.amount >= 0.f && noise.amount <= 1.f))
+    throw std::invalid_argument(name + " must be in [0, 1] (got " + std::to_string(noise.amount) +
+                                ")");
+  if (!(noise.scale > 0.f && noise.scale <= 1e3f))
+    throw std::invalid_argument(name + "_scale must be in (0, 1000] m (got " +
+                                std::to_string(noise.scale) + ")");
+  if (!(noise.rate >= 0.f && noise.rate <= 1e3f))
+    throw std::invalid_argument(name + "_rate must be in [0, 1000] per second (got " +
+                                std::to_string(noise.rate) + ")");
+}
+
 }  // namespace
 
 void SourceSettings::validate() const {
@@ -37,15 +54,8 @@ void SourceSettings::validate() const {
   checkFinite("fuel", fuel);
   checkFinite("motion_factor", motionFactor);
   for (int a = 0; a < 3; ++a) checkFinite("velocity", velocity[a]);
-  if (!(fuelNoise.amount >= 0.f && fuelNoise.amount <= 1.f))
-    throw std::invalid_argument("fuel_noise must be in [0, 1] (got " +
-                                std::to_string(fuelNoise.amount) + ")");
-  if (!(fuelNoise.scale > 0.f && fuelNoise.scale <= 1e3f))
-    throw std::invalid_argument("fuel_noise_scale must be in (0, 1000] m (got " +
-                                std::to_string(fuelNoise.scale) + ")");
-  if (!(fuelNoise.rate >= 0.f && fuelNoise.rate <= 1e3f))
-    throw std::invalid_argument("fuel_noise_rate must be in [0, 1000] per second (got " +
-                                std::to_string(fuelNoise.rate) + ")");
+  checkNoise("fuel_noise", fuelNoise);
+  checkNoise("smoke_noise", smokeNoise);
   if (density < 0.f)
     throw std::invalid_argument("density must be >= 0 (got " + std::to_string(density) + ")");
   if (fuel < 0.f)
@@ -252,22 +262,30 @@ void SmokeSolver::applySources(float dt) {
   for (std::size_t index = 0; index < mSources.size(); ++index) {
     const Source& src = mSources[index];
     const SourceSettings& s = src.settings;
-    const bool noisy = mParams.combustion && s.fuel > 0.f && s.fuelNoise.amount > 0.f;
+    // A source that burns flickers; one that only smokes breaks up.
+    const bool burns = mParams.combustion && s.fuel > 0.f;
+    const bool flicker = burns && s.fuelNoise.amount > 0.f;
+    const bool breakup = !burns && s.smokeNoise.amount > 0.f;
     for (std::size_t m = 0; m < src.cells.cells.size(); ++m) {
       const std::uint32_t c = src.cells.cells[m];
-      // The flicker thins the fuel in patches (1 - a n, source_noise.h).
-      float thin = 1.f;
-      if (noisy) {
+      // Flicker thins the fuel in patches and Breakup the smoke and heat (1 - a n,
+      // source_noise.h), each with its own noise stream.
+      float thinFuel = 1.f, thinSmoke = 1.f;
+      if (flicker || breakup) {
         const glm::ivec3 ijk(int(c % std::uint32_t(n.x)), int((c / std::uint32_t(n.x)) % std::uint32_t(n.y)),
                              int(c / (std::uint32_t(n.x) * std::uint32_t(n.y))));
         const glm::vec3 p = mParams.origin + (glm::vec3(ijk) + 0.5f) * mParams.cellSize;
-        thin = sourceNoiseFactor(p, mTime, s.fuelNoise, mParams.seed, index);
+        if (flicker) thinFuel = sourceNoiseFactor(p, mTime, s.fuelNoise, mParams.seed, index);
+        if (breakup)
+          thinSmoke = sourceNoiseFactor(p, mTime, s.smokeNoise, mParams.seed,
+                                        index + kBreakupStream);
       }
       // Sources keep their cells at least as dense / hot / fuelled as they are set to.
-      mDensity[c] = std::max(mDensity[c], s.density);
+      mDensity[c] = std::max(mDensity[c], thinSmoke * s.density);
       if (s.temperature != 0.f)
-        mTemperature[c] = std::max(mTemperature[c], mParams.ambientTemperature + s.temperature);
-      if (mParams.combustion) mFuel[c] = std::max(mFuel[c], thin * s.fuel);
+        mTemperature[c] =
+            std::max(mTemperature[c], mParams.ambientTemperature + thinSmoke * s.temperature);
+      if (mParams.combustion) mFuel[c] = std::max(mFuel[c], thinFuel * s.fuel);
       glm::vec3 v = s.velocity;
       if (!src.cells.velocity.empty()) v += s.motionFactor * src.cells.velocity[m];
       if (v == glm::vec3(0.f)) continue;  // a still source leaves the flow alone
@@ -287,6 +305,7 @@ void SmokeSolver::addForces(float dt) {
   const FlagGrid* types = mHasSolids ? &mCellTypes : nullptr;
   addBuoyancy(mVelocity, mDensity, mTemperature, types, mParams, dt);
   addWind(mVelocity, mWindField, types, mParams, dt);
+  addTurbulence(mVelocity, types, mParams, mTime, dt, mTurbulence);
   Confinement confinement;
   confinement.epsilon = mParams.vorticity;
   if (mParams.combustion) {

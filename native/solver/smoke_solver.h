@@ -12,6 +12,7 @@
 #include "solver/pressure.h"
 #include "solver/smoke_params.h"
 #include "solver/source_noise.h"
+#include "solver/turbulence.h"
 
 #include <atomic>
 #include <memory>
@@ -28,6 +29,8 @@ struct SourceSettings {
   glm::vec3 velocity{0.f};  ///< initial velocity, m/s (smoke_surfaces.txt §3.2)
   float motionFactor = 1.f; ///< share of the source object's own motion added to its velocity
   SourceNoise fuelNoise;    ///< flicker: patches of thinner fuel (source_noise.h)
+  /// breakup: patches of thinner smoke and heat, for a source that burns no fuel (source_noise.h)
+  SourceNoise smokeNoise;
   void validate() const;
 };
 
@@ -155,6 +158,7 @@ class SmokeSolver {
   ScalarGrid mScalarTmp[Advector::kMaxFields];  ///< advected scalars (burn: [0] is scratch)
   ScalarGrid mPressure, mRhs, mDivergenceTarget;
   VectorGrid mVorticity, mForce, mWindField;
+  TurbulenceLattice mTurbulence;  ///< scratch of addTurbulence()
   MacGrid3 mWindFaces;  ///< mWindField on the faces: the air beyond open sides (inflow.h)
   ScalarGrid mVorticityMagnitude;  ///< |ω|, scratch of vorticity confinement
   Advector mAdvector;

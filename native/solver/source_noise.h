@@ -1,8 +1,10 @@
 #pragma once
 /// \file source_noise.h
-/// Flicker of a fire source: a smooth, animated value noise that thins the fuel a source emits
-/// in patches, so it leaves the source as flickering tongues rather than one even sheet. A perfectly even source over a symmetric scene keeps the flow
-/// symmetric, and the flames rise as a mirrored "Christmas tree"; real burners are never even.
+/// Flicker of a fire source and Breakup of a smoke source: a smooth, animated value noise that
+/// thins what a source emits (fuel; smoke and heat) in patches, so it leaves the source as
+/// flickering tongues or uneven puffs rather than one even sheet. A perfectly even source over a
+/// symmetric scene keeps the flow symmetric, and the flames rise as a mirrored "Christmas tree";
+/// real burners are never even.
 /// Mantaflow's counterpart is a Flow Source's texture; EmberGen's is its emitter noise.
 
 #include <glm/glm.hpp>
