@@ -44,6 +44,7 @@ def make_domain(frames, resolution=RESOLUTION, name="Incense"):
     d.vorticity = 0.25                # ε: keeps the small curls a 50³ grid would smooth away
     d.density_dissipation = 0.5       # the smoke thins out as it mixes with the room's air
     d.wind, d.wind_strength = (0.12, 0.0, 0.0), 0.5  # a faint draught bends the column
+    d.turbulence = 0.0                # the paper's air: the draught and the stick's swirl alone
     d.boundary_neg_z = 'CLOSED'
     d.streaks = True
     d.emission_period = 1             # §3.2: one particle per point source per step
@@ -66,6 +67,7 @@ def make_source(frames, point_sources=POINT_SOURCES, vertex_sources=0):
     bpy.ops.plume.role_set(role='SOURCE')
     s = src.plume.source
     s.density, s.temperature = 1.0, 1.0
+    s.smoke_noise = 0.0  # an even tip, as the paper's
     s.velocity = (0.0, 0.0, 0.15)
     s.point_placement = 'CELLS'  # §3.2: random point sources in the one source cell
     s.point_sources = point_sources

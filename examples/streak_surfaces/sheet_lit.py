@@ -33,7 +33,7 @@ def main():
     out_dir = os.path.abspath(argv[0])
     first_streaks.SHOWN = int(argv[1]) if len(argv) > 1 else 30
     os.makedirs(out_dir, exist_ok=True)
-    dom, nets, build_s = first_streaks.shot(out_dir, 'RIM')
+    dom, nets, _turn, build_s = first_streaks.shot(out_dir, "defaults", still=False)
     scene = bpy.context.scene
     sun = bpy.data.objects.new("Low Sun", bpy.data.lights.new("Low Sun", 'SUN'))
     sun.data.energy = 4.0

@@ -37,7 +37,7 @@ def main():
     shutter = float(argv[1]) if len(argv) > 1 else 1.0
     first_streaks.SHOWN = int(argv[2]) if len(argv) > 2 else 16
     os.makedirs(out_dir, exist_ok=True)
-    dom, nets, build_s = first_streaks.shot(out_dir, 'RIM')
+    dom, nets, _turn, build_s = first_streaks.shot(out_dir, "defaults", still=False)
     print(f"{len(nets)} surfaces (nets {', '.join(nets)}); Build Surfaces {build_s:.1f} s",
           flush=True)
     scene = bpy.context.scene
