@@ -37,12 +37,13 @@ USAGE = ("usage: blender -b --factory-startup --python "
          "examples/streak_surfaces/compare_representations.py -- OUT_DIR [FRAMES]")
 DEFAULT_FRAMES = 84
 WIDTH, HEIGHT = 200, 320  # one pixel is about 3.8 mm at the smoke (1.7 m, 50 mm lens)
-#: Principled Volume density scale per grid: the volume's light equals the sheets' (measured on
-#: 512-sample renders of frame 84: 11.3 at 50³ and 11.5 at 150³ against the sheets' 11.7).
+#: Principled Volume density scale per grid: the volume's light (figure9_looks.measure) equals
+#: the sheets' on frame 84: 11.3 at 50³ (512 samples) and 11.5 at 150³ against the sheets' 11.7.
 VOLUME_DENSITY = {50: 40.0, 150: 70.0}
-#: Particle specks: 3 mm radius (1.6 px across), opacity per grid at full density (the 150³
-#: bake's 8,400 particles cover more of the picture: each is fainter for the same light), full
-#: at a carried density of 0.02 and fainter below it (the thinned smoke high up).
+#: Particle specks: 3 mm radius (1.6 px across), opacity per grid (the 150³ bake's 13,700
+#: particles, against 1,700 at 50³, overlap more: each is fainter for the same light, 12.2 and
+#: 10.7 against the sheets' 11.7), full at a carried density of 0.02 and fainter below it (the
+#: thinned smoke high up).
 PARTICLE_RADIUS = 0.003
 PARTICLE_OPACITY = {50: 0.2, 150: 0.015}
 PARTICLE_FULL_DENSITY = 0.02
@@ -86,7 +87,10 @@ def panels(out_dir, frames, resolution, point_sources, sheets_s=None):
     scene, dom, _ = bake(out_dir, frames, resolution, point_sources)
     paths = {}
     if sheets_s is None:
-        scene_kit.bake_surfaces(dom, "compare_representations")  # the bake is already done
+        # Its bake finds the cache complete and computes nothing; then Build Surfaces.
+        _, build_s, _, built = scene_kit.bake_surfaces(dom, "compare_representations")
+        print(f"compare_representations: Build Surfaces {build_s:.1f} s, {len(built)} surfaces",
+              flush=True)
         scene.frame_set(frames)
         looks.show_only(scene, {o for o in scene.objects if o.type == 'SURFACE'})
         path = os.path.join(out_dir, "surfaces_50.png")
