@@ -1,8 +1,9 @@
 """How compare_representations.py renders the alternatives of Figure 9 of smoke_surfaces.txt
-fairly: a Principled Volume whose density scale matches the sheets' brightness, particles as a
-particle artist draws them (small soft semi-transparent glowing specks, fading with the density
-they carry), each given at least the render time the sheets take, and the measure used to match
-the looks (the mean brightness of the smoke's pixels). Run inside Blender; needs the Plume add-on.
+fairly: a Principled Volume lit by the scene, particles as a particle artist draws them (small
+soft semi-transparent glowing specks, fading with the density they carry), each rendered for at
+least the time the sheets take (render_matched), and what a compositor sees in a panel
+(measure: the smoke's light, by which the looks are matched, its speckle and its edges). Run
+inside Blender; needs the Plume add-on.
 """
 
 import math
@@ -28,7 +29,7 @@ DENSITY_ATTRIBUTE = "smoke_density"
 
 def set_volume_look(volume_ob, density):
     """The Principled Volume of `volume_ob`: density scale `density`, the smoke's colour, lit
-    by the scene's sun (single scattering: Cycles' default of no volume bounces)."""
+    by the scene's sun (single scattering when the scene has no volume bounces)."""
     for slot in volume_ob.material_slots:
         for node in slot.material.node_tree.nodes:
             if node.type == 'PRINCIPLED_VOLUME':
