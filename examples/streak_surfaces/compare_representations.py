@@ -4,36 +4,54 @@
 
 (a) the density field of a 50³ bake rendered as a volume, (b) the same scene at 150³ as a volume,
 (c) the 20 streaklines' particles of the 50³ bake, (d) 100 point sources' particles at 150³,
-(e) Plume's streak surfaces from the 50³ bake (20 point sources). The scene is
-that of incense.py beside this file; every panel shows the last frame. The paper's point, which
-the strip shows: neither a finer grid nor more particles gives the thin sheet-like look the surfaces give
-from the coarse bake, at 1/27 of the fine grid's cells.
+(e) Plume's streak surfaces from the 50³ bake (20 point sources). The scene is that of
+incense.py beside this file; every panel shows the last frame through the same camera. The
+paper's point, which the strip shows: neither a finer grid nor more particles gives the thin
+sheet-like look the surfaces give from the coarse bake, at 1/27 of the fine grid's cells.
+
+The alternatives are rendered fairly (figure9_looks.py): each sends as much light from its smoke
+as the sheets do (the brightness above the background summed over the image; volumes by their
+Principled Volume density scale, particles by their opacity), the particles are soft
+semi-transparent specks about 1.6 pixels wide, and each alternative gets at least the render
+time the sheets take (its samples set from a short measuring render). Every panel renders with
+the add-on's Fast Sheet Render set-up (no light bounces: the volumes single-scatter the sun,
+as thin smoke does) under Blender's default colour management.
 
 Writes OUT_DIR/compare_50.blend and compare_150.blend (caches beside them), one PNG per panel
-and OUT_DIR/compare_strip.png, and prints each bake's time. Needs the Plume add-on installed.
+and OUT_DIR/compare_strip.png, and prints each bake's time and, per panel, its render time,
+samples and light. Needs the Plume add-on installed.
 """
 
 import os
 import sys
-import time
 
 import bpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
+import figure9_looks as looks  # noqa: E402
 import incense  # noqa: E402
 import scene_kit  # noqa: E402
 
 USAGE = ("usage: blender -b --factory-startup --python "
          "examples/streak_surfaces/compare_representations.py -- OUT_DIR [FRAMES]")
 DEFAULT_FRAMES = 84
-WIDTH, HEIGHT, SAMPLES = 200, 320, 32
-PARTICLE_RADIUS = 0.0025  # m
-VOLUME_DENSITY = 25.0     # Principled Volume density scale of panels (a), (b)
+WIDTH, HEIGHT = 200, 320  # one pixel is about 3.8 mm at the smoke (1.7 m, 50 mm lens)
+#: Principled Volume density scale per grid: the volume's light (figure9_looks.measure) equals
+#: the sheets' on frame 84: 11.3 at 50³ (512 samples) and 11.5 at 150³ against the sheets' 11.7.
+VOLUME_DENSITY = {50: 40.0, 150: 70.0}
+#: Particle specks: 3 mm radius (1.6 px across), opacity per grid (the 150³ bake's 13,700
+#: particles, against 1,700 at 50³, overlap more: each is fainter for the same light, 12.2 and
+#: 10.7 against the sheets' 11.7), full at a carried density of 0.02 and fainter below it (the
+#: thinned smoke high up).
+PARTICLE_RADIUS = 0.003
+PARTICLE_OPACITY = {50: 0.2, 150: 0.015}
+PARTICLE_FULL_DENSITY = 0.02
 
 
 def bake(out_dir, frames, resolution, point_sources):
-    """The incense scene at `resolution` with `point_sources` point sources in its tip, baked."""
+    """The incense scene at `resolution` with `point_sources` point sources in its tip, baked.
+    Returns (scene, domain, bake seconds)."""
     scene = scene_kit.new_scene()
     if resolution == incense.RESOLUTION:  # the tip is one cell: `point_sources` in that cell
         incense.make_source(frames, point_sources=point_sources)
@@ -42,89 +60,66 @@ def bake(out_dir, frames, resolution, point_sources):
     dom = incense.make_domain(frames, resolution, name=f"Incense{resolution}")
     scene_kit.camera(scene, (0.0, -1.7, 0.5), (90.0, 0.0, 0.0), lens=50.0)
     scene_kit.dark_studio(scene, world_color=(0.004, 0.004, 0.006))
-    scene_kit.cycles(scene, WIDTH, HEIGHT, SAMPLES, os.path.join(out_dir, "compare_"))
+    scene_kit.cycles(scene, WIDTH, HEIGHT, 16, os.path.join(out_dir, "compare_"))
+    bpy.ops.plume.surfaces_fast_render()  # every panel: no light bounces (sheet_render.py)
     scene.frame_start, scene.frame_end = 1, frames
     scene_kit.save_blend(out_dir, f"compare_{resolution}")
     bpy.context.view_layer.objects.active = dom
-    t0 = time.perf_counter()
-    if bpy.ops.plume.bake() != {'FINISHED'}:
-        sys.exit(f"compare_representations: the {resolution}^3 bake failed")
-    print(f"compare_representations: {resolution}^3 bake of {frames} frames "
-          f"{time.perf_counter() - t0:.1f} s", flush=True)
-    return scene, dom
+    bake_s = scene_kit.run_op(bpy.ops.plume.bake, "compare_representations",
+                              f"the {resolution}^3 bake")
+    print(f"compare_representations: {resolution}^3 bake of {frames} frames {bake_s:.1f} s",
+          flush=True)
+    return scene, dom, bake_s
 
 
-def particles_object(dom, frame):
-    """The streaklines' particles inside the domain at `frame` as a point cloud (geometry nodes
-    Mesh to Points), glowing white: the particle rendering of Figure 9 (c), (d)."""
-    from plume import _native, cache
-    folder = os.path.join(bpy.path.abspath(dom.plume.domain.cache_directory), dom.name)
-    snap = _native.read_streak_file(cache.streak_path(folder, frame))
-    inside = snap["positions"][snap["outside"] == 0]
-    mesh = bpy.data.meshes.new(f"{dom.name}_particles")
-    mesh.from_pydata([tuple(p) for p in inside], [], [])
-    ob = bpy.data.objects.new(mesh.name, mesh)
-    bpy.context.scene.collection.objects.link(ob)
-    ng = bpy.data.node_groups.new("ParticlePoints", 'GeometryNodeTree')
-    new_socket = scene_kit.compat().group_socket_new
-    new_socket(ng, 'INPUT', 'NodeSocketGeometry', "Geometry")
-    new_socket(ng, 'OUTPUT', 'NodeSocketGeometry', "Geometry")
-    n_in, n_out = ng.nodes.new("NodeGroupInput"), ng.nodes.new("NodeGroupOutput")
-    to_points = ng.nodes.new("GeometryNodeMeshToPoints")
-    to_points.inputs["Radius"].default_value = PARTICLE_RADIUS
-    set_mat = ng.nodes.new("GeometryNodeSetMaterial")
-    mat = bpy.data.materials.new("ParticleGlow")
-    mat.use_nodes = True
-    nt = mat.node_tree
-    nt.nodes.clear()
-    em = nt.nodes.new("ShaderNodeEmission")
-    em.inputs["Strength"].default_value = 1.5
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    nt.links.new(em.outputs[0], out.inputs["Surface"])
-    set_mat.inputs["Material"].default_value = mat
-    ng.links.new(n_in.outputs[0], to_points.inputs["Mesh"])
-    ng.links.new(to_points.outputs[0], set_mat.inputs["Geometry"])
-    ng.links.new(set_mat.outputs[0], n_out.inputs[0])
-    ob.modifiers.new("Points", 'NODES').node_group = ng
-    return ob
-
-
-def render_only(scene, visible, path):
-    """Renders the current frame with only `visible` (and the camera and light) shown."""
-    for ob in scene.objects:
-        if ob.type not in {'CAMERA', 'LIGHT'}:
-            ob.hide_render = ob not in visible
-    scene.render.filepath = path
-    bpy.ops.render.render(write_still=True)
+def report(label, path, seconds, samples):
+    m = looks.measure(path)
+    print(f"compare_representations: {label}: {seconds:.2f} s, {samples} samples; light "
+          f"{m['light']:.1f} (smoke pixels {100 * m['share']:.1f} %, mean {m['mean']:.3f}), "
+          f"speckle {m['speckle']:.2f}, edge {m['edge']:.2f}", flush=True)
     return path
 
 
-def panels(out_dir, frames, resolution, point_sources, with_surfaces):
-    scene, dom = bake(out_dir, frames, resolution, point_sources)
+def panels(out_dir, frames, resolution, point_sources, sheets_s=None):
+    """This grid's volume and particle panels, each rendered for at least `sheets_s` seconds,
+    and with `sheets_s` None first its sheets panel, whose time sets it. Returns (paths, the
+    sheets' seconds)."""
+    scene, dom, _ = bake(out_dir, frames, resolution, point_sources)
+    paths = {}
+    if sheets_s is None:
+        # Its bake finds the cache complete and computes nothing; then Build Surfaces.
+        _, build_s, _, built = scene_kit.bake_surfaces(dom, "compare_representations")
+        print(f"compare_representations: Build Surfaces {build_s:.1f} s, {len(built)} surfaces",
+              flush=True)
+        scene.frame_set(frames)
+        looks.show_only(scene, {o for o in scene.objects if o.type == 'SURFACE'})
+        path = os.path.join(out_dir, "surfaces_50.png")
+        samples = scene.cycles.samples
+        sheets_s, _ = looks.render(scene, path, samples)
+        paths["surfaces"] = report("(e) surfaces 50^3", path, sheets_s, samples)
     scene.frame_set(frames)
     volume = bpy.data.objects[dom.plume.domain.volume_object]
-    # The thin plume is 1-3 cells wide: a denser medium than the add-on's default makes it show.
-    for slot in volume.material_slots:
-        for node in slot.material.node_tree.nodes:
-            if node.type == 'PRINCIPLED_VOLUME':
-                node.inputs["Density"].default_value = VOLUME_DENSITY
-    paths = [render_only(scene, {volume}, os.path.join(out_dir, f"volume_{resolution}.png")),
-             render_only(scene, {particles_object(dom, frames)},
-                         os.path.join(out_dir, f"particles_{resolution}.png"))]
-    if with_surfaces:
-        scene_kit.bake_surfaces(dom, "compare_representations")  # the bake is already done
-        scene.frame_set(frames)
-        sheets = {o for o in scene.objects if o.type == 'SURFACE'}
-        paths.append(render_only(scene, sheets, os.path.join(out_dir, "surfaces_50.png")))
+    looks.set_volume_look(volume, VOLUME_DENSITY[resolution])
+    looks.show_only(scene, {volume})
+    path = os.path.join(out_dir, f"volume_{resolution}.png")
+    paths["volume"] = report(f"volume {resolution}^3", path,
+                             *looks.render_matched(scene, path, sheets_s))
+    specks = looks.particles_object(dom, frames, PARTICLE_RADIUS, PARTICLE_OPACITY[resolution],
+                                    PARTICLE_FULL_DENSITY, dom.plume.domain.sheet_brightness)
+    looks.show_only(scene, {specks})
+    path = os.path.join(out_dir, f"particles_{resolution}.png")
+    paths["particles"] = report(f"particles {resolution}^3 ({point_sources} sources)", path,
+                                *looks.render_matched(scene, path, sheets_s))
     bpy.ops.wm.save_mainfile()
-    return paths
+    return paths, sheets_s
 
 
 def main():
     out_dir, frames = scene_kit.parse_args(USAGE, DEFAULT_FRAMES)
-    vol50, part50, surf50 = panels(out_dir, frames, 50, 20, with_surfaces=True)
-    vol150, part150 = panels(out_dir, frames, 150, 100, with_surfaces=False)
-    strip = scene_kit.strip([vol50, vol150, part50, part150, surf50],
+    coarse, sheets_s = panels(out_dir, frames, 50, 20)
+    fine, _ = panels(out_dir, frames, 150, 100, sheets_s)
+    strip = scene_kit.strip([coarse["volume"], fine["volume"], coarse["particles"],
+                             fine["particles"], coarse["surfaces"]],
                             os.path.join(out_dir, "compare_strip.png"))
     print(f"compare_representations: (a) volume 50^3, (b) volume 150^3, (c) particles 50^3 "
           f"(20 sources), (d) particles 150^3 (100 sources), (e) surfaces 50^3 -> {strip}",
