@@ -84,6 +84,7 @@ def sphere_source(name, radius, location, density=1.0, temperature=0.0,
     bpy.ops.plume.role_set(role='SOURCE')
     s = src.plume.source
     s.density, s.temperature, s.velocity = density, temperature, velocity
+    s.smoke_noise = 0.0  # the paper's even sources (the figures were tuned before Breakup)
     src.hide_render = True
     return src
 

@@ -319,6 +319,7 @@ def build_plume(res, frames, cache_dir, sphere, name, config):
     d.time_scale = 1.0
     d.cache_directory = cache_dir
     d.vorticity = VORTICITY
+    d.turbulence = 0.0  # Mantaflow's air has no turbulence force: the same air in both
     d.alpha = ALPHA
     d.beta = BETA
     d.gravity = (0.0, 0.0, -9.81)
@@ -340,6 +341,7 @@ def build_plume(res, frames, cache_dir, sphere, name, config):
     s.density = SOURCE_DENSITY
     s.temperature = SOURCE_TEMPERATURE
     s.velocity = (0.0, 0.0, 0.0)
+    s.smoke_noise = 0.0  # an even source, as Mantaflow's
     if dom.plume.role != 'DOMAIN' or sphere.plume.role != 'SOURCE':
         raise CompareError("plume.role_set did not set the domain/source roles")
     return dom

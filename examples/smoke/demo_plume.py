@@ -67,6 +67,7 @@ def make_domain(frames, resolution):
     d.advection = 'BFECC'
     d.interpolation = 'MONOTONIC_CUBIC'
     d.vorticity = 0.4
+    d.turbulence = 0.0  # the sway below moves this plume (tuned before Turbulence)
     d.alpha = 0.0  # density is passive: the heat lifts the smoke
     d.beta = 1.5
     d.boundary_neg_z = 'CLOSED'
@@ -82,6 +83,7 @@ def make_source(frames):
     bpy.ops.plume.role_set(role='SOURCE')
     s = src.plume.source
     s.density, s.temperature = 1.0, 2.0
+    s.smoke_noise = 0.0
     src.hide_render = True
     # Sway the source slowly from side to side: the plume gets a wavy, less symmetric body (and
     # the bake exercises moving sources: their motion is added to the air they emit).

@@ -40,6 +40,7 @@ def make_domain(frames):
     d = dom.plume.domain
     d.alpha, d.beta = 0.0, 0.4
     d.vorticity = 0.2
+    d.turbulence = 0.0  # still air: the sphere alone breaks the plume
     d.density_dissipation = 0.2
     d.boundary_neg_z = 'CLOSED'
     d.streaks = True
@@ -59,6 +60,7 @@ def make_source():
     bpy.ops.plume.role_set(role='SOURCE')
     s = src.plume.source
     s.density, s.temperature = 1.0, 1.0
+    s.smoke_noise = 0.0
     s.velocity = (0.0, 0.0, 0.3)
     src.hide_render = True
     rng = random.Random(10)

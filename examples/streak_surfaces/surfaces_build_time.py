@@ -29,10 +29,12 @@ def scene(out_dir, count):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.25, location=(0.0, 0.0, 0.35))
     bpy.ops.plume.role_set(role='SOURCE')
     bpy.context.active_object.plume.source.point_placement = 'CELLS'  # count set by the cap
+    bpy.context.active_object.plume.source.smoke_noise = 0.0
     dom = scene_kit.domain_cube("Domain", 2.0, (0.0, 0.0, 1.0), 40, FRAMES)
     d = dom.plume.domain
     d.cache_directory = os.path.join(out_dir, f"cache_{count}") + "/"
     d.streaks = True
+    d.turbulence = 0.0  # the scene its times were measured on (before Turbulence)
     d.max_streaklines = count
     scene_kit.select([dom], dom)
     return dom

@@ -48,6 +48,7 @@ def make_scene(frames):
     for side in ("neg_x", "pos_x", "neg_y", "pos_y", "pos_z"):  # walls and the ceiling
         setattr(d, "boundary_" + side, 'CLOSED')
     d.vorticity = 0.3
+    d.turbulence = 0.0  # the paper's still air (tuned before Turbulence)
     toon_kit.puffs(d.toon, 8, sizes=(0.15, 0.3), densities=(0.05, 0.6),
                            death_density=0.05, depth_threshold=0.12)
     return dom

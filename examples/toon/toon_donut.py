@@ -44,6 +44,7 @@ def make_scene(frames):
     d.alpha = d.beta = 0.0           # no buoyancy: the puffs move only as they were pushed
     d.boundary_neg_z = 'OPEN'        # no floor
     d.vorticity = 0.3
+    d.turbulence = 0.0  # the paper's still air (tuned before Turbulence)
     t = d.toon
     toon_kit.puffs(t, 60, sizes=(0.08, 0.2), densities=(0.03, 0.4), death_density=0.03,
                            depth_threshold=0.1)

@@ -52,6 +52,7 @@ def make_scene(frames):
     d.cooling_rate = 8.0             # c: the hot burst cools fast ...
     d.conductivity = 0.04            # κ (m²/s): ... then loses its heat to the air around it
     d.vorticity = 0.3
+    d.turbulence = 0.0  # the paper's still air (tuned before Turbulence)
     t = d.toon
     toon_kit.puffs(t, 80, sizes=(0.08, 0.2), densities=(0.03, 0.4), death_density=0.05,
                            depth_threshold=0.1)

@@ -47,6 +47,7 @@ def make_scene(frames):
     dom = scene_kit.domain_cube("Stencils", 1.2, CENTRE, RESOLUTION, frames)
     d = dom.plume.domain
     d.vorticity = 0.3
+    d.turbulence = 0.0  # the paper's still air (tuned before Turbulence)
     t = d.toon
     toon_kit.puffs(t, 15, sizes=(0.1, 0.24), densities=(0.05, 0.5), death_density=0.04,
                    depth_threshold=0.1, birth_spacing=1.0)
