@@ -31,6 +31,10 @@ def apply_fast_cycles(scene, samples=FAST_SAMPLES, transparent_bounces=TRANSPARE
     for name in _NO_BOUNCES:
         setattr(c, name, 0)
     c.transparent_max_bounces = transparent_bounces
+    # No Russian roulette through the layers: Cycles ends some paths early once their throughput
+    # is low (deep in a fold), which speckles a sheet render at a few samples; with every
+    # transparent bounce kept, only the edges need the samples.
+    c.min_transparent_bounces = transparent_bounces
     c.caustics_reflective = c.caustics_refractive = False
 
 

@@ -9,10 +9,11 @@ x in [-0.5, 0.5] (u) and z in [0, 1] (v), so u and v are linear in x and z; it i
 about z and seen by an orthographic camera along +y, so n·v = cos θ on every pixel and screen x
 = (u − 0.5)·cos θ. Emission colour white, brightness 1, opacity 1, black world: the pixel's
 linear value is p itself (Transparent lets the black through, Emission adds p). The scene uses
-the add-on's Fast Sheet Render set-up (8 samples, no light bounces: plume.surfaces_fast_render),
-so the equation is checked on the picture that set-up gives; three sheets stacked in front of one
-another must composite as layers do, 1 − (1 − p)³, which they only do when every layer is reached
-(transparent bounces) and nothing but emission and transparency shades them.
+the add-on's Fast Sheet Render set-up (16 samples, no light bounces: plume.surfaces_fast_render),
+so the equation is checked on the picture that set-up gives; three (and 24) sheets stacked in front
+of one another must composite as layers do, 1 − (1 − p)^k, which they only do when every layer is
+reached (transparent bounces, none ended early by Russian roulette) and nothing but emission and
+transparency shades them.
 
 Run: blender_tests/run.py --blender {3.4,4.5,5.0} test_sheet_shading.py
 """
@@ -172,6 +173,13 @@ class SheetShadingTest(unittest.TestCase):
 
     def test_stacked_sheets_composite_as_layers(self):
         self.check('EXPONENTIAL', 0, 1, layers=3)
+
+    def test_deep_folds_composite_without_speckle(self):
+        # 24 layers, as where default sheets fold: Cycles' Russian roulette would end some paths
+        # deep in the stack (their throughput falls to (1 - p)^k) and speckle the picture at
+        # Fast Sheet Render's few samples; with every transparent bounce kept, each pixel is
+        # exactly 1 - (1 - p)^24.
+        self.check('EXPONENTIAL', 0, 1, layers=24)
 
     def test_linear_contour(self):
         self.check('LINEAR', 60, 1)
