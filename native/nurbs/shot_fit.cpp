@@ -111,8 +111,9 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
   // particles are sparse (gaps of many cells early in a shot: a control point that lands mid-gap
   // at one count lands beside a particle at the next), so the next kNearScanCounts counts are
   // tried before the largest: a sphere source's 256 streaklines over 60 frames with Fast Velocity
-  // miss ν at the 38 found (3.01 cells) and at 113 (3.16) but meet it at 40 (2.87), a cubic net,
-  // where trying 38 and 113 alone dropped the whole sheet to order 2 (113 x 256 flat facets).
+  // missed a ν of 3 cells on every frame at the 38 found (3.01 cells) and at 113 (3.16) but met
+  // it at 40 (2.87), where trying 38 and 113 alone dropped the whole sheet to order 2 (113 x 256
+  // flat facets); with ν of the frame (its particles 13 cells apart early on) 38 meets it.
   // Where no count of order 4 or 3 meets the tolerances, the particle net at the first order
   // (control points on the particles, ν = 0, the sheet C²) instead of order 2 (the same control
   // points drawn as flat facets).
