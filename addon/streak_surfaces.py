@@ -20,7 +20,8 @@ velocities) swings metres away from the smoke, so an artist moving a control poi
 something far off. The fit (native nurbs/shot_fit.h) goes through the particles of fit_mask(),
 keeps each within FIT_TOLERANCE_CELLS of the sheet and every control point within
 NET_TOLERANCE_CELLS of it and NEAR_TOLERANCE_CELLS of a particle, with the smallest net that
-does so on every frame (fixed for the shot, as Blender's net is). Where the streaklines leave
+does so on every frame (fixed for the shot, as Blender's net is), or, where the particles
+scatter too much for any, the cubic net whose control points are the particles. Where the streaklines leave
 the simulated box through an open side the sheet ends: no smoke is simulated past it (density 0,
 as the tracer gives those particles).
 """
@@ -47,10 +48,13 @@ FIT_TOLERANCE_CELLS = 0.5
 #: curl; with ε this keeps control points within about 3 cells of the particles.
 NET_TOLERANCE_CELLS = 1.5
 #: ν in cells: no control point is farther than this from the nearest particle the frame's sheet
-#: goes through (a control point an artist grabs sits among the particles it shapes).
-#: Where a cubic net of at most one control point per particle cannot (a plume's top scattering
-#: late in its shot), the net drops to order 2 along the streaklines, whose control points are
-#: the particles.
+#: goes through (a control point an artist grabs sits among the particles it shapes), or than
+#: half the largest gap between consecutive particles of a streakline on frames where they are
+#: farther apart (a fast source early in its shot). Where no net of order 4 or 3 keeps to ε, δ
+#: and ν (a plume's top scattering late in its shot), the control points along the streaklines
+#: are the particles themselves and the sheet stays cubic (C², no facets in a close-up), cutting
+#: the corners of the zig-zags by |Δ²p|/6 (native nurbs/shot_fit.h: the particle net); across
+#: them likewise where that keeps the sheet within ν of every particle, else order 2.
 NEAR_TOLERANCE_CELLS = 3.0
 
 
@@ -132,6 +136,10 @@ class SurfaceAnimation:
     surfaces: list  # per frame: a surface dict (control points, orders, particle parameters)
     max_residual: np.ndarray  # per frame: largest particle-to-sheet distance (an upper bound)
     net_deviation: np.ndarray  # per frame: largest control point-to-sheet distance
+    #: The control points along the streaklines are the particles (the cubic particle net where
+    #: they scatter), and across them the rows are the lines' curves (NEAR_TOLERANCE_CELLS).
+    particle_net_u: bool = False
+    particle_net_v: bool = False
 
 
 def streak_manifest(folder, domain_name):
@@ -335,7 +343,9 @@ def surface_animation(native, frames, plan, cell_size, tolerance_cells=FIT_TOLER
                   keep=keep[n]) for n in range(len(frames))]
     return SurfaceAnimation(particles=particles, control_points=cps, surfaces=dicts,
                             max_residual=np.asarray(shot["max_residual"]),
-                            net_deviation=np.asarray(shot["net_deviation"]), **head)
+                            net_deviation=np.asarray(shot["net_deviation"]),
+                            particle_net_u=bool(shot["particle_net_u"]),
+                            particle_net_v=bool(shot["particle_net_v"]), **head)
 
 
 def dense_density(native, path, resolution):

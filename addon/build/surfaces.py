@@ -10,7 +10,7 @@ import time
 import bpy
 import numpy as np
 
-from . import frame_handlers, surface_edits
+from . import frame_handlers, sheet_detail, surface_edits
 from .. import blender_compat as compat
 from ..snapshot import blend_relative
 
@@ -18,17 +18,24 @@ from ..snapshot import blend_relative
 CACHE_KEY = "plume_surface_cache"
 DOMAIN_KEY = "plume_surface_domain"
 MATERIAL = "Plume Smoke Sheet"
+#: Samples per control point without a scene camera to size them by (sheet_detail.py).
 RESOLUTION_U, RESOLUTION_V = 2, 4
 
 
 def resolution_u(order_u):
-    """Blender's samples per control point along the streaklines. An order-2 net (one control
-    point per particle where the streaklines scatter: streak_surfaces.NEAR_TOLERANCE_CELLS) is
-    straight between its control points, and with 1 sample per point Blender samples exactly at
-    them (step (n - 1) / (n - 1)): the drawn sheet is the fitted one, through every particle. With
-    2, the samples fall between the particles and cut the corners of every zig-zag, and the
-    sheet renders as bright creased outlines instead of smoke."""
+    """Blender's samples per control point along the streaklines without a camera. An order-2 net
+    (one control point per particle where the streaklines scatter too much for a smooth sheet:
+    streak_surfaces.NEAR_TOLERANCE_CELLS) is straight between its control points, and with 1
+    sample per point Blender samples exactly at them (step (n - 1) / (n - 1)): the drawn sheet is
+    the fitted one, through every particle. With 2, the samples fall between the particles and
+    cut the corners of every zig-zag, and the sheet renders as bright creased outlines instead of
+    smoke."""
     return 1 if order_u <= 2 else RESOLUTION_U
+
+
+def default_resolutions(order_u, order_v):
+    """(resolution_u, resolution_v) without a camera."""
+    return resolution_u(order_u), (1 if order_v <= 2 else RESOLUTION_V)
 
 # path -> (mtime, frame_start, control points (frames, n, 4) float32)
 _loaded = {}
@@ -88,19 +95,35 @@ def update_object(ob, frame):
     return True
 
 
-def update_all(frame):
+def update_detail(ob, scene):
+    """Sets the surface's tessellation from the scene's camera (sheet_detail.py), for the
+    control points it has now; not in edit mode (the artist's own settings while editing)."""
+    if ob.type != 'SURFACE' or not ob.data.splines or ob.mode == 'EDIT':
+        return False
+    return sheet_detail.update(ob, scene, default_resolutions)
+
+
+def update_all(frame, scene=None):
+    """Every Plume surface to `frame`, then its tessellation to the camera of `scene` (the
+    context's when None); last_update_seconds holds the time each surface took."""
+    scene = scene if scene is not None else bpy.context.scene
     del last_update_seconds[:]
     for ob in bpy.data.objects:
         if CACHE_KEY in ob:
             t0 = time.perf_counter()
-            if update_object(ob, frame):
+            moved = update_object(ob, frame)
+            if moved or ob.get(surface_edits.BAKED_KEY):
+                update_detail(ob, scene)
+            if moved:
                 last_update_seconds.append(time.perf_counter() - t0)
 
 
 @bpy.app.handlers.persistent
 def frame_change_pre(scene, *_args):
-    # frame_current + frame_subframe: Cycles' motion blur sets the scene between frames.
-    update_all(scene.frame_current + scene.frame_subframe)
+    # frame_current + frame_subframe: Cycles' motion blur sets the scene between frames. The
+    # camera is where the last evaluation left it: a camera moving between frames sizes the
+    # sheet's tessellation from its previous pose.
+    update_all(scene.frame_current + scene.frame_subframe, scene)
 
 
 def register():
@@ -193,7 +216,8 @@ def build_surfaces(context, domain, folder, frame_start, anims, sheets, settings
             ob[surface_edits.FRAME_KEY] = frame
             sp.order_u, sp.order_v = anim.order_u, anim.order_v
             sp.use_endpoint_u = sp.use_endpoint_v = True
-            sp.resolution_u, sp.resolution_v = resolution_u(anim.order_u), RESOLUTION_V
+            sp.resolution_u, sp.resolution_v = default_resolutions(anim.order_u, anim.order_v)
+            update_detail(ob, scene)
             ob[CACHE_KEY] = blend_relative(cache.surface_path(folder, i))
             _control_points(cache.surface_path(folder, i))  # loaded now, not on the first frame
             ob[DOMAIN_KEY] = domain.name

@@ -114,7 +114,7 @@ void bindNurbsFit(py::module_& m) {
       "fit_streak_shot",
       [](const FloatArrayC& points, const KeepArray& keep, double tolerance, double netTolerance,
          double particleTolerance, int orderU, int orderV, double smoothing, double exponentU,
-         double exponentV, int nu, int nv) {
+         double exponentV, int nu, int nv, bool particleNetU, bool particleNetV) {
         const std::vector<StreakGrid> frames = shotFrom(points, keep);
         ShotFitParams p;
         p.fit.orderU = orderU;
@@ -135,6 +135,8 @@ void bindNurbsFit(py::module_& m) {
             size.nv = nv;
             size.orderU = orderU;
             size.orderV = orderV;
+            size.particleNetU = particleNetU;
+            size.particleNetV = particleNetV;
           } else {
             size = chooseNetSize(frames, p);
           }
@@ -160,6 +162,8 @@ void bindNurbsFit(py::module_& m) {
         d["nv"] = s0.nv;
         d["order_u"] = s0.orderU;
         d["order_v"] = s0.orderV;
+        d["particle_net_u"] = size.particleNetU;
+        d["particle_net_v"] = size.particleNetV;
         d["control_points"] = cps;
         d["params_u"] = paramsU;
         d["params_v"] = paramsV;
@@ -173,16 +177,19 @@ void bindNurbsFit(py::module_& m) {
       py::arg("order_v") = 4, py::arg("smoothing") = SurfaceFitParams{}.smoothing,
       py::arg("exponent_u") = SurfaceFitParams{}.exponentU,
       py::arg("exponent_v") = SurfaceFitParams{}.exponentV, py::arg("nu") = 0, py::arg("nv") = 0,
+      py::arg("particle_net_u") = false, py::arg("particle_net_v") = false,
       "§3.3 for a whole shot: points (frames, lines, particles, 3) float32 and keep (frames, "
       "lines, particles), the particles each frame's sheet goes through (as fit_surface). Chooses "
-      "the smallest control net nu x nv (fixed for the shot, as Blender's net is; the order "
-      "across the lines may drop to 2 for crumpled clusters, and along them for scattered "
-      "lines, then one control point per particle) that keeps every kept particle "
+      "the smallest control net nu x nv (fixed for the shot, as Blender's net is; for crumpled "
+      "clusters across the lines, and for scattered lines along them, the order may drop to 3, "
+      "then the particle net: the control points are the particles, or the lines' curves, at "
+      "the first order, with the sheet within `particle_tolerance` of them (particle_net_u / "
+      "particle_net_v True), then order 2) that keeps every kept particle "
       "within `tolerance` (world units) of every frame's sheet, every control point within "
       "`net_tolerance` of the sheet at its Greville abscissae and within `particle_tolerance` "
-      "of the nearest kept particle — or uses nu, nv, order_u, order_v "
-      "when nu and nv are > 0 — and fits every frame with it. Returns dict(nu, nv, order_u, "
-      "order_v, control_points float32 (frames, nv*nu, 4) in Blender's flat order, params_u / "
+      "of the nearest kept particle — or uses nu, nv, order_u, order_v, particle_net_u, "
+      "particle_net_v when nu and nv are > 0 — and fits every frame with it. Returns dict(nu, nv, order_u, "
+      "order_v, particle_net_u, particle_net_v, control_points float32 (frames, nv*nu, 4) in Blender's flat order, params_u / "
       "params_v: per frame the particles' parameters (NaN where not kept), max_residual, "
       "net_deviation, net_to_particles (distance from the farthest control point to its nearest "
       "kept particle): float64 (frames,)). ValueError on bad input.");

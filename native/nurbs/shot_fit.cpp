@@ -43,6 +43,23 @@ int smallestCount(int lo, int hi, const std::function<bool(int)>& good) {
   return hi;
 }
 
+/// ν of a frame: params.particleTolerance, or half the largest gap between consecutive kept
+/// particles of a streakline when that is larger (early in a shot the particles of a fast
+/// source are many cells apart, and a control point on the sheet between two of them cannot be
+/// within 3 cells of either).
+double frameNearTolerance(const StreakGrid& g, double particleTolerance) {
+  double gap = 0.0;
+  for (int b = 0; b < g.lines; ++b) {
+    int last = -1;
+    for (int a = 0; a < g.particles; ++a) {
+      if (!g.kept(b, a)) continue;
+      if (last >= 0) gap = std::max(gap, double(glm::length(g.at(b, a) - g.at(b, last))));
+      last = a;
+    }
+  }
+  return std::max(particleTolerance, 0.5 * gap);
+}
+
 /// Counts above the one bisected on ε and δ that are tried for ν before the largest count (each
 /// try fits every frame's streaklines once).
 constexpr int kNearScanCounts = 8;
@@ -70,7 +87,11 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
   // Each frame's kept particles, bucketed once for ν.
   std::vector<NearParticles> near;
   near.reserve(frames.size());
-  for (const StreakGrid& g : frames) near.push_back(keptParticles(g));
+  std::vector<double> nearTolerance;
+  for (const StreakGrid& g : frames) {
+    near.push_back(keptParticles(g));
+    nearTolerance.push_back(frameNearTolerance(g, params.particleTolerance));
+  }
   // The counts are bisected on ε and δ, which tighten as the count grows; ν need not (more
   // control points on sparse particles may sit farther from them), so it is checked at the
   // count found and the few above it, and the largest count is the fallback.
@@ -80,20 +101,29 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
     return everyFrame(frames.size(), [&](std::size_t n) {
       const CurveFitQuality q = curveFitQuality(frames[n], nu, fit, checkNear ? &near[n] : nullptr);
       return q.maxResidual <= params.tolerance && q.netDeviation <= params.netTolerance &&
-             (!checkNear || q.netToParticles <= params.particleTolerance);
+             (!checkNear || q.netToParticles <= nearTolerance[n]);
     });
   };
   // The count at the current order along u, 0 when no count meets the three tolerances. Orders
-  // below the first are tried only where the largest count meets them; order 2 with one control
-  // point per particle always does (its control points are the particles), so it is the last.
+  // below the first are tried only where the largest count meets them; the particle net needs
+  // none (its control points are the particles), so it is the last.
   // ν can miss at the count found and at the largest by a fraction of a cell where a frame's
   // particles are sparse (gaps of many cells early in a shot: a control point that lands mid-gap
   // at one count lands beside a particle at the next), so the next kNearScanCounts counts are
   // tried before the largest: a sphere source's 256 streaklines over 60 frames with Fast Velocity
-  // miss ν at the 38 found (3.01 cells) and at 113 (3.16) but meet it at 40 (2.87), a cubic net,
-  // where trying 38 and 113 alone dropped the whole sheet to order 2 (113 x 256 flat facets).
+  // missed a ν of 3 cells on every frame at the 38 found (3.01 cells) and at 113 (3.16) but met
+  // it at 40 (2.87), where trying 38 and 113 alone dropped the whole sheet to order 2 (113 x 256
+  // flat facets); with ν of the frame (its particles 13 cells apart early on) 38 meets it.
+  // Where no count of order 4 or 3 meets the tolerances, the particle net at the first order
+  // (control points on the particles, ν = 0, the sheet C²) instead of order 2 (the same control
+  // points drawn as flat facets).
   const int firstU = std::min(params.fit.orderU, maxU);
   auto countU = [&]() {
+    if (fit.orderU <= kMinBlenderOrder && firstU > kMinBlenderOrder) {
+      fit.orderU = firstU;
+      fit.particleNetU = true;
+      return maxU;
+    }
     const bool last = fit.orderU <= kMinBlenderOrder;
     if (fit.orderU < firstU && !last && !fitsU(maxU, true)) return 0;
     const int nu =
@@ -107,6 +137,7 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
   for (fit.orderU = firstU;; --fit.orderU)
     if ((size.nu = countU()) > 0) break;
   size.orderU = fit.orderU;
+  size.particleNetU = fit.particleNetU;
   // The lines' curves do not depend on nv or the order across: fitted once per frame.
   std::vector<LineCurves> curves(frames.size());
   parallelFor(0, int(frames.size()), [&](int n) {
@@ -116,17 +147,41 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
     return everyFrame(frames.size(), [&](std::size_t n) {
       const SurfaceFit f = fitAcross(frames[n], curves[n], nv, fit);
       return f.maxResidual <= params.tolerance && f.netDeviation <= params.netTolerance &&
-             (!checkNear || netToParticles(f.surface, near[n]) <= params.particleTolerance);
+             (!checkNear || netToParticles(f.surface, near[n]) <= nearTolerance[n]);
     });
   };
   // Across the streaklines: the highest order whose interpolating sheet keeps to the
   // tolerances, then the fewest control points with it.
-  for (fit.orderV = std::min(params.fit.orderV, maxV); fit.orderV > kMinBlenderOrder; --fit.orderV)
+  const int firstV = std::min(params.fit.orderV, maxV);
+  for (fit.orderV = firstV; fit.orderV > kMinBlenderOrder; --fit.orderV)
     if (fitsV(maxV, true)) break;
+  // Before order 2 across, the particle net across (rows = the lines' curves, so ν holds as it
+  // does for them), where every frame has all maxV lines (a line with no kept particle has no
+  // curve to be a row) and its sheet keeps every kept particle and control point within ν.
+  // Unlike the particles along a streakline, which sample one curve (a zig-zag along it is the
+  // tracer's scatter, which the particle net along u smooths at any size), neighbouring lines in
+  // the greedy order that zig-zag are a folded sheet: cutting through the folds by more than ν
+  // would hide them, and order 2 keeps them.
+  if (fit.orderV <= kMinBlenderOrder && firstV > kMinBlenderOrder) {
+    SurfaceFitParams onLines = fit;
+    onLines.orderV = firstV;
+    onLines.particleNetV = true;
+    const bool fits = everyFrame(frames.size(), [&](std::size_t n) {
+      if (int(curves[n].lines.size()) != maxV) return false;
+      const SurfaceFit f = fitAcross(frames[n], curves[n], maxV, onLines);
+      return f.maxResidual <= nearTolerance[n] && f.netDeviation <= nearTolerance[n];
+    });
+    if (fits) fit = onLines;
+  }
   size.orderV = fit.orderV;
-  size.nv = smallestCount(std::max(std::min(fit.orderV, maxV), 2), maxV,
-                          [&](int n) { return fitsV(n, false); });
-  if (size.nv < maxV && !fitsV(size.nv, true)) size.nv = maxV;
+  size.particleNetV = fit.particleNetV;
+  if (fit.particleNetV) {
+    size.nv = maxV;
+  } else {
+    size.nv = smallestCount(std::max(std::min(fit.orderV, maxV), 2), maxV,
+                            [&](int n) { return fitsV(n, false); });
+    if (size.nv < maxV && !fitsV(size.nv, true)) size.nv = maxV;
+  }
   const std::vector<SurfaceFit> fits = fitShot(frames, size, params.fit);
   for (const SurfaceFit& f : fits) {
     size.maxResidual = std::max(size.maxResidual, f.maxResidual);
@@ -141,6 +196,8 @@ std::vector<SurfaceFit> fitShot(const std::vector<StreakGrid>& frames, const Net
   SurfaceFitParams fit = params;
   fit.orderU = size.orderU;
   fit.orderV = size.orderV;
+  fit.particleNetU = size.particleNetU;
+  fit.particleNetV = size.particleNetV;
   fit.validate();
   checkFrames(frames);
   std::vector<SurfaceFit> out(frames.size());

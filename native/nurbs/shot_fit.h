@@ -23,7 +23,10 @@ struct ShotFitParams {
   double netTolerance = 0.04;
   /// ν: largest distance allowed between a control point and the nearest kept particle of its
   /// frame, world units (the add-on passes 3 cells): the control point an artist grabs sits among
-  /// the particles it shapes, even where they are too sparse for δ to say so.
+  /// the particles it shapes, even where they are too sparse for δ to say so. On a frame whose
+  /// streaklines have consecutive kept particles farther apart than 2ν (a fast source early in
+  /// its shot), half that largest gap instead: a control point on the sheet between two such
+  /// particles cannot be nearer either.
   double particleTolerance = 0.06;
 
   /// Throws std::invalid_argument: fit.validate(), the three tolerances finite and > 0.
@@ -36,6 +39,8 @@ struct NetSize {
   int nv = 2;
   int orderU = 2;  ///< the order used along the streaklines (at most fit.orderU)
   int orderV = 2;  ///< the order used across the streaklines (at most fit.orderV)
+  bool particleNetU = false;  ///< SurfaceFitParams::particleNetU: the control points are the particles
+  bool particleNetV = false;  ///< SurfaceFitParams::particleNetV: the rows are the lines' curves
   double maxResidual = 0.0;     ///< max over frames of SurfaceFit::maxResidual
   double netDeviation = 0.0;    ///< max over frames of SurfaceFit::netDeviation
   double netToParticles = 0.0;  ///< max over frames of SurfaceFit::netToParticles
@@ -44,18 +49,24 @@ struct NetSize {
 /// Counts for a shot of frames (all with the same particles and lines; the kept ones may
 /// change): along u the smallest nu in [min(order_u, P), P] (P = particles, at least 2) for
 /// which every frame's streakline curves pass within ε of their particles and have their
-/// control points within δ of the curve and within ν of a particle (curveFitQuality()), by
+/// control points within δ of the curve and within ν of a particle (curveFitQuality(); ν of
+/// the frame, see ShotFitParams::particleTolerance), by
 /// bisection on ε and δ, then the first of that count and the 8 above it that meets ν too (ν
 /// is not monotone in the count: a control point may land mid-gap between sparse particles at
 /// one count and beside one at the next), else P; then, with that nu, the smallest nv in
 /// [min(order_v, L), L] (L = lines, at least 2) for which every frame's surface does (fitSurface(), netToParticles()). Where the lines
 /// scatter along u (the top of a plume late in its shot: consecutive particles many cells apart,
-/// zig-zagging) even P control points at order_u miss, and the order along them drops (3, then
-/// 2): at nu = P those interpolate every particle at its slot's Greville abscissa
-/// (slotsInterpolated()), and at order 2 every control point is a particle. Where the lines are
-/// too crumpled across (a smooth sheet through them swings beyond δ even when it interpolates
-/// them: the greedy order of many streaklines zig-zags), the order across them drops likewise
-/// (4, 3, then 2, whose control points are the lines' own curves) before nv is chosen. Where
+/// zig-zagging) even P control points at order_u miss, and the order along them drops to 3: at
+/// nu = P that interpolates every particle at its slot's Greville abscissa (slotsInterpolated()).
+/// Where that misses too, the particle net (SurfaceFitParams::particleNetU) at order_u: every
+/// control point is a particle (ν = 0) and the sheet stays C² (no facets in a close-up, Figure
+/// 7), cutting the corners of the zig-zags by |Δ²p|/6 (ε and δ give way there; order 2 drew the
+/// same control points as flat facets through the particles). Where the lines are too crumpled
+/// across (a smooth sheet through them swings beyond δ even when it interpolates them: the
+/// greedy order of many streaklines zig-zags), the order across them drops likewise (4, 3, then
+/// the particle net across, whose rows are the lines' own curves, where its sheet stays within ν
+/// of every kept particle, then 2: zig-zagging neighbours are a folded sheet, not scatter) before
+/// nv is chosen. Where
 /// even the largest count misses, the largest is used; NetSize says what it gives. Frames are
 /// fitted in parallel; the result does not depend on the thread count.
 NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams& params);

@@ -72,7 +72,10 @@ LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params)
   const KnotDomain dom = drawnDomain(nu, c.order);
   // One control point per slot at a low order: every line interpolated at the same Greville
   // abscissae (Schoenberg-Whitney holds there, so no penalty is needed), one factorisation.
-  const bool slots = slotsInterpolated(g, nu, params);
+  // The particle net uses the same slots and Greville abscissae, without solving for the
+  // control points: the fitter only evaluates the curve there.
+  const bool onParticles = particleNetU(g, nu, params);
+  const bool slots = onParticles || slotsInterpolated(g, nu, params);
   std::unique_ptr<CurveFitter> slotFit;
   if (slots) slotFit = std::make_unique<CurveFitter>(interpolationParameters(nu, c.order, true),
                                                      nu, c.order, true, /*smoothing=*/0.0);
@@ -107,7 +110,10 @@ LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params)
     }
     const CurveFitter& fit = slots ? *slotFit : *own;
     glm::dvec3* row = c.controlPoints.data() + std::size_t(r) * std::size_t(nu);
-    fit.fit(data.data(), 1, row, 1);
+    if (onParticles)
+      std::copy(data.begin(), data.end(), row);
+    else
+      fit.fit(data.data(), 1, row, 1);
     CurveFitQuality& q = c.quality[std::size_t(r)];
     for (std::size_t i = 0; i < kept.size(); ++i) {
       const std::size_t k = std::size_t(rowOf[i]);
@@ -119,8 +125,12 @@ LineCurves fitLines(const StreakGrid& g, int nu, const SurfaceFitParams& params)
   return c;
 }
 
+bool particleNetU(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
+  return params.particleNetU && nu == g.particles && nu >= 2;
+}
+
 bool slotsInterpolated(const StreakGrid& g, int nu, const SurfaceFitParams& params) {
-  return nu == g.particles && nu >= 2 && std::min(params.orderU, nu) <= 3;
+  return !params.particleNetU && nu == g.particles && nu >= 2 && std::min(params.orderU, nu) <= 3;
 }
 
 NearParticles keptParticles(const StreakGrid& g) {
@@ -204,6 +214,7 @@ SurfaceFit fitAcross(const StreakGrid& g, const LineCurves& curves, int nv,
   // (coincident lines merged), penalised least squares.
   const int rows = int(curves.lines.size());
   const bool interpolate = rows == nv;
+  const bool onLines = interpolate && params.particleNetV;
   std::vector<double> tv;
   if (interpolate) {
     tv = interpolationParameters(nv, s.orderV, true);
@@ -222,7 +233,10 @@ SurfaceFit fitAcross(const StreakGrid& g, const LineCurves& curves, int nv,
   // Step 2: one fit across the lines per column u of their control points.
   const CurveFitter fv(tv, nv, s.orderV, true, interpolate ? 0.0 : params.smoothing);
   std::vector<glm::dvec3> net(std::size_t(nu) * std::size_t(nv));
-  parallelFor(0, nu, [&](int u) { fv.fit(curves.controlPoints.data() + u, nu, net.data() + u, nu); });
+  if (onLines)  // the particle net across: the lines' curves are the rows of the net
+    net = curves.controlPoints;
+  else
+    parallelFor(0, nu, [&](int u) { fv.fit(curves.controlPoints.data() + u, nu, net.data() + u, nu); });
   s.controlPoints.resize(net.size());
   for (std::size_t n = 0; n < net.size(); ++n) s.controlPoints[n] = glm::vec4(glm::vec3(net[n]), 1.f);
 

@@ -26,6 +26,17 @@ struct SurfaceFitParams {
   double exponentU = 0.5;
   /// α across the streaklines.
   double exponentV = 0.5;
+  /// The particle net along u: with one control point per particle slot (nu = particles) the
+  /// control points are the particles themselves (slots not kept hold the nearest kept particle
+  /// of the line, as in slotsInterpolated()), drawn at orderU, and particle a sits at the
+  /// Greville abscissa ḡ_a of its control point. The sheet is then as smooth as orderU allows
+  /// (C² when cubic) and cuts the corners of a zig-zag (|c_a − C(ḡ_a)| = |Δ²p_a|/6 on uniform
+  /// cubic knots) instead of passing through every particle: chooseNetSize()'s last resort
+  /// along u, instead of order 2.
+  bool particleNetU = false;
+  /// The particle net across: with nv = the lines that have kept particles, the control points
+  /// are the lines' own curves (their u control points), line b at the Greville abscissa ḡ_b.
+  bool particleNetV = false;
 
   /// Throws std::invalid_argument: orders in [2, 6], smoothing and exponents in [0, 1].
   void validate() const;
@@ -86,6 +97,10 @@ struct SurfaceFit {
 /// gives equal control points (constant along it). Lines with no kept particle take no part.
 /// nu, nv >= 2. Throws std::invalid_argument on bad input.
 SurfaceFit fitSurface(const StreakGrid& grid, int nu, int nv, const SurfaceFitParams& params);
+
+/// True when fitSurface() makes each streakline's control points its particles
+/// (params.particleNetU with nu = particles >= 2).
+bool particleNetU(const StreakGrid& grid, int nu, const SurfaceFitParams& params);
 
 /// True when fitSurface() interpolates each streakline with one control point per particle slot
 /// at the slots' Greville abscissae (order along u of 2 or 3, nu = particles >= 2) instead of
