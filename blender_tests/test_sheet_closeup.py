@@ -5,13 +5,13 @@ every default (a 2 m domain at 40³, a UV sphere of radius 0.25 m as the Source,
 baked and built through the operators; a camera at 1920 × 1080 0.6 m from the largest sheet at
 frame 60 where it flares out near the source (a fixed pose), and the frame set again (the
 frame handler sizes the tessellation for the camera). Without rendering, from the evaluated mesh of every sheet:
-- along the streaklines every sheet is cubic (the fit keeps order 4 where the particles allow
-  it, here everywhere);
+- along and across the streaklines every sheet is cubic (the fit keeps order 4 where the
+  particles allow it, here everywhere);
 - projected to the 1920 × 1080 image, no tessellation edge with an end in the picture is longer
   than sheet_detail.PIXELS_PER_EDGE (8 px), or than the vertex cap (sheet_detail.MAX_VERTICES)
   allows where it binds, by more than EDGE_RATIO_MAX;
-- the turn between consecutive tessellated edges along u, where all three vertices are in the
-  picture, stays below TURN_DEG_MAX (a facet shows as a sharp turn at a control point);
+- the turn between consecutive tessellated edges along u is printed (see below why it is not
+  bounded);
 - a sheet's tessellation stays within the cap.
 With an orthographic camera of the same width at the sheet the edges keep the same bound;
 without a camera the resolutions are the defaults. The handler's time per surface is printed.
@@ -42,11 +42,12 @@ from sheet_closeup import (DISTANCE, FRAMES, closeup_camera, newcomer_scene,  # 
 #: points say. Measured 0.83-0.97 (orthographic) and 0.79-1.09 (perspective), the same in 3.4.1,
 #: 4.2, 4.5 and 5.0; the add-on before (order 2, one sample per control point) gave 38-83.
 EDGE_RATIO_MAX = 1.2
-#: Largest turn between consecutive edges along u, degrees. Measured 0.54-0.96 on the cubic
-#: sheets (8-14 px edges where the sheets curl out of the rim); a facet
-#: turns by the angle between the legs of the net at a control point: 11.1 on the order-2 sheets
-#: of the add-on before.
-TURN_DEG_MAX = 2.0
+#: The largest turn between consecutive edges along u is printed, not bounded: on the laminar
+#: sheets of the defaults before Turbulence it was 0.54-0.96° (an order-2 facet turned 11.1°),
+#: but the stirred sheets of today's defaults curl for real, down to radii of a few edges (up to
+#: 65° between 20 px edges, on cubic sheets whose edges keep to the bound): a turn no longer tells
+#: a facet from the smoke's own shape. Facets are excluded by the orders (test_sheets_are_cubic)
+#: and the edges' length.
 
 
 def closeup_figures(scene, pts):
@@ -107,11 +108,15 @@ class SheetCloseupTest(unittest.TestCase):
         print(f"  {len(orders)} sheets, orders u x v {orders}")
         self.assertTrue(orders)
         self.assertEqual({u for u, _ in orders}, {4})
+        # Across too, where a sheet has the 4 lines a cubic needs (the rows are the lines' curves
+        # where a cubic through them would swing off).
+        nets = [o.data.splines[0].point_count_v for o in surfaces()]
+        self.assertEqual({v for (_, v), n in zip(orders, nets) if n >= 4}, {4})
 
     def check_closeup(self, label):
         from plume.build import sheet_detail, surfaces as build
         scene = bpy.context.scene
-        worst_ratio = worst_turn = 0.0
+        worst_ratio = 0.0
         seen = 0
         for ob in surfaces():
             pts = tessellation(ob)
@@ -125,12 +130,11 @@ class SheetCloseupTest(unittest.TestCase):
                   f"vertices, cut by {cut:.2f} for the cap), {n} in the picture: longest edge "
                   f"{edge:.2f} px ({ratio:.2f} of the bound), largest turn along u {turn:.3f} deg")
             if n:
-                worst_ratio, worst_turn = max(worst_ratio, ratio), max(worst_turn, turn)
+                worst_ratio = max(worst_ratio, ratio)
                 seen += n
         ms = [1000 * s for s in build.last_update_seconds]
         print(f"  {label}: handler {', '.join(f'{t:.2f}' for t in ms)} ms per surface")
         self.assertLessEqual(worst_ratio, EDGE_RATIO_MAX)
-        self.assertLessEqual(worst_turn, TURN_DEG_MAX)
         self.assertGreater(seen, 1000)  # the close-up shows the sheets, finely
 
     def test_closeup_has_no_facets(self):

@@ -6,7 +6,7 @@ smooth as the camera comes close, where a volume or particles break up).
 
 The newcomer's scene of first_streaks.py with every default (a 2 m domain at 40³, a UV sphere of
 radius 0.25 m as the Source, 60 frames): Bake, Build Surfaces, then a camera 0.6 m from the
-largest sheet at frame 60 where it flares out of the rim near the source (CAMERA_LOCATION: the
+largest sheet at frame 60 where it flares out of the rim above the source (closeup_target: the
 frame spans about 0.43 m, nine cells of the grid), Fast Sheet Render at 1920 x 1080, rendered
 twice from the same build:
 - fixed: at the resolution used without a camera (2 samples per control point along the
@@ -19,6 +19,7 @@ had no camera sizing: only the fixed render is made then). blender_tests/test_sh
 asserts what the camera render shows, on the same scene and camera.
 """
 
+import math
 import os
 import sys
 import time
@@ -33,12 +34,13 @@ USAGE = ("usage: blender -b --factory-startup --python "
          "examples/streak_surfaces/sheet_closeup.py -- OUT_DIR [BEFORE_PNG]")
 FRAMES = 60
 WIDTH, HEIGHT = 1920, 1080
-#: The close-up, fixed so that add-ons whose fits differ see the same smoke from the same place:
-#: 0.6 m from the largest sheet (Domain_surface_1) of the bake at frame 60, where it flares out of
-#: the rim near the source, 40° off its normal (the frame spans about 0.43 m, nine cells).
-CAMERA_LOCATION = (0.2472, 0.3675, 0.2147)
-CAMERA_TARGET = (-0.1825, -0.0226, 0.3668)
+#: The close-up: DISTANCE from the control point of the largest sheet (most control points) at
+#: frame 60 nearest TARGET_HEIGHT, where the sheets flare out of the rim above the source, seen
+#: from outside the plume, VIEW_TURN_DEG around the vertical off the line from the plume's axis
+#: (the frame spans about 0.43 m, nine cells).
 DISTANCE = 0.6      # m, from the camera to its target
+TARGET_HEIGHT = 0.75  # m
+VIEW_TURN_DEG = 40.0
 #: The manual's part of each render: left, top, width, height in pixels from the image's top
 #: left (the second sheet's outline, where it curls out of the rim), halved to 320 x 360.
 CROP = (1120, 0, 640, 720)
@@ -79,13 +81,28 @@ def tessellation(ob):
     return (co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]).reshape(nu, nv, 3)
 
 
+def closeup_target():
+    """(target, camera location) of the close-up on the current frame's sheets."""
+    import numpy as np
+    from mathutils import Matrix, Vector
+    sheet = max(surfaces(), key=lambda o: len(o.data.splines[0].points))
+    co = np.array([tuple(p.co)[:3] for p in sheet.data.splines[0].points])
+    co = co @ np.array(sheet.matrix_world)[:3, :3].T + np.array(sheet.matrix_world)[:3, 3]
+    target = Vector(co[np.argmin(np.abs(co[:, 2] - TARGET_HEIGHT))])
+    out = Vector((target.x, target.y, 0.0))
+    out = out.normalized() if out.length > 1e-6 else Vector((0.0, -1.0, 0.0))
+    out = Matrix.Rotation(math.radians(VIEW_TURN_DEG), 3, 'Z') @ out
+    return target, target + DISTANCE * out
+
+
 def closeup_camera(scene):
-    """The WIDTH x HEIGHT close-up camera, made the scene camera."""
+    """The WIDTH x HEIGHT close-up camera on the current frame's sheets, made the scene camera."""
     from mathutils import Vector
     cam = bpy.data.objects.new("Closeup", bpy.data.cameras.new("Closeup"))
     scene.collection.objects.link(cam)
-    cam.location = CAMERA_LOCATION
-    view = Vector(CAMERA_TARGET) - Vector(CAMERA_LOCATION)
+    target, location = closeup_target()
+    cam.location = location
+    view = Vector(target) - Vector(location)
     cam.rotation_euler = view.to_track_quat('-Z', 'Y').to_euler()
     cam.data.lens = 50.0
     scene.camera = cam

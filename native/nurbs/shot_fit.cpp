@@ -157,21 +157,18 @@ NetSize chooseNetSize(const std::vector<StreakGrid>& frames, const ShotFitParams
     if (fitsV(maxV, true)) break;
   // Before order 2 across, the particle net across (rows = the lines' curves, so ν holds as it
   // does for them), where every frame has all maxV lines (a line with no kept particle has no
-  // curve to be a row) and its sheet keeps every kept particle and control point within ν.
-  // Unlike the particles along a streakline, which sample one curve (a zig-zag along it is the
-  // tracer's scatter, which the particle net along u smooths at any size), neighbouring lines in
-  // the greedy order that zig-zag are a folded sheet: cutting through the folds by more than ν
-  // would hide them, and order 2 keeps them.
+  // curve to be a row). Its sheet is C² across and cuts each zig-zag of neighbouring lines by
+  // |Δ²p|/6, as the particle net along u does: lines that cross in a stirred plume make the
+  // greedy order zig-zag, and order 2 drew those zig-zags as creased facets that show in any
+  // close-up.
   if (fit.orderV <= kMinBlenderOrder && firstV > kMinBlenderOrder) {
-    SurfaceFitParams onLines = fit;
-    onLines.orderV = firstV;
-    onLines.particleNetV = true;
-    const bool fits = everyFrame(frames.size(), [&](std::size_t n) {
-      if (int(curves[n].lines.size()) != maxV) return false;
-      const SurfaceFit f = fitAcross(frames[n], curves[n], maxV, onLines);
-      return f.maxResidual <= nearTolerance[n] && f.netDeviation <= nearTolerance[n];
+    const bool allLines = everyFrame(frames.size(), [&](std::size_t n) {
+      return int(curves[n].lines.size()) == maxV;
     });
-    if (fits) fit = onLines;
+    if (allLines) {
+      fit.orderV = firstV;
+      fit.particleNetV = true;
+    }
   }
   size.orderV = fit.orderV;
   size.particleNetV = fit.particleNetV;

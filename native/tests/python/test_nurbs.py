@@ -138,7 +138,11 @@ def test_fit_streak_shot_chooses_one_net_for_every_frame():
     frames, lines, particles = keep.shape
     assert 4 <= shot["nu"] < particles and 2 <= shot["nv"] <= lines
     assert shot["control_points"].shape == (frames, shot["nu"] * shot["nv"], 4)
-    assert shot["max_residual"].max() <= 0.5 * cell
+    # The 4 lines fan around the plume's axis: a cubic through them swings off, so the rows are
+    # the lines' own curves (the particle net across), a smooth tube that cuts the fan's corners
+    # by 1.40 cells (measured), where order 2 drew a square one through them.
+    assert shot["particle_net_v"] and shot["order_v"] == 4
+    assert shot["max_residual"].max() <= 1.5 * cell
     assert shot["net_deviation"].max() <= 1.5 * cell
     assert len(shot["params_u"]) == frames
     fixed = _native.fit_streak_shot(pts, keep, tolerance=cell, net_tolerance=cell, nu=6, nv=3,
