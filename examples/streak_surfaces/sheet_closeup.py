@@ -13,7 +13,8 @@ twice from the same build:
   streaklines, 4 across; 1 along an order-2 direction, whose samples are its control points);
 - camera: with the tessellation sized by the camera on every frame (at most 8 px per edge).
 Writes OUT_DIR/sheet_closeup_{fixed,camera}.png (1920 x 1080), CROP of each halved to
-320 x 360 as *_crop.png, and OUT_DIR/sheet_closeup_strip.png: those crops side by side, after BEFORE's (a
+320 x 360 as *_crop.png, and OUT_DIR/sheet_closeup_strip.png: those crops side by side, after
+BEFORE's if given (a
 fixed render made by this script with an older add-on, whose fit fell back to order 2 and which
 had no camera sizing: only the fixed render is made then). blender_tests/test_sheet_closeup.py
 asserts what the camera render shows, on the same scene and camera.
@@ -42,8 +43,9 @@ DISTANCE = 0.6      # m, from the camera to its target
 TARGET_HEIGHT = 0.75  # m
 VIEW_TURN_DEG = 40.0
 #: The manual's part of each render: left, top, width, height in pixels from the image's top
-#: left (the second sheet's outline, where it curls out of the rim), halved to 320 x 360.
-CROP = (1120, 0, 640, 720)
+#: left (where the largest sheet curls out of the rim, its outline against the background),
+#: halved to 320 x 360.
+CROP = (300, 360, 640, 720)
 
 
 def newcomer_scene(cache_directory):
