@@ -63,11 +63,9 @@ def see_through(alpha):
     return float(covered.mean()), float((alpha[covered] < SEE_THROUGH_ALPHA).mean())
 
 
-def shot(out_dir, name, still):
-    """The newcomer's scene, in still air when `still`, baked and built; the .blend is
-    OUT_DIR/first_<name>.blend with its cache in OUT_DIR/<name>_cache. Returns (domain, control
-    nets "nu x nv", mean turning angle at the last frame, build seconds)."""
-    scene = scene_kit.new_scene()
+def newcomer_scene(cache_directory, still=False):
+    """The newcomer's Source and Domain (Streak Surfaces on, every other setting at its default;
+    in still air when `still`) in the current scene, over frames 1..FRAMES. Returns the domain."""
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.25, location=(0.0, 0.0, 0.35))
     src = bpy.context.active_object
     src.name = "Source"
@@ -75,11 +73,21 @@ def shot(out_dir, name, still):
     src.hide_render = True
     dom = scene_kit.domain_cube("Domain", 2.0, (0.0, 0.0, 1.0), 40, FRAMES)
     dom.plume.domain.streaks = True
-    dom.plume.domain.cache_directory = f"//{name}_cache/"
+    dom.plume.domain.cache_directory = cache_directory
     if still:
         dom.plume.domain.turbulence = 0.0
         src.plume.source.smoke_noise = 0.0
+    scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, FRAMES
+    return dom
+
+
+def shot(out_dir, name, still):
+    """The newcomer's scene, in still air when `still`, baked and built; the .blend is
+    OUT_DIR/first_<name>.blend with its cache in OUT_DIR/<name>_cache. Returns (domain, control
+    nets "nu x nv", mean turning angle at the last frame, build seconds)."""
+    scene = scene_kit.new_scene()
+    dom = newcomer_scene(f"//{name}_cache/", still)
     scene_kit.camera(scene, (0.0, -4.5, 1.0), target=(0.0, 0.0, 1.0))
     scene_kit.dark_studio(scene)
     scene_kit.save_blend(out_dir, f"first_{name}")

@@ -30,10 +30,10 @@ import bpy
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.dirname(HERE)]  # this pipeline's examples, then examples/ (the kits)
 import scene_kit  # noqa: E402
+from first_streaks import FRAMES, newcomer_scene  # noqa: E402,F401  (the test imports them here)
 
 USAGE = ("usage: blender -b --factory-startup --python "
          "examples/streak_surfaces/sheet_closeup.py -- OUT_DIR [BEFORE_PNG]")
-FRAMES = 60
 WIDTH, HEIGHT = 1920, 1080
 #: The close-up: DISTANCE from the control point of the largest sheet (most control points) at
 #: frame 60 nearest TARGET_HEIGHT, where the sheets flare out of the rim above the source, seen
@@ -46,21 +46,6 @@ VIEW_TURN_DEG = 40.0
 #: left (where the largest sheet curls out of the rim, its outline against the background),
 #: halved to 320 x 360.
 CROP = (300, 360, 640, 720)
-
-
-def newcomer_scene(cache_directory):
-    """first_streaks.py's scene, every default: the Source and the Domain (streaks on)."""
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.25, location=(0.0, 0.0, 0.35))
-    src = bpy.context.active_object
-    src.name = "Source"
-    bpy.ops.plume.role_set(role='SOURCE')
-    src.hide_render = True
-    dom = scene_kit.domain_cube("Domain", 2.0, (0.0, 0.0, 1.0), 40, FRAMES)
-    dom.plume.domain.streaks = True
-    dom.plume.domain.cache_directory = cache_directory
-    scene = bpy.context.scene
-    scene.frame_start, scene.frame_end = 1, FRAMES
-    return dom
 
 
 def surfaces():
