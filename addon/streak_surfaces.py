@@ -324,10 +324,13 @@ def fit_mask(frame, sources, particles):
 
 def surface_animation(native, frames, plan, cell_size, tolerance_cells=FIT_TOLERANCE_CELLS,
                       net_tolerance_cells=NET_TOLERANCE_CELLS,
-                      near_tolerance_cells=NEAR_TOLERANCE_CELLS) -> SurfaceAnimation:
+                      near_tolerance_cells=NEAR_TOLERANCE_CELLS, box=None) -> SurfaceAnimation:
     """The least-squares surfaces (§3.3, native fit_streak_shot) of the cluster's streaklines at
     every frame, on one control net chosen for the whole shot, through the particles of
-    fit_mask() (not those not yet emitted, nor those past the open sides)."""
+    fit_mask() (not those not yet emitted, nor those past the open sides). With `box` (lo, hi),
+    the domain's corners, control points are kept inside it: a net fitted to a line that ends
+    at an open side may put its last control point up to δ past it (a stirred plume reaching
+    the top: 0.9 cells), where no smoke is simulated and an artist would find it off the box."""
     particles = max(int(np.max(np.asarray(frames[-1]["counts"])[plan.sources])), 1)
     grids = np.stack([streakline_grid(f, plan.sources, particles) for f in frames])
     keep = np.stack([fit_mask(f, plan.sources, particles) for f in frames])
@@ -336,7 +339,10 @@ def surface_animation(native, frames, plan, cell_size, tolerance_cells=FIT_TOLER
                                   net_tolerance=net_tolerance_cells * cell_size,
                                   particle_tolerance=near_tolerance_cells * cell_size,
                                   order_u=ORDER_U, order_v=ORDER_V)
-    cps = np.asarray(shot["control_points"], dtype=np.float32)
+    cps = np.array(shot["control_points"], dtype=np.float32)
+    if box is not None:
+        np.clip(cps[..., :3], np.asarray(box[0], np.float32), np.asarray(box[1], np.float32),
+                out=cps[..., :3])
     head = {k: int(shot[k]) for k in ("nu", "nv", "order_u", "order_v")}
     dicts = [dict(head, control_points=cps[n], endpoint_u=True, endpoint_v=True,
                   params_u=np.asarray(shot["params_u"][n]), params_v=np.asarray(shot["params_v"][n]),

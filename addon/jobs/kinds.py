@@ -108,10 +108,13 @@ def surfaces(spec, job):
         raise BakeError(f"Plume: threshold h0 = {h0} joins no two streaklines: raise "
                         "streak_threshold (0 = the default mean of h)")
     anims = []
+    cell = float(m["cell_size"])
+    lo = np.asarray(m["origin"], dtype=np.float64)
+    box = (lo, lo + np.asarray(m["resolution"], dtype=np.float64) * cell)
     for i, plan in enumerate(plans):
         job.set_progress(i, len(plans), "surface")
         job.check_cancel()
-        anims.append(ss.surface_animation(native, frames, plan, float(m["cell_size"])))
+        anims.append(ss.surface_animation(native, frames, plan, cell, box=box))
     maps = _density_maps(native, job, folder, m, anims, settings)
     for i, anim in enumerate(anims):
         job.check_cancel()

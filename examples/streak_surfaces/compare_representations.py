@@ -47,6 +47,9 @@ VOLUME_DENSITY = {50: 40.0, 150: 70.0}
 PARTICLE_RADIUS = 0.003
 PARTICLE_OPACITY = {50: 0.2, 150: 0.015}
 PARTICLE_FULL_DENSITY = 0.02
+#: Samples of the renders that match each panel's light to the sheets' (the sheets' own count;
+#: the final renders take about as many, matched to the sheets' time).
+MATCH_SAMPLES = 16
 
 
 def bake(out_dir, frames, resolution, point_sources):
@@ -80,10 +83,11 @@ def report(label, path, seconds, samples):
     return path
 
 
-def panels(out_dir, frames, resolution, point_sources, sheets_s=None):
-    """This grid's volume and particle panels, each rendered for at least `sheets_s` seconds,
-    and with `sheets_s` None first its sheets panel, whose time sets it. Returns (paths, the
-    sheets' seconds)."""
+def panels(out_dir, frames, resolution, point_sources, sheets_s=None, sheets_light=None):
+    """This grid's volume and particle panels, each rendered for at least `sheets_s` seconds
+    with the light of the sheets (`sheets_light`; match_light() from VOLUME_DENSITY and
+    PARTICLE_OPACITY), and with `sheets_s` None first its sheets panel, whose time and light set
+    them. Returns (paths, the sheets' seconds, the sheets' light)."""
     scene, dom, _ = bake(out_dir, frames, resolution, point_sources)
     paths = {}
     if sheets_s is None:
@@ -96,28 +100,35 @@ def panels(out_dir, frames, resolution, point_sources, sheets_s=None):
         path = os.path.join(out_dir, "surfaces_50.png")
         samples = scene.cycles.samples
         sheets_s, _ = looks.render(scene, path, samples)
+        sheets_light = looks.measure(path)["light"]
         paths["surfaces"] = report("(e) surfaces 50^3", path, sheets_s, samples)
     scene.frame_set(frames)
     volume = bpy.data.objects[dom.plume.domain.volume_object]
-    looks.set_volume_look(volume, VOLUME_DENSITY[resolution])
     looks.show_only(scene, {volume})
     path = os.path.join(out_dir, f"volume_{resolution}.png")
+    density = looks.match_light(scene, path, lambda v: looks.set_volume_look(volume, v),
+                                VOLUME_DENSITY[resolution], sheets_light, MATCH_SAMPLES)
+    print(f"compare_representations: volume {resolution}^3 density scale {density:.1f}",
+          flush=True)
     paths["volume"] = report(f"volume {resolution}^3", path,
                              *looks.render_matched(scene, path, sheets_s))
     specks = looks.particles_object(dom, frames, PARTICLE_RADIUS, PARTICLE_OPACITY[resolution],
                                     PARTICLE_FULL_DENSITY, dom.plume.domain.sheet_brightness)
     looks.show_only(scene, {specks})
     path = os.path.join(out_dir, f"particles_{resolution}.png")
+    opacity = looks.match_light(scene, path, lambda v: looks.set_speck_opacity(specks, v),
+                                PARTICLE_OPACITY[resolution], sheets_light, MATCH_SAMPLES)
+    print(f"compare_representations: particles {resolution}^3 opacity {opacity:.3f}", flush=True)
     paths["particles"] = report(f"particles {resolution}^3 ({point_sources} sources)", path,
                                 *looks.render_matched(scene, path, sheets_s))
     bpy.ops.wm.save_mainfile()
-    return paths, sheets_s
+    return paths, sheets_s, sheets_light
 
 
 def main():
     out_dir, frames = scene_kit.parse_args(USAGE, DEFAULT_FRAMES)
-    coarse, sheets_s = panels(out_dir, frames, 50, 20)
-    fine, _ = panels(out_dir, frames, 150, 100, sheets_s)
+    coarse, sheets_s, sheets_light = panels(out_dir, frames, 50, 20)
+    fine, _, _ = panels(out_dir, frames, 150, 100, sheets_s, sheets_light)
     strip = scene_kit.strip([coarse["volume"], fine["volume"], coarse["particles"],
                              fine["particles"], coarse["surfaces"]],
                             os.path.join(out_dir, "compare_strip.png"))
