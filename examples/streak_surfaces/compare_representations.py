@@ -37,13 +37,14 @@ USAGE = ("usage: blender -b --factory-startup --python "
          "examples/streak_surfaces/compare_representations.py -- OUT_DIR [FRAMES]")
 DEFAULT_FRAMES = 84
 WIDTH, HEIGHT = 200, 320  # one pixel is about 3.8 mm at the smoke (1.7 m, 50 mm lens)
-#: Principled Volume density scale per grid: the volume's light (figure9_looks.measure) equals
-#: the sheets' on frame 84: 11.3 at 50³ (512 samples) and 11.5 at 150³ against the sheets' 11.7.
+#: Principled Volume density scale per grid where match_light starts; it ends where the volume's
+#: light (figure9_looks.measure) equals the sheets' on frame 84 (2026-11-29: 20.6 at 50³ and
+#: 36.4 at 150³, for the cubic sheets' 7.3).
 VOLUME_DENSITY = {50: 40.0, 150: 70.0}
-#: Particle specks: 3 mm radius (1.6 px across), opacity per grid (the 150³ bake's 13,700
-#: particles, against 1,700 at 50³, overlap more: each is fainter for the same light, 12.2 and
-#: 10.7 against the sheets' 11.7), full at a carried density of 0.02 and fainter below it (the
-#: thinned smoke high up).
+#: Particle specks: 3 mm radius (1.6 px across), opacity per grid where match_light starts (the
+#: 150³ bake's 13,700 particles, against 1,700 at 50³, overlap more: each is fainter for the
+#: same light; it ended at 0.105 and 0.007), full at a carried density of 0.02 and fainter below
+#: it (the thinned smoke high up).
 PARTICLE_RADIUS = 0.003
 PARTICLE_OPACITY = {50: 0.2, 150: 0.015}
 PARTICLE_FULL_DENSITY = 0.02
