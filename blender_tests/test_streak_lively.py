@@ -35,8 +35,7 @@ TURN_RATIO_MIN = 5.0
 SHEETS_MIN, SHEETS_MAX = 2, 12
 #: Of the pixels the sheets cover (alpha > 0.05 on a transparent film), the share whose alpha is
 #: below 0.8, i.e. that show a fifth of the background or more. Measured 0.73 (3.4.1), 0.90 (bpy
-#: 4.5), 0.96 (bpy 5.3), from the same bake: many pixels sit near 0.8, where the Blenders' own
-#: transparency sampling tips them one way or the other.
+#: 4.5), 0.96 (bpy 5.3), from the same bake: the Blenders' renders differ there.
 SEE_THROUGH_MIN = 0.6
 #: Share of the frame the sheets cover: the smoke is in the picture (measured 0.123-0.135).
 COVER_MIN = 0.04
