@@ -42,9 +42,9 @@ PYTHONS = ((3, 11), (3, 13))
 #: Written into the package: what was built, for whom (the add-on's native.py reads MODULES).
 BUILD_INFO = "PLUME_BUILD.txt"
 PACKAGE = "plume"
-#: Never copied from the add-on's source folder into the zip.
+#: Never copied from the add-on's source folder into the zip (README.md is the developers' page).
 EXCLUDED_DIRS = {"__pycache__"}
-EXCLUDED_FILE = re.compile(r"(\.pyc$|^_native.*\.so$|^\.)")
+EXCLUDED_FILE = re.compile(r"(\.pyc$|^_native.*\.so$|^\.|^README\.md$)")
 
 _DYN = re.compile(r"\((NEEDED|RUNPATH|RPATH|SONAME)\)\s+[^\[]*\[(.*)\]")
 _VERNEED_FILE = re.compile(r"^\s*0x[0-9a-f]+:\s+Version:\s+\d+\s+File:\s+(\S+)", re.M)
