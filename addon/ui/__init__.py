@@ -1,5 +1,6 @@
-"""Panels of the Physics tab (draw() never reads the disk: cache_state holds what they show)."""
+"""Panels of the Physics tab, and of a built smoke sheet (draw() never reads the disk:
+cache_state holds what they show)."""
 
-from . import flame_panels, panels
+from . import flame_panels, panels, sheet_panels
 
-classes = panels.classes + flame_panels.classes
+classes = panels.classes + flame_panels.classes + sheet_panels.classes

@@ -1,0 +1,77 @@
+"""The panel of a built smoke sheet (a Plume streak surface), where an artist who selected one
+looks: Properties › Object Data, and the 3D Viewport's sidebar (N) › Plume, which stays in view
+in Edit Mode while control points are moved. It says how hand edits work (the Smoke Surfaces
+paper's §5) and holds the buttons that act on this sheet: Store / Clear Edits, Bake to
+Keyframes, Export Mesh."""
+
+import bpy
+
+from ..build import surface_edits
+from ..build.surfaces import CACHE_KEY, DOMAIN_KEY
+
+#: What the panel tells the artist, one short line each (panels do not wrap text).
+HOW_EDITS_WORK = (
+    "Edits follow the smoke on every frame,",
+    "turned and carried with the sheet.",
+    "Changing frame after Edit Mode stores them;",
+    "Store Edits does it at once.",
+)
+
+
+def is_sheet(ob):
+    """True for a smoke sheet Build Surfaces made (its control points come from the cache)."""
+    return ob is not None and ob.type == 'SURFACE' and CACHE_KEY in ob
+
+
+def draw_sheet(layout, ob):
+    """The sheet's hints and buttons (the operators act on the active sheet and the selected
+    ones)."""
+    col = layout.column()
+    col.label(text=f"Smoke sheet of domain '{ob.get(DOMAIN_KEY, '?')}'", icon='SURFACE_NSURFACE')
+    if ob.get(surface_edits.BAKED_KEY):
+        col.label(text="Baked to keyframes: edit its keyframes", icon='KEYINGSET')
+        return
+    box = col.box()
+    if ob.mode == 'EDIT':
+        box.label(text="Move control points (G, R, S), then Store Edits", icon='INFO')
+    else:
+        box.label(text="Tab into Edit Mode to move control points", icon='INFO')
+    for line in HOW_EDITS_WORK:
+        box.label(text=line)
+    row = col.row(align=True)
+    row.operator("plume.surface_edits_store", icon='EDITMODE_HLT')
+    row.operator("plume.surface_edits_clear", icon='X')
+    row = col.row(align=True)
+    row.operator("plume.surfaces_bake_keyframes", icon='KEYINGSET')
+    row.operator("plume.surfaces_export_mesh", icon='MESH_GRID')
+
+
+class DATA_PT_plume_sheet(bpy.types.Panel):
+    bl_label = "Plume Smoke Sheet"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        return is_sheet(context.object)
+
+    def draw(self, context):
+        draw_sheet(self.layout, context.object)
+
+
+class VIEW3D_PT_plume_sheet(bpy.types.Panel):
+    bl_label = "Smoke Sheet"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "Plume"
+
+    @classmethod
+    def poll(cls, context):
+        return is_sheet(context.object)
+
+    def draw(self, context):
+        draw_sheet(self.layout, context.object)
+
+
+classes = [DATA_PT_plume_sheet, VIEW3D_PT_plume_sheet]
