@@ -76,7 +76,7 @@ class BadInputTest(unittest.TestCase):
 
     def test_no_active_object(self):
         select_only(None)
-        self.assert_bake_fails("not a Plume domain", "role_set")
+        self.assert_bake_fails("not a Plume domain", "Physics Properties › Plume › Domain")
 
     def test_active_object_not_a_domain(self):
         select_only(self.source)

@@ -126,7 +126,7 @@ class StreakDefaultsTest(unittest.TestCase):
         folder = os.path.join(self.tmp, "Domain")
         assert_reports_error(
             self, bpy.ops.plume.bake, r"streaklines over 5000 frames hold [0-9.]+ GB of "
-            r"particles, more than the [0-9.]+ GB of memory free: lower max_streaklines",
+            r"particles, more than the [0-9.]+ GB of memory free: lower Max Streaklines",
             lambda: (tree_listing(folder), len(bpy.data.objects), len(bpy.data.volumes)))
         self.assertFalse(os.path.exists(folder))
 
