@@ -135,7 +135,8 @@ class StreakDefaultsTest(unittest.TestCase):
         dom.plume.domain.max_streaklines = 1
         folder = os.path.join(self.tmp, "Domain")
         assert_reports_error(self, bpy.ops.plume.bake,
-                             r"max_streaklines must be 0 \(no limit\) or in \[2, ",
+                             r"Max Streaklines \(Physics Properties › Plume › Streak "
+                             r"Surfaces\) must be 0 \(no limit\) or in \[2, ",
                              lambda: tree_listing(folder))
 
 

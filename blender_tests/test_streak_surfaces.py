@@ -359,7 +359,8 @@ class StreakBadInputTest(unittest.TestCase):
         dom.plume.domain.emission_period = 0
         with self.assertRaises(RuntimeError) as ctx:
             bpy.ops.plume.bake()
-        self.assertIn("emission_period must be in [1, 100000]", str(ctx.exception))
+        self.assertIn("Emission Period (Physics Properties › Plume › Streak Surfaces) must be in "
+                      "[1, 100000]", str(ctx.exception))
         self.assertFalse(os.path.exists(self.cache))
 
 
