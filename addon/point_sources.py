@@ -52,7 +52,7 @@ def vertex_point_sources(params, domain_name, emitter):
         first = int(outside[0])
         raise BakeError(
             f"Plume: source '{e.name}': {len(outside)} of the {len(points)} vertices of "
-            f"point_source_mesh '{e.point_source_mesh}' lie outside domain '{domain_name}' "
+            f"its Point Source Mesh '{e.point_source_mesh}' lie outside domain '{domain_name}' "
             f"(box {_vec(lo)} to {_vec(hi)}), e.g. vertex {first} at {_vec(points[first])}: "
             "move the mesh inside the domain")
     return points
@@ -115,8 +115,8 @@ def split_groups(points, first_group, split, source_name=""):
     if n < 2 * split:
         raise BakeError(f"Plume: source '{source_name}': candidate_split {split} needs at least "
                         f"{2 * split} point sources (2 per candidate group, §3.3); it has {n}: "
-                        "lower Split Into Groups (Physics Properties › Plume › Source) or add point "
-                        "sources")
+                        "lower Split Into Groups (Physics Properties › Plume › Source) or add "
+                        "point sources")
     axis = int(np.argmax(points.max(axis=0) - points.min(axis=0)))
     order = np.argsort(points[:, axis], kind="stable")
     groups = np.empty(n, dtype=np.int64)

@@ -1,15 +1,16 @@
-"""Where an artist finds a domain setting that a message names by its Python name: the core and
-the bake's checks say "vorticity must be in [0, 1000]", the report says "Vorticity (Physics
-Properties › Plume › Forces) must be in [0, 1000]". The label is the property's own name; the
-panel is the one that draws it (ui/panels.py; test_roles_ui draws them and checks this table)."""
+"""Where an artist finds a domain's or a Source's setting that a message names by its Python
+name: the core and the bake's checks say "vorticity must be in [0, 1000]", the report says
+"Vorticity (ε) (Physics Properties › Plume › Forces) must be in [0, 1000]". The label is the
+property's own name; the panel is the one that draws it (ui/panels.py; test_roles_ui draws the
+panels and checks these tables)."""
 
 import re
 
-from .properties import PlumeDomainSettings
+from .properties import PlumeDomainSettings, PlumeSourceSettings
 
 TAB = "Physics Properties › Plume"
 
-#: The domain's panels (ui/panels.py) and the settings each draws.
+#: The domain's panels (ui/panels.py) and the settings each draws (the messages' own names).
 DOMAIN_PANELS = (
     ("Settings", ("resolution", "frame_start", "frame_end", "time_scale", "substeps", "use_cfl",
                   "cfl", "seed", "threads", "adaptive_domain", "adaptive_margin",
@@ -31,33 +32,44 @@ DOMAIN_PANELS = (
     ("Cache", ("motion_source", "mantaflow_domain", "cache_directory", "velocity_everywhere")),
 )
 
-# "domain 'Smoke': vorticity must ...": the setting the message is about follows the domain.
-_SUBJECT = re.compile(r"(domain '[^']*': )([a-z][a-z0-9_]*)\b")
+#: The Source panel's settings.
+SOURCE_PANELS = (
+    ("Source", ("density", "temperature", "smoke_noise", "smoke_noise_scale", "smoke_noise_rate",
+                "fuel", "fuel_noise", "fuel_noise_scale", "fuel_noise_rate", "velocity",
+                "motion_factor", "emit_particles", "point_source_mesh", "point_placement",
+                "point_sources", "candidate_group", "candidate_split")),
+)
+
+#: What a message names ("domain 'Smoke': ...") -> its settings' class and panels.
+OWNERS = {"domain": (PlumeDomainSettings, DOMAIN_PANELS),
+          "source": (PlumeSourceSettings, SOURCE_PANELS)}
+
+# "domain 'Smoke': vorticity must ...": the setting the message is about follows its owner.
+_SUBJECT = re.compile(r"\b(domain|source) '[^']*': ([a-z][a-z0-9_]*)\b")
 _SNAKE = re.compile(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b")
 
 
-def domain_setting(name):
-    """'Label (Physics Properties › Plume › Panel)' of a domain setting's Python name; None when
-    no domain panel draws one of that name."""
-    for panel, names in DOMAIN_PANELS:
+def setting_path(name, owner="domain"):
+    """'Label (Physics Properties › Plume › Panel)' of a domain's (or a Source's, owner
+    "source") setting by its Python name; None when no panel of the owner draws one."""
+    cls, panels = OWNERS[owner]
+    for panel, names in panels:
         if name in names:
-            label = PlumeDomainSettings.bl_rna.properties[name].name
-            return f"{label} ({TAB} › {panel})"
+            return f"{cls.bl_rna.properties[name].name} ({TAB} › {panel})"
     return None
 
 
-def _label(m):
-    name = m.group(0)
-    if any(name in names for _panel, names in DOMAIN_PANELS):
-        return PlumeDomainSettings.bl_rna.properties[name].name
-    return name
-
-
 def in_ui_words(message):
-    """`message` with the domain setting it is about named as its panel shows it, the panel
-    with it, and the other domain settings it names (snake_case ones) by their labels."""
+    """`message` with the setting it is about named as its panel shows it, the panel with it,
+    and the owner's other settings it names (snake_case ones) by their labels."""
     m = _SUBJECT.search(message)
-    where = None if m is None else domain_setting(m.group(2))
+    where = None if m is None else setting_path(m.group(2), m.group(1))
     if where is None:
         return message
-    return message[:m.start(2)] + where + _SNAKE.sub(_label, message[m.end():])
+    cls, panels = OWNERS[m.group(1)]
+
+    def label(word):
+        name = word.group(0)
+        drawn = any(name in names for _panel, names in panels)
+        return cls.bl_rna.properties[name].name if drawn else name
+    return message[:m.start(2)] + where + _SNAKE.sub(label, message[m.end():])

@@ -85,7 +85,9 @@ class BadInputTest(unittest.TestCase):
     def test_resolution_zero(self):
         self.domain.plume.domain.resolution = 0
         self.assertEqual(self.domain.plume.domain.resolution, 0, "resolution must not be clamped")
-        self.assert_bake_fails("Resolution (Physics Properties › Plume › Settings) must be in [2, 1024]", "Domain")
+        self.assert_bake_fails("Resolution (Physics Properties › Plume › Settings) "
+                               "must be in [2, 1024]",
+                               "Domain")
 
     def test_resolution_5000(self):
         self.domain.plume.domain.resolution = 5000
@@ -109,7 +111,9 @@ class BadInputTest(unittest.TestCase):
     def test_frame_end_before_start(self):
         d = self.domain.plume.domain
         d.frame_start, d.frame_end = 10, 5
-        self.assert_bake_fails("End (Physics Properties › Plume › Settings) must not be before Start", "5 < 10")
+        self.assert_bake_fails("End (Physics Properties › Plume › Settings) must not "
+                               "be before Start",
+                               "5 < 10")
 
     def test_cache_folder_not_writable(self):
         # Tests run as root, so chmod would not stop them: put the cache under a regular file.

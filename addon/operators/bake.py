@@ -80,7 +80,7 @@ class BakeJob(JobRunner):
         return ('WARNING' if result.cancelled else 'INFO'), text
 
     def error_text(self, exc):
-        return f"Plume: bake of '{self.domain_name}' failed: {exc}"
+        return setting_paths.in_ui_words(f"Plume: bake of '{self.domain_name}' failed: {exc}")
 
     def busy_text(self):
         return f"Plume: domain '{self.domain_name}' is already baking"

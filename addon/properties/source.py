@@ -83,9 +83,10 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
     candidate_split: IntProperty(
         name="Split Into Groups", default=1, soft_min=1, soft_max=64,
         description="Splits this source's point sources into this many candidate groups so that "
-                    "streaklines of different parts never share a surface: a Rim into this many arcs (1: arcs of about 8 point sources), other "
-                    "point sources into groups of equal count along their longest extent (1: no "
-                    "split); more than 1 replaces Candidate Group; validated at bake time to "
+                    "streaklines of different parts never share a surface: a Rim into this "
+                    "many arcs (1: arcs of about 8 point sources), other point sources into "
+                    "groups of equal count along their longest extent (1: no split); more than "
+                    "1 replaces Candidate Group; validated at bake time to "
                     f"{text('candidate_split')}")
 
 
