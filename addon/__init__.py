@@ -16,6 +16,7 @@ bl_info = {
     "description": "Smoke and fire simulation with streak surfaces, toon smoke, graph fire "
                    "and structural flames",
     "category": "Physics",
+    "doc_url": "https://github.com/plume-developers/plume/blob/main/README.md#readme",
 }
 
 

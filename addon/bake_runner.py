@@ -124,7 +124,8 @@ class BakeRunner:
             self._fuel_cells = self._fuel_cells_of(params)
         error = cache.check_writable(snap.cache_folder)
         if error is not None:
-            raise BakeError(f"Plume: cache_directory '{snap.cache_directory}' is not writable "
+            raise BakeError(f"Plume: the Cache Directory '{snap.cache_directory}' (Physics "
+                            "Properties › Plume › Cache) is not writable "
                             f"({snap.cache_folder}: {error})")
         self._plan()
 

@@ -31,8 +31,8 @@ SUBSTEPS_RANGE = RANGES["flames.substeps"]
 STOPS_RANGE = (-40.0, 40.0)
 #: Samples per flame when the scene has no camera (no projected area to size them from).
 FIXED_PARTICLES = 4000
-NO_SOURCE = ("Plume: the scene has no Flame Source (make a mesh one with "
-             "plume.role_set(role='FLAME_SOURCE'))")
+NO_SOURCE = ("Plume: the scene has no Flame Source: select a mesh and press "
+             "Physics Properties › Plume › Flame Source")
 
 
 def volume_path(folder, frame):

@@ -257,7 +257,8 @@ def load_graph(native, folder, owner):
     path = graph_path(folder)
     if not os.path.isfile(path):
         raise BakeError(f"Plume: {owner} has no flow graph yet: select the fire states and "
-                        "press Build Flow Graph (plume.flowgraph_build) first")
+                        "press Build Flow Graph first (Physics Properties › Plume › Flow-Graph "
+                        "Fire)")
     try:
         with np.load(path, allow_pickle=False) as data:
             cost = np.array(data["cost"])

@@ -79,7 +79,8 @@ class MantaflowTraceRunner(BakeRunner):
         self._first = self._read(plan.files[0])
         error = cache.check_writable(snap.cache_folder)
         if error is not None:
-            raise BakeError(f"Plume: cache_directory '{snap.cache_directory}' is not writable "
+            raise BakeError(f"Plume: the Cache Directory '{snap.cache_directory}' (Physics "
+                            "Properties › Plume › Cache) is not writable "
                             f"({snap.cache_folder}: {error})")
 
     def _prepare_tracer(self, plan, owner):

@@ -40,8 +40,9 @@ def vertex_point_sources(params, domain_name, emitter):
     points = np.ascontiguousarray(e.point_source_vertices, dtype=np.float32).reshape(-1, 3)
     if len(points) == 0:
         raise BakeError(f"Plume: source '{e.name}': point_source_mesh '{e.point_source_mesh}' has "
-                        "no vertices (give it vertices, or clear point_source_mesh to place "
-                        "point_sources random points per source cell)")
+                        "no vertices (give it vertices, or clear Point Source Mesh in Physics "
+                        "Properties › Plume › Source to place Point Sources random points per "
+                        "source cell)")
     if not np.all(np.isfinite(points)):
         raise BakeError(f"Plume: source '{e.name}': point_source_mesh '{e.point_source_mesh}' has "
                         "vertices that are not finite numbers")
@@ -51,7 +52,7 @@ def vertex_point_sources(params, domain_name, emitter):
         first = int(outside[0])
         raise BakeError(
             f"Plume: source '{e.name}': {len(outside)} of the {len(points)} vertices of "
-            f"point_source_mesh '{e.point_source_mesh}' lie outside domain '{domain_name}' "
+            f"its Point Source Mesh '{e.point_source_mesh}' lie outside domain '{domain_name}' "
             f"(box {_vec(lo)} to {_vec(hi)}), e.g. vertex {first} at {_vec(points[first])}: "
             "move the mesh inside the domain")
     return points
@@ -114,7 +115,8 @@ def split_groups(points, first_group, split, source_name=""):
     if n < 2 * split:
         raise BakeError(f"Plume: source '{source_name}': candidate_split {split} needs at least "
                         f"{2 * split} point sources (2 per candidate group, §3.3); it has {n}: "
-                        "lower candidate_split or add point sources")
+                        "lower Split Into Groups (Physics Properties › Plume › Source) or add "
+                        "point sources")
     axis = int(np.argmax(points.max(axis=0) - points.min(axis=0)))
     order = np.argsort(points[:, axis], kind="stable")
     groups = np.empty(n, dtype=np.int64)
@@ -267,7 +269,8 @@ def check_memory(domain_name, streaklines, frames, particles_per_frame):
         raise BakeError(
             f"Plume: domain '{domain_name}': {streaklines:,} streaklines over {frames} frames "
             f"hold {need / 2**30:.1f} GB of particles, more than the {have / 2**30:.1f} GB of "
-            "memory free: lower max_streaklines (or the Sources' point_sources), or bake fewer "
+            "memory free: lower Max Streaklines (Physics Properties › Plume › Streak "
+            "Surfaces) or the Sources' Point Sources, or bake fewer "
             "frames")
 
 

@@ -7,7 +7,7 @@ if tuple(bpy.app.version) < (3, 4, 0):
                       "tested in 3.4.1 and 4.2 LTS to 5.3", name=__name__)
 
 from . import native  # noqa: E402,F401  (fails here, with a clear message)
-from . import cache_state, operators, properties, ui  # noqa: E402
+from . import cache_state, manual, operators, properties, ui  # noqa: E402
 from .jobs import handlers as _job_handlers  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
 from .build import toon_points as _toon_points  # noqa: E402
@@ -27,9 +27,11 @@ def register():
     _flame_spines.register()  # persistent frame_change_pre handler of flame spines and lights
     _job_handlers.register()  # persistent load_pre + atexit: a file load or quit ends the jobs
     cache_state.register()  # the panels' cache state: read when a job ends or a file loads
+    bpy.utils.register_manual_map(manual.manual_map)  # right click › Online Manual
 
 
 def unregister():
+    bpy.utils.unregister_manual_map(manual.manual_map)
     cache_state.unregister()
     _job_handlers.unregister()  # running jobs end first, their temporaries removed
     _flame_spines.unregister()

@@ -348,8 +348,8 @@ def validate_python_side(domain_name, resolution, frame_start, frame_end, solver
             f"longest axis (got {resolution})")
     if frame_end < frame_start:
         raise BakeError(
-            f"Plume: domain '{domain_name}': frame_end ({frame_end}) must not be before "
-            f"frame_start ({frame_start})")
+            f"Plume: domain '{domain_name}': frame_end must not be before frame_start (got "
+            f"{frame_end} < {frame_start})")
     for name, value in dataclasses.asdict(solver).items():
         values = value if isinstance(value, (tuple, list)) else (value,)
         for v in values:

@@ -147,10 +147,12 @@ def streak_manifest(folder, domain_name):
     m = cache.read_manifest(folder)
     if m is None or m.get("last_complete_frame", -1) < m.get("frame_start", 0):
         raise BakeError(f"Plume: domain '{domain_name}' has no bake yet: turn on Streak Surfaces "
-                        "and bake it first (plume.bake)")
+                        "and bake it first (Physics Properties › Plume › Streak Surfaces, then "
+                        "Bake)")
     if not m.get("streaks"):
         raise BakeError(f"Plume: domain '{domain_name}' was baked without streak surfaces: turn "
-                        "on Streak Surfaces (domain.plume.domain.streaks) and bake again")
+                        "on Streak Surfaces (Physics Properties › Plume › Streak Surfaces) and "
+                        "bake again")
     return m
 
 
@@ -178,8 +180,8 @@ def group_distances(native, frames) -> Dict[int, GroupDistances]:
         if len(ids) < 2:
             raise BakeError(
                 f"Plume: candidate group {g} has a single point source (source ID {int(ids[0])}); "
-                "a surface needs at least 2: raise the source's point_sources or give it the "
-                "candidate_group of another source")
+                "a surface needs at least 2: raise the source's Point Sources or give it the "
+                "Candidate Group of another source (Physics Properties › Plume › Source)")
     try:
         shared = native.StreakFrames(frames)  # converted once for every group
     except ValueError as e:

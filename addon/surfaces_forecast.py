@@ -61,7 +61,7 @@ def check_memory(domain_name, lines, particles, frames):
             f"Plume: surfaces of '{domain_name}': {lines:,} streaklines over {frames} frames need "
             f"about {need / 2**30:.1f} GB (their particles and the distances h between them), "
             f"more than the {have / 2**30:.1f} GB of memory free: lower Max Streaklines "
-            "(max_streaklines) and bake again")
+            "(Physics Properties › Plume › Streak Surfaces) and bake again")
 
 
 def shot_size(native, folder, manifest):

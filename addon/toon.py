@@ -149,7 +149,7 @@ def toon_manifest(folder, domain_name):
     m = cache.read_manifest(folder)
     if m is None or m.get("last_complete_frame", -1) < m.get("frame_start", 0):
         raise BakeError(f"Plume: domain '{domain_name}' has no bake yet: bake it first "
-                        "(plume.bake), then build the toon smoke")
+                        "(Physics Properties › Plume › Bake), then build the toon smoke")
     first = cache.volume_path(folder, int(m["frame_start"]))
     if not os.path.isfile(first):
         raise BakeError(f"Plume: volume file {first} is missing: bake the domain again")
@@ -187,7 +187,8 @@ def check_bake(settings: ToonSettings, manifest, domain_name=""):
     holds density and velocity only (no temperature to drive the colour ramp)."""
     if manifest.get("motion_source") == "mantaflow" and settings.color_driver == 'TEMPERATURE':
         raise BakeError(f"Plume: domain '{domain_name}' traces a Mantaflow cache, which carries "
-                        "density and velocity only: set the toon color_driver to DENSITY or SPEED")
+                        "density and velocity only: set Colour Driver to Density or Speed "
+                        "(Physics Properties › Plume › Toon Smoke)")
 
 
 def frame_dt(manifest):

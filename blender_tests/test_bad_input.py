@@ -76,7 +76,7 @@ class BadInputTest(unittest.TestCase):
 
     def test_no_active_object(self):
         select_only(None)
-        self.assert_bake_fails("not a Plume domain", "role_set")
+        self.assert_bake_fails("not a Plume domain", "Physics Properties › Plume › Domain")
 
     def test_active_object_not_a_domain(self):
         select_only(self.source)
@@ -85,29 +85,35 @@ class BadInputTest(unittest.TestCase):
     def test_resolution_zero(self):
         self.domain.plume.domain.resolution = 0
         self.assertEqual(self.domain.plume.domain.resolution, 0, "resolution must not be clamped")
-        self.assert_bake_fails("resolution", "[2, 1024]", "Domain")
+        self.assert_bake_fails("Resolution (Physics Properties › Plume › Settings) "
+                               "must be in [2, 1024]",
+                               "Domain")
 
     def test_resolution_5000(self):
         self.domain.plume.domain.resolution = 5000
-        self.assert_bake_fails("resolution", "5000")
+        self.assert_bake_fails("Resolution (Physics Properties › Plume › Settings)", "5000")
 
     def test_resolution_above_memory(self):
         # 1000^3 cells is inside the per-axis range but far above the memory bound (512^3).
         self.domain.plume.domain.resolution = 1000
-        self.assert_bake_fails("resolution", "cells")
+        self.assert_bake_fails("Resolution (Physics Properties › Plume › Settings)", "cells")
 
     def test_negative_vorticity(self):
         self.domain.plume.domain.vorticity = -1.0
-        self.assert_bake_fails("vorticity", "-1")
+        self.assert_bake_fails("Vorticity (ε) (Physics Properties › Plume › Forces) must be in "
+                               "[0, 1000]", "-1")
 
     def test_nan_alpha(self):
         self.domain.plume.domain.alpha = float("nan")
-        self.assert_bake_fails("alpha", "finite")
+        self.assert_bake_fails("Density Buoyancy (α) (Physics Properties › Plume › Forces)",
+                               "finite")
 
     def test_frame_end_before_start(self):
         d = self.domain.plume.domain
         d.frame_start, d.frame_end = 10, 5
-        self.assert_bake_fails("frame_end", "frame_start")
+        self.assert_bake_fails("End (Physics Properties › Plume › Settings) must not "
+                               "be before Start",
+                               "5 < 10")
 
     def test_cache_folder_not_writable(self):
         # Tests run as root, so chmod would not stop them: put the cache under a regular file.
@@ -115,7 +121,8 @@ class BadInputTest(unittest.TestCase):
         with open(blocker, "w") as f:
             f.write("x")
         self.domain.plume.domain.cache_directory = os.path.join(blocker, "cache") + "/"
-        msg = self.assert_bake_fails("cache_directory", "not_a_folder")
+        msg = self.assert_bake_fails("Cache Directory", "not_a_folder",
+                                     "(Physics Properties › Plume › Cache) is not writable")
         self.assertFalse(os.path.exists(os.path.join(blocker, "cache")), msg)
 
     def test_non_manifold_obstacle(self):

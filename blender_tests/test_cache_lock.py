@@ -284,7 +284,7 @@ class CacheLockTest(unittest.TestCase):
         run_cancelled(PLUME_OT_bake, BakeJob(), after=2)
         self.assertFalse(os.path.exists(self.lock_file()), "cancelled bake kept its lock")
         self.domain.plume.domain.vorticity = -1.0  # refused in prepare(), after the lock
-        self.assert_refused("vorticity")
+        self.assert_refused("Vorticity (ε) (Physics Properties › Plume › Forces)")
         self.assertFalse(os.path.exists(self.lock_file()))
         self.domain.plume.domain.vorticity = 0.0
         self.assert_baked()
@@ -338,7 +338,8 @@ class CacheLockTest(unittest.TestCase):
         with open(blocker, "w") as f:
             f.write("x")
         self.domain.plume.domain.cache_directory = os.path.join(blocker, "cache") + "/"
-        self.assert_refused("cache_directory", "not_a_folder", "not writable")
+        self.assert_refused("Cache Directory", "not_a_folder",
+                            "(Physics Properties › Plume › Cache) is not writable")
 
 
 if __name__ == "__main__":

@@ -352,7 +352,8 @@ class FlamesTest(unittest.TestCase):
         src.plume.flame.color_image = None
         src.plume.flame.color_source = 'PROFILE'
         src.plume.role = 'NONE'
-        assert_reports_error(self, op, r"no Flame Source", state)
+        assert_reports_error(self, op, r"no Flame Source: select a mesh and press "
+                             r"Physics Properties › Plume › Flame Source", state)
 
     def test_noise_settings_reach_the_bake(self):
         """§4.2: the spine's Kolmogorov noise moves the candle's control points (off, eq. 1

@@ -252,7 +252,8 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         assert_reports_error(self, op, "different domain sizes", self.state)
         # Synthesis without a graph.
         select_only(other)
-        assert_reports_error(self, bpy.ops.plume.fire_synthesize, "has no flow graph yet",
+        assert_reports_error(self, bpy.ops.plume.fire_synthesize,
+                             "has no flow graph yet.*Build Flow Graph first",
                              self.state)
 
     def test_3_point_preview(self):

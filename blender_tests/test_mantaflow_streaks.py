@@ -256,7 +256,7 @@ class MantaflowStreaksTest(unittest.TestCase):
         select_only(dom)
         # No temperature in a traced cache: the TEMPERATURE colour driver is refused.
         assert_reports_error(self, bpy.ops.plume.toon_build, "carries density and velocity "
-                             "only.*DENSITY or SPEED",
+                             "only: set Colour Driver to Density or Speed",
                              lambda: (datablock_counts(), tree_listing(folder)))
         t.color_driver = 'DENSITY'
         self.assertEqual(bpy.ops.plume.toon_build(), {'FINISHED'})

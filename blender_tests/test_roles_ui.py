@@ -189,6 +189,33 @@ class RolesUiTest(unittest.TestCase):
         self.assertIn(("operator", "plume.cache_free"), cache_log)
         self.assertTrue(any(e[0] == "label" and e[1].startswith("Frames: 0 / 50") for e in cache_log))
 
+    def test_messages_name_the_panel_that_draws_the_setting(self):
+        """A bake's message names a domain setting by its label and the panel that draws it
+        (setting_paths.py): every setting of that table is drawn by the panel it names."""
+        from plume import ui
+        from plume import setting_paths
+        panels = {cls.bl_label: cls for cls in ui.classes
+                  if getattr(cls, "bl_parent_id", "") == "PHYSICS_PT_plume"}
+        for role, table in (('DOMAIN', setting_paths.DOMAIN_PANELS),
+                            ('SOURCE', setting_paths.SOURCE_PANELS)):
+            bpy.ops.plume.role_set(role=role)
+            for label, names in table:
+                log = draw_panel(self, panels[label], self.cube)
+                drawn = {name for kind, name in log if kind == "prop"}
+                self.assertLessEqual(set(names), drawn, label)
+        self.assertEqual(
+            setting_paths.in_ui_words("Plume: domain 'Cube': turbulence_scale must be in [0, 9]; "
+                                      "turbulence_rate too (got -1)"),
+            "Plume: domain 'Cube': Turbulence Size (Physics Properties › Plume › Forces) must be "
+            "in [0, 9]; Turbulence Speed too (got -1)")
+        self.assertEqual(
+            setting_paths.in_ui_words("Plume: source 'S': candidate_split 2 needs 4 point "
+                                      "sources: lower candidate_split"),
+            "Plume: source 'S': Split Into Groups (Physics Properties › Plume › Source) 2 needs "
+            "4 point sources: lower Split Into Groups")
+        unknown = "Plume: domain 'Cube': 3 streaklines over 5 frames"
+        self.assertEqual(setting_paths.in_ui_words(unknown), unknown)
+
     def test_panel_hidden_without_object(self):
         context = SimpleNamespace(object=None, active_object=None)
         self.assertFalse(bpy.types.PHYSICS_PT_plume.poll(context))

@@ -126,7 +126,7 @@ class StreakDefaultsTest(unittest.TestCase):
         folder = os.path.join(self.tmp, "Domain")
         assert_reports_error(
             self, bpy.ops.plume.bake, r"streaklines over 5000 frames hold [0-9.]+ GB of "
-            r"particles, more than the [0-9.]+ GB of memory free: lower max_streaklines",
+            r"particles, more than the [0-9.]+ GB of memory free: lower Max Streaklines",
             lambda: (tree_listing(folder), len(bpy.data.objects), len(bpy.data.volumes)))
         self.assertFalse(os.path.exists(folder))
 
@@ -135,7 +135,8 @@ class StreakDefaultsTest(unittest.TestCase):
         dom.plume.domain.max_streaklines = 1
         folder = os.path.join(self.tmp, "Domain")
         assert_reports_error(self, bpy.ops.plume.bake,
-                             r"max_streaklines must be 0 \(no limit\) or in \[2, ",
+                             r"Max Streaklines \(Physics Properties › Plume › Streak "
+                             r"Surfaces\) must be 0 \(no limit\) or in \[2, ",
                              lambda: tree_listing(folder))
 
 

@@ -111,6 +111,10 @@ def counts():
             len(bpy.data.curves))
 
 
+#: Where the Source panel is, as the messages name it
+AT = r"\(Physics Properties › Plume › Source\)"
+
+
 class StreakSourcesTest(unittest.TestCase):
     def setUp(self):
         reset_scene()
@@ -173,10 +177,10 @@ class StreakSourcesTest(unittest.TestCase):
         dots = add_point_mesh([(0.0, 0.0, 0.5), (0.5, 0.0, 0.5), (3.0, 0.0, 0.5)])
         src.plume.source.point_source_mesh = dots
         select_only(dom)
-        self.assert_bake_error(r"source 'Source': 1 of the 3 vertices of point_source_mesh 'Dots' "
-                               r"lie outside domain 'Domain' .*vertex 2 at \(3, 0, 0\.5\)")
+        self.assert_bake_error(r"source 'Source': 1 of the 3 vertices of its Point Source Mesh "
+                               r"'Dots' lie outside domain 'Domain' .*vertex 2 at \(3, 0, 0\.5\)")
         src.plume.source.point_source_mesh = add_point_mesh([], name="Empty")
-        self.assert_bake_error(r"source 'Source': point_source_mesh 'Empty' has no vertices")
+        self.assert_bake_error(rf"source 'Source': Point Source Mesh {AT} 'Empty' has no vertices")
         # A script can bypass the property's poll; the bake still refuses a non-mesh.
         curve = bpy.data.objects.new("Path", bpy.data.curves.new("Path", 'CURVE'))
         bpy.context.scene.collection.objects.link(curve)
@@ -185,12 +189,12 @@ class StreakSourcesTest(unittest.TestCase):
         except (TypeError, ValueError, RuntimeError):
             pass
         else:
-            self.assert_bake_error(r"point_source_mesh 'Path' must be a mesh object")
+            self.assert_bake_error(rf"Point Source Mesh {AT} 'Path' must be a mesh object")
         # Two vertices cannot make two groups of two.
         src.plume.source.point_source_mesh = add_point_mesh([(0, 0, 0.5), (0.1, 0, 0.5)], "Two")
         src.plume.source.candidate_split = 2
-        self.assert_bake_error(r"source 'Source': candidate_split 2 needs at least 4 point "
-                               r"sources .*it has 2")
+        self.assert_bake_error(rf"source 'Source': Split Into Groups {AT} 2 needs "
+                               r"at least 4 point sources .*it has 2.*lower Split Into Groups")
 
     # ------------------------------------------------------------------ split into groups
     def test_split_groups_pure(self):
@@ -244,12 +248,14 @@ class StreakSourcesTest(unittest.TestCase):
         dom, src = build_scene(self.cache)
         for value in (0, 65, -1):
             src.plume.source.candidate_split = value
-            self.assert_bake_error(r"source 'Source': candidate_split must be in \[1, 64\] "
+            self.assert_bake_error(rf"source 'Source': Split Into Groups {AT} must be "
+                                   r"in \[1, 64\] "
                                    rf"candidate groups \(got {value}\)")
         src.plume.source.candidate_split = 64
         src.plume.source.point_placement = 'CELLS'
         src.plume.source.point_sources = 1
-        self.assert_bake_error(r"candidate_split 64 needs at least 128 point sources")
+        self.assert_bake_error(rf"Split Into Groups {AT} 64 needs at least 128 "
+                               r"point sources")
 
     def test_hand_groups_from_vertex_groups(self):
         """§3.3 manual grouping (Figure 3(b)): the vertex groups of a point source mesh are
@@ -263,7 +269,8 @@ class StreakSourcesTest(unittest.TestCase):
         src.plume.source.point_source_mesh = dots
         select_only(dom)
         # A hand group of one vertex cannot make a surface: refused, named, nothing written.
-        self.assert_bake_error(r"point_source_mesh 'Ring': vertex group 'Right' holds 1 vertex; a "
+        self.assert_bake_error(rf"Point Source Mesh {AT} 'Ring': vertex group "
+                               r"'Right' holds 1 vertex; a "
                                r"hand-made candidate group needs at least 2")
         dots.vertex_groups["Right"].add([6, 7, 8], 1.0, 'REPLACE')
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
@@ -371,7 +378,8 @@ class StreakSourcesTest(unittest.TestCase):
         fcurve = compat.fcurves(src).find("plume.source.density")
         fcurve.keyframe_points[1].co.y = -1.0
         select_only(dom)
-        self.assert_bake_error(r"source 'Source': density must be >= 0 \(got -1\.0 at frame 3\)")
+        self.assert_bake_error(rf"source 'Source': Density {AT} must be >= 0 "
+                               r"\(got -1\.0 at frame 3\)")
 
     def test_bad_tracer_checkpoint_starts_over(self):
         dom, _src = build_scene(self.cache, frame_end=2)

@@ -345,19 +345,22 @@ class StreakBadInputTest(unittest.TestCase):
     def test_baked_without_streaks(self):
         build_scene(self.cache, frame_end=2, streaks=False)
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        self.assert_error(r"baked without streak surfaces")
+        self.assert_error(r"baked without streak surfaces: turn on Streak Surfaces "
+                          r"\(Physics Properties › Plume › Streak Surfaces\)")
 
     def test_group_with_one_source(self):
         build_scene(self.cache, frame_end=2, point_sources=1)
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
-        self.assert_error(r"candidate group 0 has a single point source")
+        self.assert_error(r"candidate group 0 has a single point source.*raise the source's "
+                          r"Point Sources")
 
     def test_bad_emission_period_writes_nothing(self):
         dom = build_scene(self.cache, frame_end=2)
         dom.plume.domain.emission_period = 0
         with self.assertRaises(RuntimeError) as ctx:
             bpy.ops.plume.bake()
-        self.assertIn("emission_period must be in [1, 100000]", str(ctx.exception))
+        self.assertIn("Emission Period (Physics Properties › Plume › Streak Surfaces) must be in "
+                      "[1, 100000]", str(ctx.exception))
         self.assertFalse(os.path.exists(self.cache))
 
 

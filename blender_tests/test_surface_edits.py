@@ -278,7 +278,8 @@ class SurfaceEditsTest(unittest.TestCase):
         for op in (bpy.ops.plume.surface_edits_clear, bpy.ops.plume.surfaces_export_mesh):
             with self.assertRaises(RuntimeError) as ctx:
                 op()
-            self.assertIn("has no streak surfaces: build them first", str(ctx.exception))
+            self.assertIn("has no streak surfaces: build them first (Physics Properties › Plume › "
+                          "Streak Surfaces › Build Surfaces)", str(ctx.exception))
         self.assertEqual(counts(), before)
         bpy.data.objects.remove(other, do_unlink=True)
 

@@ -310,7 +310,8 @@ class ToonSmokeTest(unittest.TestCase):
         d.toon.birth_spacing = 0.5
         cam = bpy.context.scene.camera
         bpy.context.scene.camera = None
-        assert_reports_error(self, op, "has no camera", lambda: state(self.folder))
+        assert_reports_error(self, op, "has no camera.*add a camera \\(Add › Camera\\)",
+                             lambda: state(self.folder))
         bpy.context.scene.camera = cam
         self.assertEqual(op(), {'FINISHED'})  # and with good input it builds
 

@@ -41,7 +41,8 @@ def sheet_file(ob, frame):
     sheet = cache.sheet_path(os.path.dirname(path), int(m.group(1)), f)
     if not os.path.isfile(sheet):
         raise BakeError(f"Plume: density map {sheet} of surface '{ob.name}' is missing: build "
-                        "the surfaces again (plume.surfaces_build)")
+                        "the surfaces again (Physics Properties › Plume › Streak Surfaces › Build "
+                        "Surfaces)")
     return sheet
 
 

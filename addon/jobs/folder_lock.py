@@ -180,7 +180,7 @@ class FolderLock:
     def __init__(self, folder, fd, record, made_dirs, on_lost):
         self.folder, self.path = folder, lock_path(folder)
         self.record, self.lost = record, False
-        #: The setting naming the folder in reports ("cache_directory '//x/'"), if any.
+        #: The setting naming the folder in reports ("the Cache Directory '//x/' (...)"), if any.
         self.setting = None
         self._fd, self._made, self._on_lost = fd, made_dirs, on_lost
         self._refreshed = time.monotonic()
@@ -320,8 +320,8 @@ def _try_once(folder, record):
 
 def acquire(folder, job, setting=None, on_lost=None):
     """The lock of cache folder `folder` for job title `job` (the folder is made when missing);
-    LockHeld naming the holder, BakeError naming `setting` (e.g. "cache_directory '//x/'") when
-    the folder cannot be written. on_lost() is called if the lock is taken from us (the file
+    LockHeld naming the holder, BakeError naming `setting` (e.g. "the Cache Directory '//x/'")
+    when the folder cannot be written. on_lost() is called if the lock is taken from us (the file
     deleted by hand and another writer started)."""
     folder = os.path.abspath(folder)
     what = setting or f"cache folder '{folder}'"

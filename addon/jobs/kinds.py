@@ -106,7 +106,8 @@ def surfaces(spec, job):
     plans = ss.plan_surfaces(native, groups, h0)
     if not plans:
         raise BakeError(f"Plume: threshold h0 = {h0} joins no two streaklines: raise "
-                        "streak_threshold (0 = the default mean of h)")
+                        "Threshold (h0) in Physics Properties › Plume › Streak Surfaces (0 = the "
+                        "default mean of h)")
     anims = []
     cell = float(m["cell_size"])
     lo = np.asarray(m["origin"], dtype=np.float64)

@@ -18,6 +18,7 @@ from ..jobs import JobRunner, folder_lock, registry
 from ..settings import BakeError
 from ..version import VERSION
 from ..snapshot import NOT_A_DOMAIN, active_domain, cache_folder_of, take_snapshot
+from .. import setting_paths
 
 
 def domain_key(name):
@@ -38,14 +39,18 @@ class BakeJob(JobRunner):
     def prepare(self, context):
         """Snapshot + the checks that need no solver; BakeError on bad input, nothing written
         (the child checks the rest, the emitters' voxels, before it writes anything)."""
-        snap = take_snapshot(context, addon_version=VERSION)
+        try:
+            snap = take_snapshot(context, addon_version=VERSION)
+            if snap.mantaflow is None:
+                bake_runner.check_input(snap, _native)
+        except BakeError as e:  # the setting named as its panel shows it
+            raise BakeError(setting_paths.in_ui_words(str(e))) from None
         self.domain_name = snap.domain_name
         self.objects = (snap.domain_name,)
-        if snap.mantaflow is None:
-            bake_runner.check_input(snap, _native)
         self.unburnt_fuel = fuel_warning.unburnt_fuel(snap)  # a warning: the bake runs
         self.claim(domain_key(snap.domain_name))
-        self.lock_folder(snap.cache_folder, f"cache_directory '{snap.cache_directory}'")
+        self.lock_folder(snap.cache_folder, f"the Cache Directory '{snap.cache_directory}' "
+                                             "(Physics Properties › Plume › Cache)")
         self.snapshot, self.folder = snap, snap.cache_folder
         self.set_progress(0, snap.frame_count, "frame")
 
@@ -75,7 +80,7 @@ class BakeJob(JobRunner):
         return ('WARNING' if result.cancelled else 'INFO'), text
 
     def error_text(self, exc):
-        return f"Plume: bake of '{self.domain_name}' failed: {exc}"
+        return setting_paths.in_ui_words(f"Plume: bake of '{self.domain_name}' failed: {exc}")
 
     def busy_text(self):
         return f"Plume: domain '{self.domain_name}' is already baking"

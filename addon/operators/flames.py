@@ -37,8 +37,9 @@ class FlamesJob(JobRunner):
         self.claim(FLAMES_KEY)
         snap = flames_snapshot(context)
         flames.validate_snapshot(snap)
-        self.lock_folder(snap.folder, "the flames' cache_directory "
-                                      f"'{context.scene.plume_flames.cache_directory}'")
+        self.lock_folder(snap.folder, "the flames' Cache folder "
+                                      f"'{context.scene.plume_flames.cache_directory}' "
+                                      "(Physics Properties › Plume › Flames)")
         self.objects = tuple(dict.fromkeys(src.name for src in snap.sources))
         self.snap, self.folder = snap, snap.folder
         self.set_progress(0, snap.frame_count, "frame")

@@ -15,7 +15,8 @@ class PLUME_OT_role_set(bpy.types.Operator):
     bl_label = "Set Plume Role"
     bl_options = {'REGISTER', 'UNDO'}
 
-    role: EnumProperty(name="Role", items=ROLE_ITEMS, default='DOMAIN')
+    role: EnumProperty(name="Role", items=ROLE_ITEMS, default='DOMAIN',
+                      description="What the objects become in a Plume simulation")
 
     def execute(self, context):
         active = context.active_object

@@ -21,17 +21,17 @@ def surface_targets(context, allow_baked=False):
     ob = context.active_object
     if ob is None:
         raise BakeError("Plume: no active object: select a Plume streak surface (made by "
-                        "plume.surfaces_build) or its domain")
+                        "Build Surfaces) or its domain")
     if CACHE_KEY in ob:
         obs = [ob] + [o for o in context.selected_objects if o is not ob and CACHE_KEY in o]
     elif ob.type == 'MESH' and ob.plume.role == 'DOMAIN':
         obs = [o for o in bpy.data.objects if o.get(DOMAIN_KEY) == ob.name and CACHE_KEY in o]
         if not obs:
             raise BakeError(f"Plume: domain '{ob.name}' has no streak surfaces: build them first "
-                            "(Build Surfaces, plume.surfaces_build)")
+                            "(Physics Properties › Plume › Streak Surfaces › Build Surfaces)")
     else:
         raise BakeError(f"Plume: '{ob.name}' is not a Plume streak surface: select a surface made "
-                        "by plume.surfaces_build, or its domain")
+                        "by Build Surfaces, or its domain")
     out = []
     for o in obs:
         if o.get(edits.BAKED_KEY) and not allow_baked:

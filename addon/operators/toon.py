@@ -41,8 +41,9 @@ class ToonJob(JobRunner):
         toon.check_bake(settings, manifest, domain.name)
         if scene.camera is None:
             raise BakeError(f"Plume: scene '{scene.name}' has no camera: the billboards face "
-                            "the scene camera and the outlines need its Depth pass; set "
-                            "scene.camera")
+                            "the scene camera and the outlines need its Depth pass: add a camera "
+                            "(Add › Camera) and make it the scene's (Scene Properties › Scene "
+                            "› Camera)")
         self.objects = (domain.name, scene.camera.name)  # the billboards face the camera
         self.claim(domain_key(domain.name))
         self.lock_folder(folder)

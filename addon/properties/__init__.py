@@ -20,7 +20,7 @@ ROLE_ITEMS = (
     ('DOMAIN', "Domain", "Box holding the smoke simulation grid", 'MESH_CUBE', 1),
     ('SOURCE', "Source", "Emits smoke (density, heat, fuel) into the domain", 'OUTLINER_OB_FORCE_FIELD', 2),
     ('OBSTACLE', "Obstacle", "Closed mesh the smoke flows around", 'MOD_PHYSICS', 3),
-    ('FLAME_SOURCE', "Flame Source", "Emits structural flames (flames_bake)", 'LIGHT_SUN', 4),
+    ('FLAME_SOURCE', "Flame Source", "Emits structural flames (Bake Flames)", 'LIGHT_SUN', 4),
 )
 
 

@@ -142,13 +142,15 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     # --- Advection ---
     advection: EnumProperty(
         name="Advection", default='BFECC',
+        description="How the smoke, heat and velocity are carried along the flow each step",
         items=(('SEMI_LAGRANGIAN', "Semi-Lagrangian", "Stable first-order backtrace (Stam 1999)"),
-               ('BFECC', "BFECC", "Back and forth error compensation (Kim et al. 2005; "
-                                  "smoke_surfaces.txt §3.1): sharper detail"),
+               ('BFECC', "BFECC", "Back and forth error compensation (Kim et al. 2005, "
+                                  "as in the Smoke Surfaces paper): sharper detail"),
                ('MACCORMACK', "MacCormack", "Selle et al. 2008: BFECC's accuracy with two passes "
                                             "instead of three (faster)")))
     interpolation: EnumProperty(
         name="Interpolation", default='MONOTONIC_CUBIC',
+        description="How the grid is sampled between cells when it is carried along the flow",
         items=(('LINEAR', "Linear", "Trilinear sampling"),
                ('MONOTONIC_CUBIC', "Monotonic Cubic", "Monotonic cubic sampling (Fedkiw 2001 eq. 12-13): "
                                                       "keeps small rolling features, no new extrema")))
@@ -222,7 +224,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                     "smoke of density ~1 at the smoke points")
     flame_smoke_point: FloatProperty(
         name="Smoke Point", default=SMOKE_POINT, soft_min=0.0, soft_max=2.0, unit='LENGTH',
-        description="§6.3: the minimum laminar flame height at which smoke first escapes from "
+        description="The minimum laminar flame height at which smoke first escapes from "
                     "the flame tip (m): flames shorter than this (|tip − base|) emit no smoke. "
                     f"The default, {SMOKE_POINT:g} m, keeps candles clean and lets torches' and "
                     "campfires' tall flames smoke (fuels' smoke points: ~0.02 m kerosene to "
@@ -234,9 +236,9 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     # --- Streak surfaces (smoke_surfaces.txt §3.2-3.4) ---
     pathlines: BoolProperty(
         name="Record Pathlines", default=False,
-        description="Record pathline groups during this fire bake for flow-graph fire "
-                    "(graph_fire_synthesis.txt §4.2): particles seeded at Δx/2 in the fuel "
-                    "cells every node step, integrated with RK4, sampled over their lifetime")
+        description="Record pathline groups during this fire bake for Flow-Graph Fire: "
+                    "particles seeded in the fuel cells every node step and followed over their "
+                    "lifetime (Graph-based Fire Synthesis paper)")
     pathline_nodes_per_frame: IntProperty(
         name="Nodes per Frame", default=4, min=RANGES["pathline_nodes_per_frame"][0],
         max=RANGES["pathline_nodes_per_frame"][1],
@@ -252,8 +254,8 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         description="Store the pathline samples as 16-bit floats (half the file size)")
     streaks: BoolProperty(
         name="Streak Surfaces", default=False,
-        description="Streak Surfaces: trace particles from point sources (smoke_surfaces.txt §3.2) "
-                    "during the bake, for plume.surfaces_build")
+        description="Trace particles from the Sources' point sources during the bake, for "
+                    "Streak Surfaces › Build Surfaces")
     emission_period: IntProperty(
         name="Emission Period", default=1, soft_min=1, soft_max=20,
         description="Steps between two particles of a point source (§3.2: one every step)")
@@ -270,9 +272,8 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                 "Trace the velocity of an existing Blender Mantaflow gas bake (OpenVDB cache) "
                 "instead of simulating; the volume frames hold the Mantaflow density, and "
                 "the streak surfaces and toon smoke follow its velocity")),
-        description="What moves the streak and toon particles (smoke_surfaces.txt §3.2: "
-                    "particles \"advected by the velocity field\"; cartoon_smoke.txt §2.1: "
-                    "\"we require only the output of a smoke simulator\")")
+        description="What moves the streak and toon particles: any smoke simulation's velocity "
+                    "will do, Plume's own or a Mantaflow bake")
     mantaflow_domain: PointerProperty(
         name="Mantaflow Domain", type=bpy.types.Object, poll=lambda _self, ob: is_gas_domain(ob),
         description="Blender fluid domain (type Gas, adaptive domain off) whose OpenVDB cache, "

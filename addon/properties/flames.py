@@ -21,19 +21,19 @@ PROFILE_ITEMS = (
     ('CUSTOM', "Custom Curve", "The profile r(s) drawn as a curve object (Profile Curve)"),
 )
 COLOR_ITEMS = (
-    ('PROFILE', "Profile Colours", "§5.1: the profile's own colour image, painted from "
+    ('PROFILE', "Profile Colours", "The profile's own colour image, painted from "
                                    "photographs (candle: blue base, yellow-white core, orange to "
                                    "red tip; torch and campfire: yellow base, orange, red tip)"),
-    ('IMAGE', "Colour Image", "§5.1: your reference photograph (Colour Image) mapped on the "
+    ('IMAGE', "Colour Image", "Your reference photograph (Colour Image) mapped on the "
                               "profile's side view, base at the bottom"),
     ('BLACKBODY', "Blackbody", "The blackbody colour of each particle's temperature "
                                "(Temperature × d(x)/I, §5.1: hotter regions are bluer)"),
 )
 SPREAD_ITEMS = (
     ('NONE', "Always Burning", "Every flame of the source burns from the first frame"),
-    ('MAPS', "Maps", "§6.2: greyscale images on the mesh's UVs give each flame's activation "
+    ('MAPS', "Maps", "Greyscale images on the mesh's UVs give each flame's activation "
                      "time (and optionally burn duration, intensity, diameter, height)"),
-    ('MODEL', "Spread Model", "§6.2 eq. 7: the flame front leaves the ignition point at "
+    ('MODEL', "Spread Model", "The flame front leaves the ignition point at "
                               "v_s = T_f / L (cos θ + h sin θ)"),
 )
 
@@ -45,16 +45,16 @@ def _image(name, what):
 class PlumeFlameSourceSettings(bpy.types.PropertyGroup):
     # --- Shape (§4.4, §5.1) ---
     profile: EnumProperty(name="Profile", items=PROFILE_ITEMS, default='CANDLE',
-                          description="§4.4, Figure 3: the normalized profile r(s) whose surface "
+                          description="The normalized profile r(s) whose surface "
                                       "of revolution around the spine is the visible flame")
     profile_curve: PointerProperty(
         name="Profile Curve", type=bpy.types.Object, poll=lambda _s, ob: ob.type == 'CURVE',
         description="Custom profile (§4.4): the first spline of this curve, drawn from the base "
                     "to the tip; local X is the radius, the longer of local Y and Z the height")
     color_source: EnumProperty(name="Colour", items=COLOR_ITEMS, default='PROFILE',
-                               description="§5.1: where each particle's base colour comes from "
+                               description="Where each particle's base colour comes from "
                                            "(its brightness comes from eq. 5-6)")
-    color_image: _image("Colour Image", "§5.1: a reference photograph (RGB) mapped on the 2D "
+    color_image: _image("Colour Image", "A reference photograph (RGB) mapped on the 2D "
                                         "profile's side view, base at the bottom, tip at the "
                                         "top: each particle's base colour and relative "
                                         "brightness (Colour: Colour Image)")
@@ -81,20 +81,20 @@ class PlumeFlameSourceSettings(bpy.types.PropertyGroup):
                     "diffusion and the buoyancy of the spine's points; >= 0")
     # --- Spread (§6.2) ---
     spread: EnumProperty(name="Spread", items=SPREAD_ITEMS, default='NONE',
-                         description="§6.2: when each flame of the source starts to burn")
-    activation_map: _image("Activation Map", "§6.2: greyscale on the UVs; value v starts the "
+                         description="When each flame of the source starts to burn")
+    activation_map: _image("Activation Map", "Greyscale on the UVs; value v starts the "
                                               "flame there at v × Time Scale seconds")
     time_scale: FloatProperty(name="Time Scale", default=2.0, soft_min=0.0, soft_max=60.0,
                               unit='TIME_ABSOLUTE',
                               description="Seconds for an activation-map value of 1; >= 0")
-    duration_map: _image("Duration Map", "§6.2: greyscale; the flame burns v × Duration Scale "
+    duration_map: _image("Duration Map", "Greyscale; the flame burns v × Duration Scale "
                                           "seconds (none: until the end)")
     duration_scale: FloatProperty(name="Duration Scale", default=5.0, soft_min=0.0,
                                   soft_max=60.0, unit='TIME_ABSOLUTE',
                                   description="Seconds of burning for a duration value of 1")
-    intensity_map: _image("Intensity Map", "§6.2: greyscale; multiplies the flame's intensity")
-    diameter_map: _image("Diameter Map", "§6.2: greyscale; multiplies the flame's radius r")
-    height_map: _image("Height Map", "§6.2: greyscale; multiplies H_p, H_i and H_max")
+    intensity_map: _image("Intensity Map", "Greyscale; multiplies the flame's intensity")
+    diameter_map: _image("Diameter Map", "Greyscale; multiplies the flame's radius r")
+    height_map: _image("Height Map", "Greyscale; multiplies H_p, H_i and H_max")
     ignition: PointerProperty(
         name="Ignition", type=bpy.types.Object,
         description="Spread model: where the fire starts (none: the source's origin)")
@@ -148,17 +148,17 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
     # --- Shape and detail (§4.4-4.5) ---
     particles_per_pixel: FloatProperty(
         name="Particles per Pixel", default=10.0, soft_min=0.1, soft_max=100.0,
-        description="§5.3: particles per pixel of the flame's projected area on the scene "
+        description="Particles per pixel of the flame's projected area on the scene "
                     "camera (the paper: about ten); > 0")
     max_particles: IntProperty(name="Max Particles", default=50000, soft_min=100,
                                soft_max=1000000,
                                description="Most particles per flame (the paper: 1,000 to 50,000)")
     merging: BoolProperty(name="Merging", default=True,
-                          description="§4.5: drop particles inside a neighbouring flame and "
+                          description="Drop particles inside a neighbouring flame and "
                                       "outside their own (flames appear to merge)")
     # --- Noise (§4.2 on the spine, §4.5 on the render particles) ---
     flow_noise: FloatProperty(name="Flow Noise", default=CANDLE["flow_noise"], soft_min=0.0, soft_max=1.0,
-                              description="§4.5: buoyancy (flow) noise amplitude, in widest "
+                              description="Buoyancy (flow) noise amplitude, in widest "
                                           "radii of the profile; 0 turns it off; in "
                                           + text('flames.flow_noise'))
     flow_noise_scale: FloatProperty(
@@ -177,7 +177,7 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
                     + text('flames.flow_noise_rotation'))
     kolmogorov: FloatProperty(name="Kolmogorov Noise", default=CANDLE["kolmogorov"], soft_min=0.0,
                               soft_max=0.1, unit='LENGTH', precision=4,
-                              description="§4.5: RMS displacement of the render particles by the "
+                              description="RMS displacement of the render particles by the "
                                           "Kolmogorov-spectrum turbulence (m); 0 turns it off; "
                                           "in " + text('flames.kolmogorov'))
     kolmogorov_scale: FloatProperty(
@@ -188,7 +188,7 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
     kolmogorov_frequency: FloatProperty(
         name="Kolmogorov Frequency (ν)", default=0.5, soft_min=0.0, soft_max=10.0,
         description="ν: how fast the render particles' Kolmogorov noise changes in place (Hz, "
-                    "§4.5: generated per frame); in " + text('flames.kolmogorov_frequency'))
+                    "Generated per frame); in " + text('flames.kolmogorov_frequency'))
     kolmogorov_drift: FloatVectorProperty(
         name="Kolmogorov Drift (c)", size=3, subtype='VELOCITY', unit='VELOCITY',
         default=(0.0, 0.0, 0.5), soft_min=-5.0, soft_max=5.0,
@@ -197,7 +197,7 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
     spine_noise: FloatProperty(
         name="Spine Noise", default=CANDLE["spine_noise"], soft_min=0.0, soft_max=0.5, unit='VELOCITY',
         precision=3,
-        description="§4.2, §7: RMS speed (m/s) of the Kolmogorov-spectrum velocity added to eq. "
+        description="RMS speed (m/s) of the Kolmogorov-spectrum velocity added to eq. "
                     "1 for every control point of the spines (the torch's \"thermal buoyancy and "
                     "Kolmogorov noise\"): the flames sway and curl; 0 turns it off; in "
                     + text('flames.spine_noise'))
@@ -227,12 +227,12 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
     wind_domain: PointerProperty(
         name="Wind Domain", type=bpy.types.Object,
         poll=lambda _s, ob: getattr(ob, "plume", None) is not None and ob.plume.role == 'DOMAIN',
-        description="§6.1: a baked Plume domain whose velocity adds to w, frame by frame, "
+        description="A baked Plume domain whose velocity adds to w, frame by frame, "
                     "where it holds smoke, or everywhere when baked with Velocity Everywhere "
                     "(the paper used a 40³ solver around obstacles)")
     use_obstacles: BoolProperty(
         name="Obstacles", default=True,
-        description="§6.1: spine points are pushed out of the scene's Obstacle objects (closed "
+        description="Spine points are pushed out of the scene's Obstacle objects (closed "
                     "meshes, voxelized at Voxel Size at the first frame)")
     # --- Rendering (§5) ---
     voxel_size: FloatProperty(name="Voxel Size", default=CANDLE["voxel_size"], soft_min=0.0005, soft_max=0.1,
@@ -248,7 +248,7 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
                     "looks as bright as the light it casts, both E × Light Unit)")
     opacity: FloatProperty(
         name="Opacity", default=1.0, soft_min=0.0, soft_max=20.0,
-        description="§5.3: absorption density where d = I, falling as (d/I)^2 with the "
+        description="Absorption density where d = I, falling as (d/I)^2 with the "
                     "particles' relative brightness: real flames are highly transparent, only "
                     "bright things show through their core; in [0, 10000]")
     heat_of_combustion: FloatProperty(
@@ -263,16 +263,20 @@ class PlumeFlamesSettings(bpy.types.PropertyGroup):
                     "(0.018 W in Blender's units, 683 lm/W); > 0")
     lights: BoolProperty(
         name="Flame Lights", default=True,
-        description="§5.2: a point light of radius h/3 at the middle of each flame, of power "
+        description="A point light of radius h/3 at the middle of each flame, of power "
                     "E × Light Unit and the flame's mean colour")
     cache_directory: StringProperty(
         name="Cache", subtype='DIR_PATH', default="//plume_cache/flames/",
         description="Folder of flames_####.vdb and spines_####.npz ('//' = next to the .blend)")
     # --- Built data ---
-    volume_object: StringProperty(name="Volume Object", default="")
-    spines_object: StringProperty(name="Spines Object", default="")
-    frames_baked: IntProperty(name="Frames Baked", default=0, min=0)
-    summary: StringProperty(name="Summary", default="")
+    volume_object: StringProperty(name="Volume Object", default="",
+                                  description="Name of the Volume object showing the flames bake")
+    spines_object: StringProperty(name="Spines Object", default="",
+                                  description="Name of the curve object showing the flame spines")
+    frames_baked: IntProperty(name="Frames Baked", default=0, min=0,
+                              description="Frames of the last flames bake available in the cache")
+    summary: StringProperty(name="Summary", default="",
+                            description="What the last flames bake made")
 
 
 classes = (PlumeFlameSourceSettings, PlumeFlamesSettings)

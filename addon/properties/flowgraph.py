@@ -43,6 +43,7 @@ class PlumeFlowGraphSettings(bpy.types.PropertyGroup):
                       description="Seed of the random walk (same seed, same fire)")
     traversal: EnumProperty(
         name="Traversal", default='BIASED',
+        description="How the random walk picks the next node of the flow graph",
         items=(('UNIFORM', "Random", "Every out-edge equally likely, p = 1/d(V_i) (§5.1)"),
                ('BIASED', "Temporal Bias", "The temporal edge with probability γ, the "
                                            "transitions share 1 − γ (eq. 12)")))

@@ -42,7 +42,7 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
         description="How many times a second the breakup's patches change")
     velocity: FloatVectorProperty(
         name="Initial Velocity", size=3, default=(0.0, 0.0, 0.0), subtype='VELOCITY', unit='VELOCITY',
-        description="Velocity given to the air in the source's cells, m/s (smoke_surfaces.txt §3.2)")
+        description="Velocity given to the air in the source's cells, m/s")
     motion_factor: FloatProperty(name="Motion Factor", default=1.0, soft_min=0.0, soft_max=2.0,
                                  description="Share of the source object's own motion added to its velocity")
     point_placement: EnumProperty(
@@ -50,19 +50,18 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
         items=(('RIM', "Rim",
                 "A ring of point sources around the source's outline, across the direction the "
                 "smoke leaves it (its Initial Velocity, else against gravity), one a cell apart, "
-                "cut into arcs of about 8 (each its own candidate group, §3.3): sheets that wrap "
+                "cut into arcs of about 8 (each its own candidate group): sheets that wrap "
                 "the smoke, a few per source"),
                ('CELLS', "Cells",
-                "Point Sources random points in every source cell (smoke_surfaces.txt §3.2: "
-                "\"10-20 point sources are placed randomly in a source cell\"): the paper's set-up "
+                "Point Sources random points in every source cell (10-20 in the Smoke Surfaces "
+                "paper): the paper's set-up "
                 "for a source one to four cells wide; a wide source fills the smoke's volume "
                 "with streaklines and its sheets fold many times over")),
-        description="Where this source's point sources are, when it has no Point Source Mesh "
-                    "(smoke_surfaces.txt §3.2)")
+        description="Where this source's point sources are, when it has no Point Source Mesh")
     point_sources: IntProperty(
         name="Point Sources", default=16, soft_min=1, soft_max=64,
-        description="Tracer point sources per source cell when Placement is Cells (10-20 in "
-                    "smoke_surfaces.txt §3.2)")
+        description="Tracer point sources per source cell when Placement is Cells (10-20 in the "
+                    "Smoke Surfaces paper)")
     candidate_group: IntProperty(
         name="Candidate Group", default=-1, soft_min=-1, soft_max=64,
         description="Streaklines are clustered only inside a candidate group (-1: the source's own group)")
@@ -70,13 +69,13 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
         name="Point Source Mesh", type=bpy.types.Object, poll=lambda _self, ob: ob.type == 'MESH',
         description="Mesh whose vertices (world space, evaluated at the domain's first frame) are "
                     "this source's point sources, one streakline each, instead of Point Sources "
-                    "random points per cell (smoke_surfaces.txt §3.2); they must lie in the "
-                    "domain. Its vertex groups, if any, are hand-made candidate groups (§3.3): "
+                    "random points per cell; they must lie in the "
+                    "domain. Its vertex groups, if any, are hand-made candidate groups: "
                     "streaklines of different groups never share a surface")
     emit_particles: BoolProperty(
         name="Emit Particles", default=True,
-        description="Emit streakline particles from this source's point sources (smoke_surfaces.txt "
-                    "§3.2, Figure 10): keyframe it off to leave a gap in the streaklines. Emission "
+        description="Emit streakline particles from this source's point sources: keyframe it off "
+                    "to leave a gap in the streaklines. Emission "
                     "pauses only on frames where no Source with point sources emits (every "
                     "streakline keeps the same particle count); while another source still emits, "
                     "this one's particles keep coming and carry the smoke's density there (zero "
@@ -84,15 +83,16 @@ class PlumeSourceSettings(bpy.types.PropertyGroup):
     candidate_split: IntProperty(
         name="Split Into Groups", default=1, soft_min=1, soft_max=64,
         description="Splits this source's point sources into this many candidate groups so that "
-                    "streaklines of different parts never share a surface (smoke_surfaces.txt "
-                    "§3.3): a Rim into this many arcs (1: arcs of about 8 point sources), other "
-                    "point sources into groups of equal count along their longest extent (1: no "
-                    "split); more than 1 replaces Candidate Group; validated at bake time to "
+                    "streaklines of different parts never share a surface: a Rim into this "
+                    "many arcs (1: arcs of about 8 point sources), other point sources into "
+                    "groups of equal count along their longest extent (1: no split); more than "
+                    "1 replaces Candidate Group; validated at bake time to "
                     f"{text('candidate_split')}")
 
 
 class PlumeObstacleSettings(bpy.types.PropertyGroup):
     slip: EnumProperty(
         name="Slip", default='NO_SLIP',
+        description="How the air moves along the obstacle's surface",
         items=(('NO_SLIP', "No Slip", "The air next to the obstacle moves with it"),
                ('FREE_SLIP', "Free Slip", "Only the normal part of the flow is stopped")))

@@ -75,6 +75,7 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
         description="Particle budget: emission, then birth stop when it is reached")
     integration: EnumProperty(
         name="Integration", default='EULER',
+        description="How the toon particles are moved through the velocity field each substep",
         items=(('EULER', "Euler", "Euler substeps, as the paper (§2.1)"),
                ('MIDPOINT', "Midpoint", "Explicit midpoint substeps (second order)")))
     cfl: FloatProperty(
@@ -141,8 +142,8 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
         update=_look_changed)
     use_freestyle: BoolProperty(
         name="Freestyle Lines", default=False,
-        description="Also draw Freestyle silhouette lines (render.use_freestyle with a Plume line "
-                    "set) as an alternative outline style")
+        description="Also draw Freestyle silhouette lines (turns on Render Properties › Freestyle "
+                    "with a Plume line set) as an alternative outline style")
     # --- Built data ---
     object_name: StringProperty(name="Toon Object", default="",
                                 description="Name of the point object of this domain's toon smoke")

@@ -13,8 +13,8 @@ from .. import blender_compat as compat
 from .. import cache
 from ..settings import BakeError, EmitterSnapshot, SourceParams
 
-NOT_A_DOMAIN = ("Plume: the active object is not a Plume domain "
-                "(set one with plume.role_set(role='DOMAIN'))")
+NOT_A_DOMAIN = ("Plume: the active object is not a Plume domain: select the domain, or make "
+                "a box one with Physics Properties › Plume › Domain")
 
 #: Roles that take part in a grid bake (Flame Sources belong to flames_bake).
 EMITTER_ROLES = {'SOURCE', 'OBSTACLE'}
