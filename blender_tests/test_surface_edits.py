@@ -131,6 +131,24 @@ class SurfaceEditsTest(unittest.TestCase):
         np.testing.assert_allclose(points_of(ob, evaluated), want, atol=1e-5,
                                    err_msg=f"{ob.name} on frame {frame}")
 
+    def test_0_a_sheet_shows_its_own_panel(self):
+        # Selecting a sheet shows how hand edits work and its buttons, in Properties › Object
+        # Data and in the viewport's sidebar; the domain does not get them.
+        from test_roles_ui import draw_panel
+        ob = self.obs[0]
+        for name in ("DATA_PT_plume_sheet", "VIEW3D_PT_plume_sheet"):
+            cls = getattr(bpy.types, name)
+            log = draw_panel(self, cls, ob)
+            self.assertIsNotNone(log, f"{name} on a sheet")
+            ops = {n for kind, n in log if kind == "operator"}
+            self.assertLessEqual({"plume.surface_edits_store", "plume.surface_edits_clear",
+                                  "plume.surfaces_bake_keyframes",
+                                  "plume.surfaces_export_mesh"}, ops)
+            labels = " ".join(n for kind, n in log if kind == "label")
+            self.assertIn("Tab into Edit Mode", labels)
+            self.assertIn("Changing frame after Edit Mode stores them", labels)
+            self.assertIsNone(draw_panel(self, cls, bpy.data.objects["Domain"]))
+
     def test_1_edit_moves_with_surface(self):
         ob, others = self.obs[0], self.obs[1:]
         edited = self.edit_on_frame(ob)

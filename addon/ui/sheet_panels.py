@@ -74,4 +74,4 @@ class VIEW3D_PT_plume_sheet(bpy.types.Panel):
         draw_sheet(self.layout, context.object)
 
 
-classes = [DATA_PT_plume_sheet, VIEW3D_PT_plume_sheet]
+classes = (DATA_PT_plume_sheet, VIEW3D_PT_plume_sheet)
