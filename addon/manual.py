@@ -4,8 +4,10 @@ a right click › Online Manual (F1) on any Plume button or setting opens the ma
 pipeline through Blender's manual map (bpy.utils.register_manual_map). No ``bpy`` here:
 manual_map() is the hook, registration.py registers it."""
 
-# The repository's public address: the one place to change when it moves. The README and the
-# manuals are read from its main branch.
+# The repository's public address: the one place to change when it moves (with the two literal
+# copies in __init__.py's bl_info and blender_manifest.toml, which test_tooltips compares). The
+# README and the manuals are read from its main branch. A placeholder until the project
+# publishes one: no public address exists yet, so these links do not open.
 REPOSITORY_URL = "https://github.com/plume-developers/plume"
 DOCS_URL = REPOSITORY_URL + "/blob/main/"
 
