@@ -129,8 +129,8 @@ class DiskFullTest(unittest.TestCase):
         make_room()
         msg = str(cm.exception)
         print("  report:", msg.strip())
-        for words in (reason, folder, "cache_directory", f"volume_{K:04d}.vdb",
-                      "frames finished before are kept"):
+        for words in (reason, folder, "Cache Directory", "Physics Properties › Plume › Cache",
+                      f"volume_{K:04d}.vdb", "frames finished before are kept"):
             self.assertIn(words, msg)
         m = read_manifest(folder)
         self.assertEqual(m["last_complete_frame"], K - 1)
