@@ -10,6 +10,7 @@ from ..operators.bake import is_baking, is_busy
 from .. import cache_state
 from ..operators import surfaces
 from ..properties import ROLE_ITEMS
+from .sheet_panels import draw_sheet_buttons
 
 
 class PlumePanel:
@@ -254,13 +255,7 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
             col.operator("plume.surfaces_fast_render", icon='RENDER_STILL')
         # On the built surfaces (all of this domain's; §5 hand edits, keyframes, mesh export).
         if d.surfaces_collection:
-            sub = col.column(align=True)
-            row = sub.row(align=True)
-            row.operator("plume.surface_edits_store", icon='EDITMODE_HLT')
-            row.operator("plume.surface_edits_clear", icon='X')
-            row = sub.row(align=True)
-            row.operator("plume.surfaces_bake_keyframes", icon='KEYINGSET')
-            row.operator("plume.surfaces_export_mesh", icon='MESH_GRID')
+            draw_sheet_buttons(col)
 
 
 class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):

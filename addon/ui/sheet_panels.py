@@ -38,40 +38,40 @@ def draw_sheet(layout, ob):
         box.label(text="Tab into Edit Mode to move control points", icon='INFO')
     for line in HOW_EDITS_WORK:
         box.label(text=line)
-    row = col.row(align=True)
+    draw_sheet_buttons(col)
+
+
+def draw_sheet_buttons(layout):
+    """Store / Clear Edits, Bake to Keyframes, Export Mesh (also on the domain's Streak
+    Surfaces panel, where they act on all of its sheets)."""
+    sub = layout.column(align=True)
+    row = sub.row(align=True)
     row.operator("plume.surface_edits_store", icon='EDITMODE_HLT')
     row.operator("plume.surface_edits_clear", icon='X')
-    row = col.row(align=True)
+    row = sub.row(align=True)
     row.operator("plume.surfaces_bake_keyframes", icon='KEYINGSET')
     row.operator("plume.surfaces_export_mesh", icon='MESH_GRID')
 
 
-class DATA_PT_plume_sheet(bpy.types.Panel):
+class SheetPanel:
+    """Shown when the active object is a smoke sheet."""
+
+    @classmethod
+    def poll(cls, context):
+        return is_sheet(context.object)
+
+    def draw(self, context):
+        draw_sheet(self.layout, context.object)
+
+
+class DATA_PT_plume_sheet(SheetPanel, bpy.types.Panel):
     bl_label = "Plume Smoke Sheet"
-    bl_space_type = 'PROPERTIES'
-    bl_region_type = 'WINDOW'
-    bl_context = "data"
-
-    @classmethod
-    def poll(cls, context):
-        return is_sheet(context.object)
-
-    def draw(self, context):
-        draw_sheet(self.layout, context.object)
+    bl_space_type, bl_region_type, bl_context = 'PROPERTIES', 'WINDOW', "data"
 
 
-class VIEW3D_PT_plume_sheet(bpy.types.Panel):
+class VIEW3D_PT_plume_sheet(SheetPanel, bpy.types.Panel):
     bl_label = "Smoke Sheet"
-    bl_space_type = 'VIEW_3D'
-    bl_region_type = 'UI'
-    bl_category = "Plume"
-
-    @classmethod
-    def poll(cls, context):
-        return is_sheet(context.object)
-
-    def draw(self, context):
-        draw_sheet(self.layout, context.object)
+    bl_space_type, bl_region_type, bl_category = 'VIEW_3D', 'UI', "Plume"
 
 
 classes = (DATA_PT_plume_sheet, VIEW3D_PT_plume_sheet)
