@@ -209,7 +209,7 @@ class MantaflowStreaksTest(unittest.TestCase):
 
     def test_no_mantaflow_domain_set(self):
         dom = plume_domain("NoManta", self.tmp, None)
-        self.expect_error(dom, "mantaflow_domain is not set")
+        self.expect_error(dom, "Mantaflow Domain is not set", "Physics Properties › Plume › Cache")
 
     def test_mantaflow_domain_not_baked(self):
         gas = unbaked_gas_domain(os.path.join(self.tmp, "never_baked"), "Unbaked Gas")
