@@ -160,8 +160,9 @@ def check_source(m, frame_start, frame_end):
     only (the VDB files are checked when read)."""
     owner = f"Plume: domain '{m.domain_name}'"
     if not m.object_name:
-        raise BakeError(f"{owner}: motion_source is Mantaflow Cache but mantaflow_domain is not set: "
-                        "pick the Blender fluid domain (type Gas) whose cache moves the particles")
+        raise BakeError(f"{owner}: motion_source is Mantaflow Cache but mantaflow_domain is not "
+                        "set: pick the Blender fluid domain (type Gas) whose cache moves the "
+                        "particles")
     name = f"Plume: Mantaflow domain '{m.object_name}'"
     if not m.is_gas_domain:
         raise BakeError(f"{owner}: mantaflow_domain '{m.object_name}' is not a Blender fluid "
