@@ -1,7 +1,7 @@
 """The README's first recipe, "a candle in ten minutes", step by step through the operators and
 values it lists: a new General scene without its cube, the wax and wick cylinders, the wick made
 a Flame Source with its defaults, Bake Flames over frames 1-48, the camera at (0, -0.34, 0.1) m
-turned (90°, 0, 0) with a 50 mm lens, a black world, Auto Exposure, Cycles, render. The picture the recipe
+turned (90°, 0, 0) with a 50 mm lens, a black world, frame 48, Auto Exposure, Cycles, render. The picture the recipe
 promises: a small warm flame, lit and coloured, neither black nor white, under the Blender's
 own view transform. Only the render's size and samples are set here (the recipe leaves
 Blender's, which would take minutes): 480 x 270, 32 samples.
@@ -64,7 +64,7 @@ class RecipeCandleTest(unittest.TestCase):
         cam.data.lens = LENS
         world = scene.world.node_tree.nodes["Background"]  # World › Surface › Color: black
         world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-        scene.frame_set(FRAME_END)
+        scene.frame_set(FRAME_END)  # the Timeline's current frame (on frame 1 the flame is a blob)
         assert bpy.ops.plume.flames_auto_exposure() == {'FINISHED'}
         scene.render.engine = 'CYCLES'
         scene.cycles.device = 'CPU'
