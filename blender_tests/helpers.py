@@ -115,6 +115,32 @@ def incense_streak_scene(cache_dir, resolution, frames, point_sources=10):
     return dom
 
 
+def recipe_new_file():
+    """A manual recipe's first step: File › New › General, the add-on enabled, the cube deleted."""
+    bpy.ops.wm.read_homefile(use_factory_startup=True)
+    enable_addon()
+    bpy.ops.object.select_all(action='DESELECT')
+    bpy.data.objects["Cube"].select_set(True)
+    bpy.ops.object.delete()
+
+
+def recipe_sphere_domain(cache_directory, streaks=False):
+    """The recipes' smoke scene, as they list it: a UV sphere (radius 0.25 m at z 0.35 m) made
+    the Source and hidden from renders, a 2 m cube at z 1 m made the Domain (Resolution 40, End
+    60, Streak Surfaces when `streaks`), baked. Returns the domain."""
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.25, location=(0.0, 0.0, 0.35))
+    assert bpy.ops.plume.role_set(role='SOURCE') == {'FINISHED'}
+    bpy.context.active_object.hide_render = True
+    bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.0, 0.0, 1.0))
+    dom = bpy.context.active_object
+    assert bpy.ops.plume.role_set(role='DOMAIN') == {'FINISHED'}
+    d = dom.plume.domain
+    d.resolution, d.frame_end, d.streaks = 40, 60, streaks
+    d.cache_directory = cache_directory
+    assert bpy.ops.plume.bake() == {'FINISHED'}
+    return dom
+
+
 def add_cube_obstacle(size=0.3, location=(0.45, 0.0, 1.1), name="Obstacle"):
     bpy.ops.mesh.primitive_cube_add(size=size, location=location)
     ob = bpy.context.active_object

@@ -19,7 +19,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 
 import fire_look  # noqa: E402
-from helpers import OUT_DIR, image_pixels, rmtree, run, temp_dir  # noqa: E402
+from helpers import OUT_DIR, image_pixels, recipe_new_file, rmtree, run, temp_dir  # noqa: E402
 
 #: The recipe's values.
 WAX = dict(radius=0.012, depth=0.08, location=(0.0, 0.0, 0.04))
@@ -41,15 +41,8 @@ class RecipeCandleTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = temp_dir("plume_recipe_candle_")
-        bpy.ops.wm.read_homefile(use_factory_startup=True)  # File › New › General
-        from helpers import enable_addon
-        enable_addon()
+        recipe_new_file()
         scene = bpy.context.scene
-        cube = bpy.data.objects["Cube"]
-        for ob in bpy.context.view_layer.objects:
-            ob.select_set(ob == cube)
-        bpy.context.view_layer.objects.active = cube
-        bpy.ops.object.delete()
         bpy.ops.mesh.primitive_cylinder_add(**WAX)
         bpy.ops.mesh.primitive_cylinder_add(**WICK)
         cls.wick = bpy.context.active_object

@@ -22,7 +22,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import OUT_DIR, enable_addon, image_pixels, rmtree, run, temp_dir  # noqa: E402
+from helpers import (OUT_DIR, image_pixels, recipe_new_file, recipe_sphere_domain,  # noqa: E402
+                     rmtree, run, temp_dir)
 
 EDIT_FRAME, LATER_FRAME = 30, 40
 MOVE = np.array([0.1, 0.0, 0.05], dtype=np.float32)
@@ -43,22 +44,10 @@ class RecipeSheetsTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = temp_dir("plume_recipe_sheets_")
-        bpy.ops.wm.read_homefile(use_factory_startup=True)  # File › New › General
-        enable_addon()
+        recipe_new_file()
         scene = bpy.context.scene
-        bpy.ops.object.select_all(action='DESELECT')
-        bpy.data.objects["Cube"].select_set(True)
-        bpy.ops.object.delete()
-        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.25, location=(0.0, 0.0, 0.35))
-        assert bpy.ops.plume.role_set(role='SOURCE') == {'FINISHED'}
-        bpy.context.active_object.hide_render = True
-        bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.0, 0.0, 1.0))
-        dom = cls.dom = bpy.context.active_object
-        assert bpy.ops.plume.role_set(role='DOMAIN') == {'FINISHED'}
+        dom = cls.dom = recipe_sphere_domain(cls.tmp + "/", streaks=True)
         d = dom.plume.domain
-        d.resolution, d.frame_end, d.streaks = 40, 60, True
-        d.cache_directory = cls.tmp + "/"
-        assert bpy.ops.plume.bake() == {'FINISHED'}
         assert bpy.ops.plume.surfaces_build() == {'FINISHED'}
         cls.sheets = sorted((o for o in bpy.data.objects if o.type == 'SURFACE'),
                             key=lambda o: o.name)
