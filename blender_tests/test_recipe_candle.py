@@ -1,31 +1,30 @@
-"""The README's first recipe, "a candle in ten minutes", step by step through the operators and
-values it lists: a new General scene without its cube, the wax and wick cylinders, the wick made
-a Flame Source with its defaults, Bake Flames over frames 1-48, the camera at (0, -0.34, 0.1) m
-turned (90°, 0, 0) with a 50 mm lens, a black world, frame 48, Auto Exposure, Cycles, render. The picture the recipe
-promises: a small warm flame, lit and coloured, neither black nor white, under the Blender's
-own view transform. Only the render's size and samples are set here (the recipe leaves
-Blender's, which would take minutes): 480 x 270, 32 samples.
+"""The README's first recipe, "a candle in ten minutes", performed by its own steps
+(`examples/flames/recipe_candle.py`, which the screenshots run too): a new General scene without
+its cube, the wax and wick cylinders, the wick made a Flame Source with its defaults, Bake Flames
+over frames 1-48, the camera at (0, -0.34, 0.1) m turned (90°, 0, 0) with a 50 mm lens, a black
+world, frame 48, Auto Exposure, Cycles, render. The picture the recipe promises: a small warm
+flame, lit and coloured, neither black nor white, under the Blender's own view transform. Only
+the render's size and samples are set here (the recipe leaves Blender's, which would take
+minutes): 480 x 270, 32 samples.
 
 Run: python3 blender_tests/run.py --blender 5.3 test_recipe_candle.py
 """
 
-import math
 import os
 import sys
 import unittest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+EXAMPLES = os.path.join(os.path.dirname(HERE), "examples")
+sys.path[:0] = [HERE, EXAMPLES, os.path.join(EXAMPLES, "flames")]
 
 import bpy  # noqa: E402
 
 import fire_look  # noqa: E402
-from helpers import OUT_DIR, image_pixels, recipe_new_file, rmtree, run, temp_dir  # noqa: E402
+import recipe_candle  # noqa: E402  (the recipe's steps, shared with its screenshots)
+import recipe_kit  # noqa: E402
+from helpers import OUT_DIR, image_pixels, rmtree, run, temp_dir  # noqa: E402
 
-#: The recipe's values.
-WAX = dict(radius=0.012, depth=0.08, location=(0.0, 0.0, 0.04))
-WICK = dict(vertices=8, radius=0.0008, depth=0.008, location=(0.0, 0.0, 0.082))
-FRAME_END = 48
-CAMERA_LOCATION, CAMERA_ROTATION_DEG, LENS = (0.0, -0.34, 0.1), (90.0, 0.0, 0.0), 50.0
 #: The flame's share of the frame (lit pixels), hue, clipped-white share and blue base (pixels).
 #: Measured: lit 3.6 % (bpy 5.3, AgX) and 4.1 % (3.4.1, Filmic), hue 28.3° and 33.7°, white
 #: 0.3 % and 1.1 %, blue 400 and 409 px. A flame a few centimetres tall seen from 34 cm covers
@@ -41,25 +40,9 @@ class RecipeCandleTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = temp_dir("plume_recipe_candle_")
-        recipe_new_file()
+        cls.wick = recipe_kit.run(recipe_candle.steps(cls.tmp + "/"))
         scene = bpy.context.scene
-        bpy.ops.mesh.primitive_cylinder_add(**WAX)
-        bpy.ops.mesh.primitive_cylinder_add(**WICK)
-        cls.wick = bpy.context.active_object
-        assert bpy.ops.plume.role_set(role='FLAME_SOURCE') == {'FINISHED'}
-        flames = scene.plume_flames
-        flames.frame_end = FRAME_END
-        flames.cache_directory = cls.tmp + "/"
-        assert bpy.ops.plume.flames_bake() == {'FINISHED'}
-        cam = scene.camera
-        cam.location = CAMERA_LOCATION
-        cam.rotation_euler = tuple(math.radians(a) for a in CAMERA_ROTATION_DEG)
-        cam.data.lens = LENS
-        world = scene.world.node_tree.nodes["Background"]  # World › Surface › Color: black
-        world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-        scene.frame_set(FRAME_END)  # the Timeline's current frame (on frame 1 the flame is a blob)
-        assert bpy.ops.plume.flames_auto_exposure() == {'FINISHED'}
-        scene.render.engine = 'CYCLES'
+        assert scene.render.engine == 'CYCLES'
         scene.cycles.device = 'CPU'
         scene.cycles.samples = 32
         scene.cycles.use_denoising = False

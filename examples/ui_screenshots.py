@@ -1,77 +1,131 @@
-"""Screenshots of the real panels for the README's candle recipe, taken in a windowed Blender
-(timers and screen operators need a window; `.ci/screenshots` runs this under Xvfb):
+"""Screenshots of the real panels for the manuals' recipes, taken in a windowed Blender (timers
+and screen operators need a window; `bash .ci/screenshots` runs this under Xvfb):
 
-    xvfb-run -a -s "-screen 0 1600x1000x24" blender --factory-startup \
-        --python examples/ui_screenshots.py -- OUT_DIR
+    xvfb-run -a -s "-screen 0 960x1000x24" blender --python examples/ui_screenshots.py -- \
+        OUT_ROOT [RECIPE ...]
 
-Builds the recipe's scene up to its Flame Source (the wick made one, with the Candle defaults),
-then maximizes the Properties editor on each tab the recipe uses and saves it:
-OUT_DIR/ui_flame_source.png (Properties › Physics › Plume with the wick selected: the Flame
-Source and Flames panels, where the recipe presses Bake Flames and Auto Exposure). Prints each
-path with the Blender version (the README's caption says which Blender drew it), then quits.
+Runs every recipe `examples/<pipeline>/recipe_<name>.py` (or those named, e.g. `candle`) through
+its own steps (examples/recipe_kit.py) and, at each Shot it yields, maximizes the editor the Shot
+names, shows its tab, lets Blender draw it and saves it as OUT_ROOT/<pipeline>/images/<image>.
+Prints each path with the Blender version (the manuals' captions say which Blender drew it),
+then quits; a recipe step that fails quits with status 1.
 """
 
+import glob
+import importlib.util
 import os
 import sys
+import tempfile
+import traceback
 
 import bpy
 
-#: (file name, Properties tab) of each screenshot, in order.
-SHOTS = (("ui_flame_source.png", 'PHYSICS'),)
-#: Timer steps (0.3 s) given to Blender to draw a tab before it is saved.
+EXAMPLES = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, EXAMPLES)
+#: Timer steps (0.3 s) given to Blender to draw an editor before it is saved.
 SETTLE_STEPS = 3
 
 
-def recipe_scene():
-    """The README's candle up to step 4: the wax and wick cylinders, the wick a Flame Source."""
-    import addon_utils
-    addon_utils.enable("plume", default_set=True)
-    bpy.ops.object.select_all(action='SELECT')
-    bpy.ops.object.select_by_type(type='MESH')
-    bpy.ops.object.delete()
-    bpy.ops.mesh.primitive_cylinder_add(radius=0.012, depth=0.08, location=(0.0, 0.0, 0.04))
-    bpy.ops.mesh.primitive_cylinder_add(vertices=8, radius=0.0008, depth=0.008,
-                                        location=(0.0, 0.0, 0.082))
-    bpy.context.active_object.name = "Wick"
-    if bpy.ops.plume.role_set(role='FLAME_SOURCE') != {'FINISHED'}:
-        raise RuntimeError("ui_screenshots: could not make the wick a Flame Source")
+def recipes(names):
+    """[(pipeline folder, recipe module)] of every recipe file, or of those named."""
+    found = []
+    for path in sorted(glob.glob(os.path.join(EXAMPLES, "*", "recipe_*.py"))):
+        name = os.path.basename(path)[len("recipe_"):-3]
+        if names and name not in names:
+            continue
+        folder = os.path.dirname(path)
+        sys.path.insert(0, folder)  # a recipe may import its pipeline's kit
+        spec = importlib.util.spec_from_file_location(f"recipe_{name}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        found.append((os.path.basename(folder), module))
+    missing = set(names) - {m.__name__[len("recipe_"):] for _, m in found}
+    if missing:
+        raise SystemExit(f"ui_screenshots: no recipe named {', '.join(sorted(missing))}")
+    return found
 
 
-def properties_area(window):
-    return max((a for a in window.screen.areas if a.type == 'PROPERTIES'),
+def viewport(window):
+    """The context of a click in the 3D Viewport, where a recipe's steps happen."""
+    area = max((a for a in window.screen.areas if a.type == 'VIEW_3D'),
+               key=lambda a: a.width * a.height, default=None)
+    if area is None:  # maximized Properties: the steps run in the window's context
+        return dict(window=window, screen=window.screen)
+    region = next(r for r in area.regions if r.type == 'WINDOW')
+    return dict(window=window, screen=window.screen, area=area, region=region)
+
+
+def show(window, shot):
+    """Maximizes the editor the shot names (restoring the layout first if another one is) and
+    returns its area."""
+    screen = window.screen
+    if len(screen.areas) == 1 and screen.areas[0].type != shot.editor:
+        with bpy.context.temp_override(window=window, area=screen.areas[0]):
+            bpy.ops.screen.back_to_previous()
+        screen = window.screen
+    area = max((a for a in screen.areas if a.type == shot.editor),
                key=lambda a: a.width * a.height)
+    if len(screen.areas) > 1:
+        with bpy.context.temp_override(window=window, area=area):
+            bpy.ops.screen.screen_full_area()
+        area = window.screen.areas[0]
+    if shot.editor == 'PROPERTIES':
+        area.spaces.active.context = shot.tab
+    return area
 
 
 def main():
-    out_dir = os.path.abspath(sys.argv[sys.argv.index("--") + 1])
-    os.makedirs(out_dir, exist_ok=True)
-    recipe_scene()
-    window = bpy.context.window
-    area = properties_area(window)
-    with bpy.context.temp_override(window=window, area=area):
-        bpy.ops.screen.screen_full_area()  # the Properties editor fills the window
-    state = {"shot": 0, "step": 0}
+    args = sys.argv[sys.argv.index("--") + 1:]
+    out_root, names = os.path.abspath(args[0]), args[1:]
+    todo = recipes(names)
+    cache = tempfile.mkdtemp(prefix="plume_screenshots_")
+    state = {"recipe": 0, "steps": None, "shot": None, "settle": 0}
+
+    def quit_with(code):
+        sys.stdout.flush()
+        if code:
+            os._exit(code)  # a failed step: no save prompt, no half-made picture set
+        bpy.ops.wm.quit_blender()
 
     def tick():
-        area = properties_area(window)
-        name, tab = SHOTS[state["shot"]]
-        area.spaces.active.context = tab
-        state["step"] += 1
-        if state["step"] < SETTLE_STEPS:
-            return 0.3
-        region = next(r for r in area.regions if r.type == 'WINDOW')
-        path = os.path.join(out_dir, name)
-        with bpy.context.temp_override(window=window, area=area, region=region):
-            bpy.ops.screen.screenshot_area(filepath=path)
-        print(f"ui_screenshots: {path} (Blender {bpy.app.version_string})", flush=True)
-        state["shot"] += 1
-        state["step"] = 0
-        if state["shot"] == len(SHOTS):
-            bpy.ops.wm.quit_blender()
+        try:
+            window = bpy.context.window_manager.windows[0]
+            if state["shot"] is None:  # the recipe's next steps, up to its next Shot
+                if state["steps"] is None:
+                    if state["recipe"] == len(todo):
+                        quit_with(0)
+                        return None
+                    folder, module = todo[state["recipe"]]
+                    state["folder"] = folder
+                    state["steps"] = module.steps(os.path.join(cache, folder) + "/")
+                try:
+                    with bpy.context.temp_override(**viewport(window)):
+                        state["shot"] = next(state["steps"])
+                except StopIteration:
+                    state["recipe"] += 1
+                    state["steps"] = None
+                    return 0.1
+                if state["shot"] is None:  # a file was read: its screen is drawn first
+                    return 0.3
+                state["settle"] = 0
+            area = show(window, state["shot"])
+            state["settle"] += 1
+            if state["settle"] < SETTLE_STEPS:
+                return 0.3
+            region = next(r for r in area.regions if r.type == 'WINDOW')
+            path = os.path.join(out_root, state["folder"], "images", state["shot"].image)
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with bpy.context.temp_override(window=window, area=area, region=region):
+                bpy.ops.screen.screenshot_area(filepath=path)
+            print(f"ui_screenshots: {path} (Blender {bpy.app.version_string})", flush=True)
+            state["shot"] = None
+            return 0.1
+        except Exception:
+            traceback.print_exc()
+            quit_with(1)
             return None
-        return 0.3
 
-    bpy.app.timers.register(tick, first_interval=1.0)
+    bpy.app.timers.register(tick, first_interval=1.0, persistent=True)
 
 
 if __name__ == "__main__":
