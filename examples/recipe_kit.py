@@ -51,3 +51,20 @@ def run(steps):
             next(steps)
         except StopIteration as end:
             return end.value
+
+
+def sphere_domain(cache_dir, streaks=False):
+    """The smoke recipes' shared steps: a UV sphere (radius 0.25 m at z 0.35 m) made the Source
+    and hidden from renders (Object Properties › Visibility › Renders off), a 2 m cube at z 1 m
+    made the Domain (Resolution 40, End 60, Streak Surfaces when `streaks`). Returns the domain;
+    the recipe bakes it (Bake) after its own settings."""
+    press(bpy.ops.mesh.primitive_uv_sphere_add, radius=0.25, location=(0.0, 0.0, 0.35))
+    press(bpy.ops.plume.role_set, role='SOURCE')
+    bpy.context.view_layer.objects.active.hide_render = True
+    press(bpy.ops.mesh.primitive_cube_add, size=2.0, location=(0.0, 0.0, 1.0))
+    domain = bpy.context.view_layer.objects.active
+    press(bpy.ops.plume.role_set, role='DOMAIN')
+    d = domain.plume.domain
+    d.resolution, d.frame_end, d.streaks = 40, 60, streaks
+    d.cache_directory = cache_dir
+    return domain

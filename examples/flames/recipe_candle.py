@@ -19,7 +19,7 @@ def steps(cache_dir):
     yield from new_file()                                   # 1. File › New › General, no cube
     press(bpy.ops.mesh.primitive_cylinder_add, **WAX)       # 2. the wax
     press(bpy.ops.mesh.primitive_cylinder_add, **WICK)      # 3. the wick
-    wick = bpy.context.active_object
+    wick = bpy.context.view_layer.objects.active
     wick.name = "Wick"
     press(bpy.ops.plume.role_set, role='FLAME_SOURCE')      # 4. Physics › Plume › Flame Source
     scene = bpy.context.scene
