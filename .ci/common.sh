@@ -7,7 +7,7 @@ SUDO=""
 [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 
 PACKAGES=(blender cmake g++ pybind11-dev libopenvdb-dev libglm-dev libosd-dev libtbb-dev
-          libboost-dev libboost-iostreams-dev googletest libgtest-dev libbenchmark-dev python3-pytest python3-numpy python3-matplotlib
+          libboost-dev libboost-iostreams-dev googletest libgtest-dev libbenchmark-dev python3-pytest python3-numpy python3-matplotlib python3-markdown
           xvfb xauth libgl1-mesa-dri python3-venv patchelf zip unzip binutils python3-openvdb
           ninja-build dpkg-dev clang-14 libclang-rt-14-dev)  # clang: .ci/fuzz's, installed here
 # so that no apt run of .ci/fuzz meets .ci/test's background download of the portable sources
@@ -71,6 +71,7 @@ install_addon() {
     mkdir -p "$dest"
     (cd "$ROOT/addon" && tar --exclude='__pycache__' -cf - .) | (cd "$dest" && tar -xf -)
     cp "$BUILD"/native/_native*.so "$dest/"
+    /usr/bin/python3 "$ROOT/blender_tests/install_zip/plume_manual.py" "$ROOT" "$dest/manual"
   done
 }
 

@@ -16,7 +16,8 @@ bl_info = {
     "description": "Smoke and fire simulation with streak surfaces, toon smoke, graph fire "
                    "and structural flames",
     "category": "Physics",
-    "doc_url": "https://github.com/plume-developers/plume/blob/main/README.md#readme",
+    # No doc_url: the manual ships inside the add-on (manual/), so its address depends on where
+    # Blender installed it; Edit › Preferences › Add-ons › Plume lists its pages instead.
 }
 
 

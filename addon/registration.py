@@ -7,14 +7,14 @@ if tuple(bpy.app.version) < (3, 4, 0):
                       "tested in 3.4.1 and 4.2 LTS to 5.3", name=__name__)
 
 from . import native  # noqa: E402,F401  (fails here, with a clear message)
-from . import cache_state, manual, operators, properties, ui  # noqa: E402
+from . import cache_state, manual, operators, preferences, properties, ui  # noqa: E402
 from .jobs import handlers as _job_handlers  # noqa: E402
 from .build import surfaces as _surfaces  # noqa: E402
 from .build import toon_points as _toon_points  # noqa: E402
 from .build import fire_points as _fire_points  # noqa: E402
 from .build import flame_spines as _flame_spines  # noqa: E402
 
-_classes = operators.classes + ui.classes
+_classes = operators.classes + ui.classes + preferences.classes
 
 
 def register():

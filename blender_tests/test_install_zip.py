@@ -179,6 +179,8 @@ class ZipLayoutTest(unittest.TestCase):
                           0o120000])
         # No lib/ folder of shared libraries any more: each module carries its own, statically.
         self.assertFalse([n for n in names if n.startswith("plume/lib/")], "a lib/ folder")
+        # The manual the help buttons open (plume_manual.py; test_help.py checks its links).
+        self.assertIn("plume/manual/index.html", names)
         # Blender 3.4 "Install add-on from file": a package folder whose __init__.py has bl_info.
         bl_info = self.bl_info()
         self.assertLessEqual(tuple(bl_info["blender"]), (3, 4, 0))

@@ -1,7 +1,6 @@
 """What Blender shows an artist about Plume's settings and buttons: every tooltip (property,
-enum item, operator, panel) is written in artist words — none empty, none citing a file — and
-the help: right click › Online Manual on any Plume button or setting opens its pipeline's
-manual, the add-on's Documentation / Website link opens the README.
+enum item, operator, panel) is written in artist words — none empty, none citing a file. Where
+help opens is test_help.py's.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_tooltips.py
@@ -14,13 +13,11 @@ import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-import addon_utils  # noqa: E402
 import bpy  # noqa: E402
 
 from helpers import enable_addon, run  # noqa: E402
 
 # A file name in a tooltip: "smoke_surfaces.txt", "notes.md", ...
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FILE_NAME = re.compile(r"\b[\w-]+\.(txt|md|pdf|py|json|toml)\b")
 
 
@@ -95,76 +92,5 @@ class TooltipTest(unittest.TestCase):
         self.assertEqual(bad, [], "empty tooltips: " + ", ".join(bad))
 
 
-class ManualTest(unittest.TestCase):
-    """Blender's own lookup (the Online Manual operator's) finds the Plume manual of each
-    operator and setting."""
-
-    def setUp(self):
-        self.groups, self.operators, _ = plume_classes()
-        from plume import manual
-        self.manual = manual
-        from bl_operators.wm import WM_OT_doc_view_manual
-        self.lookup = WM_OT_doc_view_manual._lookup_rna_url
-
-    def url(self, rna_id):
-        return self.lookup(rna_id, verbose=False)
-
-    def test_operator_opens_its_manual(self):
-        m = self.manual
-        for op, page in (("bpy.ops.plume.bake", m.SMOKE), ("bpy.ops.plume.role_set", m.SMOKE),
-                         ("bpy.ops.plume.surfaces_build", m.STREAKS),
-                         ("bpy.ops.plume.surface_edits_store", m.STREAKS),
-                         ("bpy.ops.plume.toon_build", m.TOON),
-                         ("bpy.ops.plume.flowgraph_build", m.FLOWGRAPH),
-                         ("bpy.ops.plume.fire_synthesize", m.FLOWGRAPH),
-                         ("bpy.ops.plume.flames_bake", m.FLAMES),
-                         ("bpy.ops.plume.flame_preset", m.FLAMES)):
-            self.assertEqual(self.url(op), m.DOCS_URL + page, op)
-
-    def test_setting_opens_its_manual(self):
-        m = self.manual
-        for rna_id, page in (("bpy.types.PlumeDomainSettings.resolution", m.SMOKE),
-                             ("bpy.types.PlumeDomainSettings.streak_threshold", m.STREAKS),
-                             ("bpy.types.PlumeDomainSettings.pathlines", m.FLOWGRAPH),
-                             ("bpy.types.PlumeDomainSettings.flame_smoke_point", m.FLAMES),
-                             ("bpy.types.PlumeSourceSettings.density", m.SMOKE),
-                             ("bpy.types.PlumeSourceSettings.point_sources", m.STREAKS),
-                             ("bpy.types.PlumeToonSettings.depth_threshold", m.TOON),
-                             ("bpy.types.PlumeFlowGraphSettings.gamma", m.FLOWGRAPH),
-                             ("bpy.types.PlumeFlamesSettings.opacity", m.FLAMES)):
-            self.assertEqual(self.url(rna_id), m.DOCS_URL + page, rna_id)
-
-    def test_every_operator_and_setting_has_a_manual(self):
-        ids = [f"bpy.ops.{cls.bl_idname}" for cls in self.operators]
-        ids += [f"bpy.types.{cls.__name__}.{prop.identifier}" for cls in self.groups
-                for prop in cls.bl_rna.properties if prop.identifier != "rna_type"]
-        missing = [i for i in ids if not (self.url(i) or "").startswith(self.manual.DOCS_URL)]
-        self.assertEqual(missing, [])
-
-    def test_manual_pages_exist(self):
-        pages = {page for _pattern, page in self.manual.PAGES} | {self.manual.README}
-        for page in pages:
-            self.assertTrue(os.path.isfile(os.path.join(REPO, page.split("#")[0])), page)
-
-    def test_addon_links_open_the_readme(self):
-        """bl_info's doc_url (Blender 3.4's Documentation button) and the manifest's website
-        (4.2+) are the README of the repository manual.py names."""
-        readme = self.manual.DOCS_URL + self.manual.README
-        mod = next(m for m in addon_utils.modules() if m.__name__.split(".")[-1] == "plume")
-        self.assertEqual(mod.bl_info["doc_url"], readme)
-        import tomllib
-        with open(os.path.join(os.path.dirname(mod.__file__), "blender_manifest.toml"), "rb") as f:
-            self.assertEqual(tomllib.load(f)["website"], readme)
-
-    def test_unregister_removes_the_map(self):
-        hook = self.manual.manual_map
-        self.assertIn(hook, bpy.utils._manual_map)
-        addon_utils.disable("plume", default_set=True)
-        try:
-            self.assertNotIn(hook, bpy.utils._manual_map)
-        finally:
-            enable_addon()
-
-
 if __name__ == "__main__":
-    run(TooltipTest, ManualTest)
+    run(TooltipTest)

@@ -5,6 +5,8 @@ scene settings also in the Scene tab."""
 import bpy
 
 from .panels import PlumePanel
+from .. import manual
+from ..operators.manual_open import draw_help
 from ..operators.flames import is_baking
 
 
@@ -124,6 +126,9 @@ class SCENE_PT_plume_flames(bpy.types.Panel):
     bl_region_type = 'WINDOW'
     bl_context = "scene"
     bl_options = {'DEFAULT_CLOSED'}
+
+    def draw_header_preset(self, context):
+        draw_help(self.layout, manual.FLAMES)
 
     def draw(self, context):
         draw_flames(self.layout, context.scene)

@@ -11,6 +11,8 @@ from .. import cache_state
 from ..operators import surfaces
 from ..properties import ROLE_ITEMS
 from .sheet_panels import draw_sheet_buttons
+from .. import manual
+from ..operators.manual_open import draw_help
 
 
 class PlumePanel:
@@ -26,6 +28,12 @@ class PlumePanel:
 
 class PlumeDomainPanel(PlumePanel):
     bl_parent_id = "PHYSICS_PT_plume"
+    #: The manual section the header's Help button (?) opens; None for no button.
+    manual_page = None
+
+    def draw_header_preset(self, context):
+        if self.manual_page:
+            draw_help(self.layout, self.manual_page)
 
     @classmethod
     def poll(cls, context):
@@ -39,6 +47,11 @@ class PHYSICS_PT_plume(PlumePanel, bpy.types.Panel):
     @classmethod
     def poll(cls, context):
         return context.object is not None and context.object.type == 'MESH'
+
+    def draw_header_preset(self, context):
+        role = context.object.plume.role
+        draw_help(self.layout, {'NONE': manual.INDEX, 'FLAME_SOURCE': manual.FLAMES}.get(
+            role, manual.SMOKE_USE))
 
     def draw(self, context):
         layout = self.layout
@@ -186,6 +199,7 @@ class PHYSICS_PT_plume_flame_smoke(PlumeDomainPanel, bpy.types.Panel):
 
 class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
     bl_label = "Cache"
+    manual_page = manual.SMOKE_CACHE
 
     def draw(self, context):
         layout = self.layout
@@ -212,6 +226,7 @@ class PHYSICS_PT_plume_cache(PlumeDomainPanel, bpy.types.Panel):
 
 class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
     bl_label = "Streak Surfaces"
+    manual_page = manual.STREAKS_USE
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw_header(self, context):
@@ -260,6 +275,7 @@ class PHYSICS_PT_plume_streaks(PlumeDomainPanel, bpy.types.Panel):
 
 class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
     bl_label = "Toon Smoke"
+    manual_page = manual.TOON
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
@@ -308,6 +324,7 @@ class PHYSICS_PT_plume_toon(PlumeDomainPanel, bpy.types.Panel):
 
 class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
     bl_label = "Flow-Graph Fire"
+    manual_page = manual.FLOWGRAPH
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):

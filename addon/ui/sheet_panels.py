@@ -6,7 +6,9 @@ Keyframes, Export Mesh."""
 
 import bpy
 
+from .. import manual
 from ..build import surface_edits
+from ..operators.manual_open import draw_help
 from ..build.surfaces import CACHE_KEY, DOMAIN_KEY
 
 #: What the panel tells the artist, one short line each (panels do not wrap text).
@@ -59,6 +61,9 @@ class SheetPanel:
     @classmethod
     def poll(cls, context):
         return is_sheet(context.object)
+
+    def draw_header_preset(self, context):
+        draw_help(self.layout, manual.STREAKS_EDITS)
 
     def draw(self, context):
         draw_sheet(self.layout, context.object)

@@ -12,7 +12,7 @@ the ELF dynamic section (``readelf -d``), the version needs (``readelf -V``, wha
 ``objdump -T`` and ``auditwheel`` read) and the dynamic symbol table (``readelf --dyn-syms``).
 
     plume_zip.py version ADDON_DIR                 # the add-on version (manifest == bl_info)
-    plume_zip.py stage ADDON_DIR OUT_DIR NATIVE_SO [NATIVE_SO ...]
+    plume_zip.py stage ADDON_DIR OUT_DIR NATIVE_SO [NATIVE_SO ...]   # with manual/ (plume_manual.py)
     plume_zip.py check PACKAGE_DIR                 # exit 1, listing every problem
     plume_zip.py floor ELF_FILE [ELF_FILE ...]     # each file's highest version needs
 
@@ -212,6 +212,10 @@ def stage(addon_dir, out_dir, natives):
         return [n for n in names if (n in EXCLUDED_DIRS and os.path.isdir(os.path.join(d, n)))
                 or EXCLUDED_FILE.search(n)]
     shutil.copytree(addon_dir, out_dir, ignore=ignore)
+    # The manual the add-on's help opens (manual.py), from the repository the add-on is in.
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plume_manual
+    plume_manual.build(os.path.dirname(os.path.abspath(addon_dir)), os.path.join(out_dir, "manual"))
     sizes, lines = {}, [f"plume {addon_version(addon_dir)}",
                         "built by cmake/portable (zig, x86_64-linux-gnu glibc 2.28, static "
                         "OpenVDB / oneTBB / Blosc / OpenSubdiv / zlib / libc++)"]
