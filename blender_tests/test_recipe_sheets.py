@@ -1,5 +1,5 @@
-"""The streak manual's recipe "smoke sheets, and a hand edit", step by step through the operators
-and values it lists: a new General scene without its cube; a UV sphere (radius 0.25 m at
+"""The streak manual's recipe "smoke sheets, and a hand edit", performed by its own steps
+(`examples/streak_surfaces/recipe_sheets.py`, which the screenshots run too): a new General scene without its cube; a UV sphere (radius 0.25 m at
 z 0.35 m) made the Source and hidden from renders; a 2 m cube at z 1 m made the Domain
 (Resolution 40, End 60, Streak Surfaces on), baked; Build Surfaces; Fast Sheet Render; the camera
 at (0, -4.5, 1) m turned (90°, 0, 0), the domain and its smoke hidden from renders; frame 60
@@ -12,21 +12,23 @@ size is set here: 240 x 320.
 Run: python3 blender_tests/run.py --blender 5.3 test_recipe_sheets.py
 """
 
-import math
 import os
 import sys
 import unittest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+EXAMPLES = os.path.join(os.path.dirname(HERE), "examples")
+sys.path[:0] = [HERE, EXAMPLES, os.path.join(EXAMPLES, "streak_surfaces")]
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (OUT_DIR, image_pixels, recipe_new_file, recipe_sphere_domain,  # noqa: E402
-                     rmtree, run, temp_dir)
+import recipe_kit  # noqa: E402
+import recipe_sheets  # noqa: E402  (the recipe's steps, shared with its screenshots)
+from helpers import OUT_DIR, image_pixels, rmtree, run, temp_dir  # noqa: E402
 
-EDIT_FRAME, LATER_FRAME = 30, 40
-MOVE = np.array([0.1, 0.0, 0.05], dtype=np.float32)
+EDIT_FRAME, LATER_FRAME = recipe_sheets.EDIT_FRAME, 40
+MOVE = np.array(recipe_sheets.MOVE, dtype=np.float32)
 #: Share of the frame brighter than the world's median by 0.05 (the sheets). Measured: 10.4 % in
 #: 3.4.1 and bpy 5.3: four stirred sheets over the default grey world.
 SHOWN_MIN = 0.04
@@ -44,20 +46,8 @@ class RecipeSheetsTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = temp_dir("plume_recipe_sheets_")
-        recipe_new_file()
+        cls.dom, cls.sheets = recipe_kit.run(recipe_sheets.sheets(cls.tmp + "/"))
         scene = bpy.context.scene
-        dom = cls.dom = recipe_sphere_domain(cls.tmp + "/", streaks=True)
-        d = dom.plume.domain
-        assert bpy.ops.plume.surfaces_build() == {'FINISHED'}
-        cls.sheets = sorted((o for o in bpy.data.objects if o.type == 'SURFACE'),
-                            key=lambda o: o.name)
-        assert bpy.ops.plume.surfaces_fast_render() == {'FINISHED'}
-        cam = scene.camera
-        cam.location = (0.0, -4.5, 1.0)
-        cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)
-        dom.hide_render = True
-        bpy.data.objects[d.volume_object].hide_render = True
-        scene.frame_set(60)
         scene.cycles.device = 'CPU'
         scene.render.resolution_x, scene.render.resolution_y = 240, 320
         scene.render.resolution_percentage = 100
@@ -85,18 +75,8 @@ class RecipeSheetsTest(unittest.TestCase):
         plain_later = sheet_points(ob).copy()
         scene.frame_set(EDIT_FRAME)
         plain = sheet_points(ob).copy()
-        bpy.ops.object.select_all(action='DESELECT')
-        ob.select_set(True)
-        bpy.context.view_layer.objects.active = ob
-        sp = ob.data.splines[0]
-        nu = sp.point_count_u
-        moved = [(sp.point_count_v // 2) * nu + u for u in range(nu // 3, nu // 3 + 3)]
-        bpy.ops.object.mode_set(mode='EDIT')  # Tab
-        sp = ob.data.splines[0]  # the edit-mode net
-        for k in moved:
-            x, y, z, w = sp.points[k].co
-            sp.points[k].co = (x + MOVE[0], y + MOVE[1], z + MOVE[2], w)  # G
-        bpy.ops.object.mode_set(mode='OBJECT')  # Tab back
+        moved = recipe_kit.run(recipe_sheets.hand_edit(ob))
+        self.assertEqual(scene.frame_current, EDIT_FRAME)
         scene.frame_set(LATER_FRAME)
         later = sheet_points(ob)
         # The untouched control points are the simulation's; the moved ones keep the move's

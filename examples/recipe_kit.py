@@ -19,6 +19,8 @@ class Shot(NamedTuple):
     image: str                   # file name in the recipe's images/ folder, ui_*.png
     editor: str = 'PROPERTIES'   # the editor maximized for the picture: PROPERTIES or VIEW_3D
     tab: str = 'PHYSICS'         # the Properties tab shown (ignored for VIEW_3D)
+    scroll: int = 0              # pixels the editor is scrolled down, to show a lower panel
+    open: tuple = ()             # panels (class names) drawn open though closed by default
 
 
 def new_file():

@@ -23,7 +23,7 @@ import bpy
 EXAMPLES = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, EXAMPLES)
 #: Timer steps (0.3 s) given to Blender to draw an editor before it is saved.
-SETTLE_STEPS = 3
+SETTLE_STEPS = 4
 
 
 def recipes(names):
@@ -53,6 +53,23 @@ def viewport(window):
         return dict(window=window, screen=window.screen)
     region = next(r for r in area.regions if r.type == 'WINDOW')
     return dict(window=window, screen=window.screen, area=area, region=region)
+
+
+def open_panels(names):
+    """Panels an artist opened by a click on their header: registered again without
+    DEFAULT_CLOSED (panel states are not in Blender's Python API), so they draw open. The
+    add-on's panels after the first one are registered again too, so the order stays."""
+    from plume import ui
+    closed = [c for c in ui.classes if c.__name__ in names and 'DEFAULT_CLOSED' in c.bl_options]
+    if not closed:
+        return
+    later = list(ui.classes[ui.classes.index(closed[0]):])
+    for cls in reversed(later):
+        bpy.utils.unregister_class(cls)
+    for cls in closed:
+        cls.bl_options = set(cls.bl_options) - {'DEFAULT_CLOSED'}
+    for cls in later:
+        bpy.utils.register_class(cls)
 
 
 def show(window, shot):
@@ -108,11 +125,22 @@ def main():
                 if state["shot"] is None:  # a file was read: its screen is drawn first
                     return 0.3
                 state["settle"] = 0
-            area = show(window, state["shot"])
+            shot = state["shot"]
+            if state["settle"] == 0:
+                open_panels(shot.open)
+            area = show(window, shot)
+            region = next(r for r in area.regions if r.type == 'WINDOW')
+            with bpy.context.temp_override(window=window, area=area, region=region):
+                if state["settle"] == 0:  # the top of the editor, no tooltip under the pointer
+                    window.cursor_warp(0, 0)
+                    for _ in range(100):
+                        bpy.ops.view2d.scroll_up(page=True)
+                elif state["settle"] == 1:  # once drawn, its height is known; 40 px a step
+                    for _ in range(shot.scroll // 40):
+                        bpy.ops.view2d.scroll_down()
             state["settle"] += 1
             if state["settle"] < SETTLE_STEPS:
                 return 0.3
-            region = next(r for r in area.regions if r.type == 'WINDOW')
             path = os.path.join(out_root, state["folder"], "images", state["shot"].image)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with bpy.context.temp_override(window=window, area=area, region=region):
