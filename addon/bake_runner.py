@@ -154,7 +154,7 @@ class BakeRunner:
         self._emitter_inputs = inputs
 
     def _load_flame_smoke(self):
-        """Flame Smoke (structural_flames.txt §6.3): reads the flames cache over the bake's frames
+        """Flame Smoke ([Structural Flames] §6.3): reads the flames cache over the bake's frames
         and passes every frame's emitters through the solver's validation, so that a missing
         or bad flames bake is reported before any file is written."""
         snap = self.snapshot
@@ -171,7 +171,7 @@ class BakeRunner:
                                 f"(frame {snap.frame_start + index}): {e}") from None
 
     def _make_tracer(self, params):
-        """StreakTracer with the point sources of every Source (smoke_surfaces.txt §3.2):
+        """StreakTracer with the point sources of every Source ([Smoke Surfaces] §3.2):
         `point_sources` random points per source cell, seeded by the domain seed and the source's
         index, or the vertices of its point_source_mesh; candidate group = the source's
         candidate_group (-1: a group of its own), or candidate_split groups of its own (§3.3)."""
@@ -190,7 +190,7 @@ class BakeRunner:
 
     def _fuel_cells_of(self, params):
         """Linear indices of the cells where the Sources with fuel inject it at the first frame:
-        the fuel-injection region Ω where pathlines are seeded (graph_fire_synthesis.txt §4.2)."""
+        the fuel-injection region Ω where pathlines are seeded ([Graph Fire Synthesis] §4.2)."""
         snap, native = self.snapshot, self._native
         cells = []
         for e in snap.emitters:

@@ -26,7 +26,7 @@ TRACER_STATE_NAME = "tracer_state.bin"
 #: its frame leaves the manifest pointing at this one.
 STATE_PREV_NAME = "state.prev.bin"
 TRACER_STATE_PREV_NAME = "tracer_state.prev.bin"
-#: Pathline groups of a fire bake (graph_fire_synthesis.txt §4.2); ".partial" while recording.
+#: Pathline groups of a fire bake ([Graph Fire Synthesis] §4.2); ".partial" while recording.
 PATHLINES_NAME = "pathlines.bin"
 KIND = "smoke"
 

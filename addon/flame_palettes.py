@@ -1,4 +1,4 @@
-"""The default colour image of each library profile (structural_flames.txt §5.1: "we find a
+"""The default colour image of each library profile ([Structural Flames] §5.1: "we find a
 reference photograph and map the picture onto the two-dimensional profile"), no ``bpy``.
 
 Each palette is painted from what photographs of such flames show, on the profile's side view,

@@ -1,4 +1,4 @@
-"""Where and when the flames of a Flame Source burn, no ``bpy`` (structural_flames.txt §4.1 "a
+"""Where and when the flames of a Flame Source burn, no ``bpy`` ([Structural Flames] §4.1 "a
 fixed point on the burning surface", §6.2 flame spread): flames placed deterministically on a
 mesh's up-facing faces, greyscale maps sampled at their UVs, and the spread model of eq. 7."""
 

@@ -1,4 +1,4 @@
-"""Structural flames settings, no ``bpy`` (structural_flames.txt): the snapshot of a scene's
+"""Structural flames settings, no ``bpy`` ([Structural Flames]): the snapshot of a scene's
 Flame Sources (per-frame settings, wind, camera, sources, obstacles), the cache file names, and
 the validation that runs before anything is written (BakeError naming the setting)."""
 

@@ -1,4 +1,4 @@
-"""Smoke from structural flames into a Plume domain (structural_flames.txt §6.3), no ``bpy``.
+"""Smoke from structural flames into a Plume domain ([Structural Flames] §6.3), no ``bpy``.
 
 "We procedurally generate smoke as particles above the tip of each flame. The smoke point above
 the tip is given simply by h, and the density of particles is the radiation intensity (Eq 5)

@@ -1,4 +1,4 @@
-"""Structural flames bake, no ``bpy`` (structural_flames.txt): the bake loop over a scene's
+"""Structural flames bake, no ``bpy`` ([Structural Flames]): the bake loop over a scene's
 Flame Sources (settings and validation in flame_settings, cache files in flame_files).
 
     snap = snapshot.flames.flames_snapshot(context)          # bpy side: FlameBakeSnapshot

@@ -1,4 +1,4 @@
-"""Flow-graph fire, no ``bpy`` (graph_fire_synthesis.txt §4.3-5.2): the states (fire bakes with
+"""Flow-graph fire, no ``bpy`` ([Graph Fire Synthesis] §4.3-5.2): the states (fire bakes with
 pathlines.bin), the graph built from them, and the synthesis that walks it.
 
     states = open_states(native, [("Calm", folder0), ("Windy", folder1)])   # BakeError if bad

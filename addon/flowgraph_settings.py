@@ -1,4 +1,4 @@
-"""Flow-graph fire settings, no ``bpy`` (graph_fire_synthesis.txt): Build Flow Graph's (§4.3) and
+"""Flow-graph fire settings, no ``bpy`` ([Graph Fire Synthesis]): Build Flow Graph's (§4.3) and
 Synthesize Fire's (§5), their validation (BakeError naming the setting), and what the graph's
 settings come to on given data: the start-up left out, the threshold ε of eq. 11, the velocity
 of the Turbulence fields a synthesis feels."""

@@ -1,5 +1,5 @@
 """A streak bake driven by a Blender Mantaflow cache instead of the Plume solver
-(smoke_surfaces.txt §3.2: particles "advected by the velocity field"), no ``bpy``.
+([Smoke Surfaces] §3.2: particles "advected by the velocity field"), no ``bpy``.
 
     runner = MantaflowTraceRunner(snapshot, _native)   # snapshot.mantaflow is set
     runner.prepare()   # raises BakeError on bad input; writes nothing, changes nothing

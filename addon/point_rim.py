@@ -1,4 +1,4 @@
-"""Rim placement of a Source's point sources (smoke_surfaces.txt §3.2-3.3), no ``bpy``: a ring
+"""Rim placement of a Source's point sources ([Smoke Surfaces] §3.2-3.3), no ``bpy``: a ring
 of point sources around the source's outline, seen along the direction the smoke leaves it.
 
 The paper's sheets come from 10-20 point sources in one to four source cells: a source a cell or

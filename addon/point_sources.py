@@ -1,4 +1,4 @@
-"""Tracer point sources of a traced bake (smoke_surfaces.txt §3.2-3.3), no ``bpy``: where each
+"""Tracer point sources of a traced bake ([Smoke Surfaces] §3.2-3.3), no ``bpy``: where each
 Source's point sources are and which candidate group each belongs to.
 
     points, groups, velocities, emitting = domain_point_sources(native, params, snapshot)

@@ -210,7 +210,7 @@ CANDIDATE_SPLIT_RANGE = RANGES["candidate_split"]
 
 @dataclass
 class StreakSettings:
-    """Streak surfaces (smoke_surfaces.txt §3.2): tracers from point sources during the bake."""
+    """Streak surfaces ([Smoke Surfaces] §3.2): tracers from point sources during the bake."""
 
     enabled: bool = False
     emission_period: int = 1  # steps between two emissions
@@ -224,7 +224,7 @@ NODES_PER_FRAME_RANGE = RANGES["pathline_nodes_per_frame"]
 
 @dataclass
 class PathlineSettings:
-    """Pathline groups of a fire bake for flow-graph fire (graph_fire_synthesis.txt §4.2): one
+    """Pathline groups of a fire bake for flow-graph fire ([Graph Fire Synthesis] §4.2): one
     group per node step Δt_n = frame / nodes_per_frame, sampled over lifetime t_max seconds."""
 
     enabled: bool = False
@@ -251,9 +251,9 @@ class BakeSnapshot:
     #: None: Plume simulates.
     mantaflow: Optional[object] = None
     pathlines: PathlineSettings = field(default_factory=PathlineSettings)
-    #: flame_smoke.FlameSmokeSettings: smoke from the flames cache (structural_flames.txt §6.3)
+    #: flame_smoke.FlameSmokeSettings: smoke from the flames cache ([Structural Flames] §6.3)
     flame_smoke: Optional[object] = None
-    #: velocity in every cell of the frame VDBs (a flames Wind Domain, structural_flames.txt §6.1)
+    #: velocity in every cell of the frame VDBs (a flames Wind Domain, [Structural Flames] §6.1)
     velocity_everywhere: bool = False
 
     @property
@@ -384,7 +384,7 @@ def validate_source(emitter, frame_start=None):
 
 
 def validate_pathlines(domain_name, pathlines, solver, streaks, emitters, bake_frames=None):
-    """Pathline recording (graph_fire_synthesis.txt §4.2) needs a fire bake with fuel sources,
+    """Pathline recording ([Graph Fire Synthesis] §4.2) needs a fire bake with fuel sources,
     lasting long enough (bake_frames) for groups to complete their lifetime."""
     if not pathlines.enabled:
         return
@@ -415,7 +415,7 @@ def validate_pathlines(domain_name, pathlines, solver, streaks, emitters, bake_f
 
 
 def validate_streaks(domain_name, streaks, emitters):
-    """Streak settings of a bake with streak surfaces on (smoke_surfaces.txt §3.2)."""
+    """Streak settings of a bake with streak surfaces on ([Smoke Surfaces] §3.2)."""
     if not streaks.enabled:
         return
     lo, hi = EMISSION_PERIOD_RANGE

@@ -1,4 +1,4 @@
-"""A fast Cycles set-up for streak sheets (smoke_surfaces.txt §3.4; the paper: 4–5 s a frame).
+"""A fast Cycles set-up for streak sheets ([Smoke Surfaces] §3.4; the paper: 4–5 s a frame).
 
 The sheet material is emission mixed with transparency by p = d·e^(−|n·v|) (build/surfaces.py):
 the sheets shade themselves and no light reaches them, so a camera ray only passes through layer

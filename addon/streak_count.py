@@ -1,4 +1,4 @@
-"""How many streaklines a domain's next bake will trace (smoke_surfaces.txt §3.2), for the Streak
+"""How many streaklines a domain's next bake will trace ([Smoke Surfaces] §3.2), for the Streak
 Surfaces panel: every Source's point sources (a rim one per cell of its length, point_sources per
 source cell, or its Point Source Mesh's vertices) and what max_streaklines keeps of them. Computed from the objects' own mesh data
 (no depsgraph evaluation: this runs while the panel draws) and cached until a setting, a Source

@@ -1,4 +1,4 @@
-"""Streak surfaces from a baked cache, no ``bpy`` (smoke_surfaces.txt §3.3-3.4): reads the
+"""Streak surfaces from a baked cache, no ``bpy`` ([Smoke Surfaces] §3.3-3.4): reads the
 streak files, computes h per candidate group, clusters with h0, orders greedily, and turns each
 cluster into per-frame NURBS control points and density maps.
 

@@ -1,4 +1,4 @@
-"""Toon smoke from a baked cache, no ``bpy`` (cartoon_smoke.txt §2.1-2.3): settings and their
+"""Toon smoke from a baked cache, no ``bpy`` ([Cartoon Smoke] §2.1-2.3): settings and their
 validation, the native ToonParams they map to, and the runner that walks the bake's
 volume_####.vdb frames with _native.ToonParticles and writes one toon_####.bin per frame.
 

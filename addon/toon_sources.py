@@ -1,4 +1,4 @@
-"""Where the toon particles are introduced on each frame (cartoon_smoke.txt §2.1: "introducing
+"""Where the toon particles are introduced on each frame ([Cartoon Smoke] §2.1: "introducing
 massless marker particles periodically at the smoke source"), no ``bpy``: the cells of the
 domain's Sources on the toon grid, frame by frame, following the sources' motion (their matrix
 at that frame, as the bake placed their smoke) and their keyed settings (a Source whose Density

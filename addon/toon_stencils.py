@@ -1,4 +1,4 @@
-"""Toon smoke stencils (cartoon_smoke.txt §2.2, Figure 3): circle, puffy cloud and hairy cloud
+"""Toon smoke stencils ([Cartoon Smoke] §2.2, Figure 3): circle, puffy cloud and hairy cloud
 generated as white RGBA images whose alpha is the stencil's cut-out, no ``bpy``. Every image is
 a pure function of its kind and size (fixed shapes, no randomness), written as an 8-bit PNG with
 a small deterministic encoder, so two builds give byte-identical files.

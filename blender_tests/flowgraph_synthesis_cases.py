@@ -1,4 +1,4 @@
-"""Walk and placement cases of the flow-graph fire test (graph_fire_synthesis.txt §5): the
+"""Walk and placement cases of the flow-graph fire test ([Graph Fire Synthesis] §5): the
 transition state (Transition Hold), target states steered by distance, and the Fire Source
 (the paper's fire blade). A mixin of FlowGraphFireTest (test_flowgraph_fire.py), whose baked
 states and graph (its test_1) they use."""

@@ -1,4 +1,4 @@
-"""Figure 9 of smoke_surfaces.txt, measured: on the incense scene of
+"""Figure 9 of [Smoke Surfaces], measured: on the incense scene of
 examples/streak_surfaces/compare_representations.py (its own functions: 50³, 20 point sources,
 the same camera, 200 x 320, every panel under the Fast Sheet Render set-up, its 84 frames: the
 150³ panels are left out, their bake is too slow for a test), the last frame rendered three ways with that example's looks (figure9_looks.py):

@@ -1,4 +1,4 @@
-"""Structural flames' picture (structural_flames.txt §5), through the operators and Cycles
+"""Structural flames' picture ([Structural Flames] §5), through the operators and Cycles
 renders read back as linear EXR:
 
 - eq. 6 reaches the image independent of the sampling: doubling Particles per Pixel leaves the

@@ -1,4 +1,4 @@
-"""Motion blur of every Plume Volume (structural_flames.txt §5.3: "the particles are then motion
+"""Motion blur of every Plume Volume ([Structural Flames] §5.3: "the particles are then motion
 blurred using the instantaneous velocities given by Eq (1)"). Cycles blurs a Volume by its
 velocity grid when Render Properties > Motion Blur is on; Plume's Volumes read it in m/s
 (velocity_unit 'SECOND', scale 1) and Blender names it ("velocity") from each frame it loads.

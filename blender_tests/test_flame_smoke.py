@@ -1,4 +1,4 @@
-"""Smoke from structural flames (structural_flames.txt §6.3), the artist's two passes
+"""Smoke from structural flames ([Structural Flames] §6.3), the artist's two passes
 through the operators: Bake Flames on a torch (5 flames, TORCH profile, 12 frames), then a 32³
 Plume domain with Flame Smoke on. The domain's VDBs hold smoke above the flame tips and none
 below the flames' base; the smoke mass doubles with Smoke Yield; a Cycles render shows it; flames

@@ -1,4 +1,4 @@
-"""Flame spread (structural_flames.txt §6.2): activation times follow the spread map,
+"""Flame spread ([Structural Flames] §6.2): activation times follow the spread map,
 through the operators: a plane is a Flame Source (plume.role_set), its Spread settings are set
 and plume.flames_bake bakes; the spines_####.npz (flame ids and their sources) tell on which
 frames each source's flame lives.

@@ -1,4 +1,4 @@
-"""Structural flames in a wind (structural_flames.txt eq. 1 w, §6.1), through the operators: a
+"""Structural flames in a wind ([Structural Flames] eq. 1 w, §6.1), through the operators: a
 Wind force field along +X makes a candle's flame lean to +X (and it stands upright without one);
 a Plume domain baked with Velocity Everywhere (a 20³ domain with a side wind and no smoke at all)
 stores its wind in clear air, and as the flames' Wind Domain it bends them; baked without the

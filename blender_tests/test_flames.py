@@ -1,4 +1,4 @@
-"""Structural flames end to end (structural_flames.txt), through the operators: a candle
+"""Structural flames end to end ([Structural Flames]), through the operators: a candle
 (1 flame, CANDLE profile) and a torch (5 flames, TORCH profile) bake 12 frames with
 plume.flames_bake; the VDBs hold the named grids, the spines curve has one spline per live flame
 through that flame's points, the lights exist with energy > 0, and Cycles renders the flames

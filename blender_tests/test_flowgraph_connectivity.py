@@ -1,4 +1,4 @@
-"""Flow-graph fire (graph_fire_synthesis.txt §4.3): states driven by the same source animation
+"""Flow-graph fire ([Graph Fire Synthesis] §4.3): states driven by the same source animation
 connect. Three fire states of one box (the campfire example's calm and breeze at half its
 resolution, and the calm with strong vorticity confinement) are baked with Record Pathlines from
 ONE fuel Source whose feed flickers with keyed noise, the same keys for every state (no

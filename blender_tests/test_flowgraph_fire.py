@@ -1,4 +1,4 @@
-"""Flow-graph fire end to end (graph_fire_synthesis.txt §4-5): two 40-frame fire states
+"""Flow-graph fire end to end ([Graph Fire Synthesis] §4-5): two 40-frame fire states
 at 32³ (no wind, and a side wind) baked with Record Pathlines, plume.flowgraph_build on both,
 then plume.fire_synthesize for 200 frames with a keyed target state: a Volume object over the
 synthesized VDB frames with grids density, temperature and flame, which renders non-empty; with

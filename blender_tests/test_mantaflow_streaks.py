@@ -1,7 +1,7 @@
-"""Streak surfaces driven by a Blender Mantaflow cache (smoke_surfaces.txt §3.2): a Quick Smoke
+"""Streak surfaces driven by a Blender Mantaflow cache ([Smoke Surfaces] §3.2): a Quick Smoke
 domain (resolution 32, 20 frames, OpenVDB) is baked once by Mantaflow; a Plume domain with
 motion_source 'MANTAFLOW' traces it (no Plume simulation) and plume.surfaces_build makes surfaces
-from the result; plume.toon_build makes toon smoke from it (cartoon_smoke.txt). The particles rise
+from the result; plume.toon_build makes toon smoke from it ([Cartoon Smoke]). The particles rise
 with the Mantaflow smoke and stay in it, checked against Blender's own reading of the cache. Bad
 input (no Mantaflow domain set, a domain not baked, a cache in another format) gives a clear error
 and writes nothing.

@@ -1,4 +1,4 @@
-"""The surface Blender tessellates is the core's surface (smoke_surfaces.txt §3.3).
+"""The surface Blender tessellates is the core's surface ([Smoke Surfaces] §3.3).
 
 For 2, 3, 5 and 11 streaklines of 1, 2, 3, 4 and 7 particles, with endpoint and uniform knots: the
 core interpolates the particles (plume._native.interpolate_surface), a SURFACE object is built from

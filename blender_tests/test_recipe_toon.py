@@ -1,5 +1,6 @@
-"""The toon manual's recipe "a cartoon puff", step by step through the operators and values it
-lists: a new General scene without its cube; a UV sphere (radius 0.25 m at z 0.35 m) made the
+"""The toon manual's recipe "a cartoon puff", performed by its own steps
+(`examples/toon/recipe_toon_puff.py`, which the screenshots run too): a new General scene
+without its cube; a UV sphere (radius 0.25 m at z 0.35 m) made the
 Source and hidden from renders; a 2 m cube at z 1 m made the Domain (Resolution 40, End 60),
 baked; the camera at (0, -5.5, 1) m turned (90°, 0, 0); Build Toon Smoke with every toon setting
 at its default; the domain and its smoke hidden from renders; frame 45 rendered. What the recipe
@@ -11,18 +12,20 @@ though bpy 5.3 takes about 100 s to draw it with software OpenGL (3.4.1: 20 s).
 Run: python3 blender_tests/run.py --blender 5.3 test_recipe_toon.py
 """
 
-import math
 import os
 import sys
 import unittest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+EXAMPLES = os.path.join(os.path.dirname(HERE), "examples")
+sys.path[:0] = [HERE, EXAMPLES, os.path.join(EXAMPLES, "toon")]
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import (OUT_DIR, image_pixels, recipe_new_file, recipe_sphere_domain,  # noqa: E402
-                     rmtree, run, temp_dir)
+import recipe_kit  # noqa: E402
+import recipe_toon_puff  # noqa: E402  (the recipe's steps, shared with its screenshots)
+from helpers import OUT_DIR, image_pixels, rmtree, run, temp_dir  # noqa: E402
 
 #: Share of the frame the puffs cover (pixels off the world's median by 0.05) and of the
 #: frame in black outline (every channel below 0.1). Measured in 3.4.1 and bpy 5.3: 17.4 % and
@@ -36,20 +39,8 @@ class RecipeToonTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = temp_dir("plume_recipe_toon_")
-        recipe_new_file()
+        recipe_kit.run(recipe_toon_puff.steps(cls.tmp + "/"))
         scene = bpy.context.scene
-        dom = recipe_sphere_domain(cls.tmp + "/")
-        d = dom.plume.domain
-        cam = scene.camera
-        cam.location = (0.0, -5.5, 1.0)
-        cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)
-        for ob in bpy.context.view_layer.objects:
-            ob.select_set(ob == dom)
-        bpy.context.view_layer.objects.active = dom
-        assert bpy.ops.plume.toon_build() == {'FINISHED'}
-        dom.hide_render = True
-        bpy.data.objects[d.volume_object].hide_render = True
-        scene.frame_set(45)
         scene.render.image_settings.file_format = 'PNG'
         out = os.path.join(OUT_DIR, "recipe_toon")
         os.makedirs(out, exist_ok=True)

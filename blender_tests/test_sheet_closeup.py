@@ -1,4 +1,4 @@
-"""Streak sheets stay smooth in a close-up (smoke_surfaces.txt Figure 7: a NURBS sheet does not
+"""Streak sheets stay smooth in a close-up ([Smoke Surfaces] Figure 7: a NURBS sheet does not
 degrade as the camera comes close), on the scene and camera of the manual's picture
 (examples/streak_surfaces/sheet_closeup.py, whose functions this uses): the newcomer's scene with
 every default (a 2 m domain at 40³, a UV sphere of radius 0.25 m as the Source, 60 frames),

@@ -1,4 +1,4 @@
-"""The streak-sheet rendering equation in the image (smoke_surfaces.txt §3.4): a flat sheet of
+"""The streak-sheet rendering equation in the image ([Smoke Surfaces] §3.4): a flat sheet of
 known orientation, carrying a known density map, rendered by Cycles through the add-on's own
 sheet material, must give p = d·e^(−|n·v|) (brighter where the sheet is seen edge-on) or, with
 the linear contour, p = d·(1 − |n·v|), pixel for pixel - with the map's columns along the

@@ -1,4 +1,4 @@
-"""Streak surfaces at an artist's scale (smoke_surfaces.txt §3.2): the scene a new user makes - a
+"""Streak surfaces at an artist's scale ([Smoke Surfaces] §3.2): the scene a new user makes - a
 2 m domain at 40³, a UV sphere of radius 0.25 m as the Source, Streak Surfaces on, every other
 setting at its default - traces a few dozen streaklines (a rim of point sources, point_rim.py;
 with Placement Cells, Max Streaklines thins the 16 point sources per source cell); the Streak

@@ -1,4 +1,4 @@
-"""The streak surfaces' control nets stay on the smoke (smoke_surfaces.txt §3.3 as a
+"""The streak surfaces' control nets stay on the smoke ([Smoke Surfaces] §3.3 as a
 least-squares fit instead of an interpolation of every particle slot).
 
 Three bakes: the Figure 1 example itself (make_source and make_domain of

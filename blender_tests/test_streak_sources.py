@@ -1,4 +1,4 @@
-"""Streakline point sources (smoke_surfaces.txt §3.2-3.3) through the operators: the vertices of
+"""Streakline point sources ([Smoke Surfaces] §3.2-3.3) through the operators: the vertices of
 a picked mesh as point sources, a source split into candidate groups, a traced bake resumed
 from the tracers' checkpoint bit for bit, and Figure 10's keyed source (density 0 and particle
 emission off for some frames). Bad values give clear errors and change nothing.

@@ -1,4 +1,4 @@
-"""Streak surfaces end to end (smoke_surfaces.txt §3.2-3.4, the paper's Figure 1 setup): a 50³
+"""Streak surfaces end to end ([Smoke Surfaces] §3.2-3.4, the paper's Figure 1 setup): a 50³
 domain with one tiny source cell holding 20 point sources bakes with streaks on, then
 plume.surfaces_build makes >= 2 SURFACE objects whose points follow the cache on frame changes,
 and a Cycles render shows semi-transparent sheets. Bad input gives a clear error, changes nothing.

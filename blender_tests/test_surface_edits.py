@@ -1,4 +1,4 @@
-"""Hand edits of streak surfaces (smoke_surfaces.txt §5, Figure 13), Bake to Keyframes and the
+"""Hand edits of streak surfaces ([Smoke Surfaces] §5, Figure 13), Bake to Keyframes and the
 OpenSubdiv mesh export, on the Figure 1 setup of test_streak_surfaces.py (50³, 20 point sources).
 
 An edit made on frame 10 is stored per control point (u, v index) as an offset in the sheet's

@@ -17,7 +17,7 @@ import bpy  # noqa: E402
 
 from helpers import enable_addon, run  # noqa: E402
 
-# A file name in a tooltip: "smoke_surfaces.txt", "notes.md", ...
+# A file name in a tooltip: "[Smoke Surfaces]", "notes.md", ...
 FILE_NAME = re.compile(r"\b[\w-]+\.(txt|md|pdf|py|json|toml)\b")
 
 

@@ -1,4 +1,4 @@
-"""Toon smoke with its defaults on an ordinary scene (cartoon_smoke.txt §2.2-2.3): a 2 m domain
+"""Toon smoke with its defaults on an ordinary scene ([Cartoon Smoke] §2.2-2.3): a 2 m domain
 at 40³ in still air (Turbulence 0), a UV sphere of radius 0.25 m as an even Source (Breakup 0),
 60 frames, Build Toon Smoke with every toon setting at its default, a camera framing the
 domain, 640x360 Cycles.

@@ -1,4 +1,4 @@
-"""Toon emission follows the Source (cartoon_smoke.txt §2.1, "introducing massless marker
+"""Toon emission follows the Source ([Cartoon Smoke] §2.1, "introducing massless marker
 particles periodically at the smoke source"): a Source that moves sideways during the shot
 introduces each frame's particles in its cells of that frame (within a cell of the sphere as
 Blender places it on the frame), a Source keyed to Density 0 on some frames and to Emit

@@ -1,4 +1,4 @@
-"""Toon outlines keep their weight relative to the picture (cartoon_smoke.txt §2.2 lines drawn
+"""Toon outlines keep their weight relative to the picture ([Cartoon Smoke] §2.2 lines drawn
 with an Outline Width in pixels of a 1080-line picture). A small bake (24³, 20 frames), Build
 Toon Smoke, Outline Width 6, then the same frame rendered from a 1920x1080 scene at 25 % (270
 lines: a 1.5 px line) and 50 % (540 lines: a 3 px line), the resolution changed after the build

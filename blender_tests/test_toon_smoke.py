@@ -1,4 +1,4 @@
-"""Toon smoke end to end (cartoon_smoke.txt §2): a small bake (24³, 20 frames), then
+"""Toon smoke end to end ([Cartoon Smoke] §2): a small bake (24³, 20 frames), then
 plume.toon_build makes a point object that follows toon_####.bin on frame changes, billboards
 with a stencil cut-out, and the "Plume Depth Differences" compositor group. A 320x240 Cycles
 render saves the Depth pass and the group's outline as 32-bit EXR: the outline equals

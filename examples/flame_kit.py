@@ -1,4 +1,4 @@
-"""Shared pieces of the structural-flames examples (structural_flames.txt), run inside
+"""Shared pieces of the structural-flames examples ([Structural Flames]), run inside
 Blender: a Flame Source made through the operators an artist clicks, simple solid materials,
 the bake (plume.flames_bake) with its per-frame figures, and the render of a few frames into a
 strip. Builds on scene_kit. Imported by the examples in examples/flames/::

@@ -240,7 +240,7 @@ def shown_frames(fractions, frames):
     return sorted({max(1, min(frames, round(f * frames))) for f in fractions})
 
 
-# --- Flow-graph fire (graph_fire_synthesis.txt) ---------------------------------------------
+# --- Flow-graph fire ([Graph Fire Synthesis]) ---------------------------------------------
 
 #: RAM a pathline sample takes while the graph is built (pathline_group.h: velocity, density,
 #: temperature as floats): the build holds every group of every state, |Ω| L 20 B per node.

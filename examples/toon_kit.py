@@ -1,4 +1,4 @@
-"""Shared pieces of the toon-smoke examples (cartoon_smoke.txt), run inside Blender: the flat
+"""Shared pieces of the toon-smoke examples ([Cartoon Smoke]), run inside Blender: the flat
 toon look in Cycles, Sources that blow a burst, the toon settings the examples share (puffs),
 the bake and Build Toon Smoke through the artist's operators, and the render of a few frames
 into a strip with the times. Builds on scene_kit. Imported by the examples in examples/toon/::

@@ -1,4 +1,4 @@
-"""Point preview of the synthesized fire (graph_fire_synthesis.txt §5.3, "optional point
+"""Point preview of the synthesized fire ([Graph Fire Synthesis] §5.3, "optional point
 preview"): a MESH object "<domain>_fire_points" whose vertices and point attributes (temperature,
 density) follow fire/points_####.npz through a persistent frame_change_pre handler, drawn as
 spheres of half a cell by a geometry-nodes "Mesh to Points" modifier with an emission material

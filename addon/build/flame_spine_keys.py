@@ -1,4 +1,4 @@
-"""Bake Spines to Keyframes (structural_flames.txt §4.1: spines shown as curve objects the
+"""Bake Spines to Keyframes ([Structural Flames] §4.1: spines shown as curve objects the
 artist can see and key): the cached spines of the baked frames become one plain curve object per
 flame id, its points keyed on every frame the flame lives, so they exist without the add-on and
 an artist can re-key them.

@@ -1,4 +1,4 @@
-"""The flame spines (structural_flames.txt §4.1, Figure 5's "structural curves") as the curve
+"""The flame spines ([Structural Flames] §4.1, Figure 5's "structural curves") as the curve
 object "Plume Flame Spines": one POLY spline per live flame through its n points (base to tip;
 separated flames through their own), rebuilt from spines_####.npz by a persistent
 frame_change_pre handler, which also moves the flame lights (flame_lights.py). Outside the baked

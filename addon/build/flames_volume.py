@@ -1,4 +1,4 @@
-"""The structural flames (structural_flames.txt §5.3: "ideally, the deformed flames should be
+"""The structural flames ([Structural Flames] §5.3: "ideally, the deformed flames should be
 volume rendered directly") as the Volume object "Plume Flames" over flames_####.vdb with an
 emission material that renders without the add-on:
 - emission: the `emission` grid (RGB W/m³ in Blender's units: each particle's share of eq. 5's

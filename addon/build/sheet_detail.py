@@ -1,4 +1,4 @@
-"""How finely Blender tessellates a streak surface, from the scene's camera (smoke_surfaces.txt
+"""How finely Blender tessellates a streak surface, from the scene's camera ([Smoke Surfaces]
 §3.3, Figure 7: a NURBS sheet, unlike a bitmap or a volume, stays smooth as the camera comes
 close). Blender draws a NURBS surface as a grid of nu·resolution_u × nv·resolution_v samples,
 evenly spread over the knot domain; a fixed resolution shows straight facets once a knot span

@@ -1,4 +1,4 @@
-"""Hand edits of streak surfaces (smoke_surfaces.txt §5, Figure 13) and "Bake to keyframes".
+"""Hand edits of streak surfaces ([Smoke Surfaces] §5, Figure 13) and "Bake to keyframes".
 
 An edit is stored per control point (u, v index) as an offset in the surface's local frame there:
 tangent t (along the streaklines, S_u), binormal b = n × t and normal n = S_u × S_v, evaluated on

@@ -1,4 +1,4 @@
-"""Streak surfaces -> Blender data (smoke_surfaces.txt §3.3-3.4): one SURFACE (NURBS) object per
+"""Streak surfaces -> Blender data ([Smoke Surfaces] §3.3-3.4): one SURFACE (NURBS) object per
 cluster with a fixed control net, its per-frame control points in a cache file read by a
 persistent frame_change_pre handler, and the "Plume Smoke Sheet" material whose opacity is
 p = d e^(-|n·v|) with d from a density-map image sequence."""

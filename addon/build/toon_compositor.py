@@ -1,4 +1,4 @@
-"""Depth-difference outlines in Blender's compositor (cartoon_smoke.txt §2.2, after Deussen &
+"""Depth-difference outlines in Blender's compositor ([Cartoon Smoke] §2.2, after Deussen &
 Strothotte 2000): the node group "Plume Depth Differences" finds a pixel on the outline when any
 of its four one-sided depth differences divided by the pixel size exceeds γ:
 

@@ -1,4 +1,4 @@
-"""Toon smoke rendering in Blender (cartoon_smoke.txt §2.2-2.3): the geometry-nodes group
+"""Toon smoke rendering in Blender ([Cartoon Smoke] §2.2-2.3): the geometry-nodes group
 "Plume Toon Billboards" (one camera-facing quad per point, `size` wide, rotated in the image
 plane along the point's projected velocity and stretched in proportion to its speed, Figure 4)
 and the flat toon material whose stencil alpha is a hard cut-out (alpha CLIP), so that the Depth pass is written

@@ -1,4 +1,4 @@
-"""Toon particles -> a point-cloud MESH object "<domain>_toon" (cartoon_smoke.txt §2.1-2.3):
+"""Toon particles -> a point-cloud MESH object "<domain>_toon" ([Cartoon Smoke] §2.1-2.3):
 its vertices and point attributes (size, velocity, colour, id) follow toon_####.bin on every
 frame through a persistent frame_change_pre handler with bulk foreach_set updates. The
 camera-dependent orientation and stretch (Figure 4) are computed by the billboard node group from

@@ -1,4 +1,4 @@
-"""plume.flames_bake and plume.flames_free (structural_flames.txt): bake the scene's Flame
+"""plume.flames_bake and plume.flames_free ([Structural Flames]): bake the scene's Flame
 Sources into flames_####.vdb + spines_####.npz, then the "Plume Flames" Volume, the "Plume Flame
 Spines" curve and the flame lights; plume.flames_bake_spines_keyframes turns the cached spines
 into keyed curve objects. plume.flames_bake is a job (jobs/): the frames are computed in a

@@ -1,4 +1,4 @@
-"""plume.flowgraph_build and plume.fire_synthesize (graph_fire_synthesis.txt §4.3-5): the
+"""plume.flowgraph_build and plume.fire_synthesize ([Graph Fire Synthesis] §4.3-5): the
 selected baked fire domains (Record Pathlines on) become the states of a flow graph stored with
 the active domain; Synthesize walks it for any number of frames into a fire Volume. Both are jobs
 (jobs/): every input is checked on the main thread before anything is written, the work runs in

@@ -1,4 +1,4 @@
-"""Operators on built streak surfaces: store / clear hand edits (smoke_surfaces.txt §5, Figure 13),
+"""Operators on built streak surfaces: store / clear hand edits ([Smoke Surfaces] §5, Figure 13),
 bake to keyframes, export as an OpenSubdiv mesh. They act on the active Plume surface (plus the
 selected ones), or, with the domain active (the panel's buttons), on all of its surfaces. Export
 Mesh is a job (jobs/): the surfaces are read on the main thread, refined in the job's child process,

@@ -1,4 +1,4 @@
-"""plume.surfaces_build on the active baked domain (smoke_surfaces.txt §3.3-3.4): streak files ->
+"""plume.surfaces_build on the active baked domain ([Smoke Surfaces] §3.3-3.4): streak files ->
 h per candidate group -> clusters (h0) -> greedy order -> one SURFACE object per cluster with
 per-frame control points and a density-map material. A job (jobs/): the settings are checked on
 the main thread, everything is computed in the job's child process (no bpy) into a staging

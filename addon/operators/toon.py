@@ -1,4 +1,4 @@
-"""plume.toon_build on the active baked domain (cartoon_smoke.txt §2): toon particles from the
+"""plume.toon_build on the active baked domain ([Cartoon Smoke] §2): toon particles from the
 bake's volume frames -> toon_####.bin, a point object following them, billboards with a stencil
 cut-out material, and the "Plume Depth Differences" compositor outlines. A job (jobs/): every
 input is checked on the main thread before anything is written or created, the particles run in

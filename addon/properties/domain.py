@@ -1,5 +1,5 @@
 """A domain's properties (``obj.plume.domain``): its grid bake (solver, combustion, cache), the
-streak surfaces it traces and builds (smoke_surfaces.txt), the pathlines it records, and the
+streak surfaces it traces and builds ([Smoke Surfaces]), the pathlines it records, and the
 toon and flow-graph settings it holds."""
 
 import bpy
@@ -185,7 +185,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
     boundary_pos_y: _boundary("+Y")
     boundary_neg_z: _boundary("-Z (floor)", default='CLOSED')
     boundary_pos_z: _boundary("+Z")
-    # --- Combustion (graph_fire_synthesis.txt eqs. 1-5) ---
+    # --- Combustion ([Graph Fire Synthesis] eqs. 1-5) ---
     combustion: BoolProperty(name="Combustion", default=False, update=_combustion_changed,
                              description="Burn fuel into heat and soot: the domain becomes a fire "
                                          f"simulation (Vorticity {SMOKE_VORTICITY:g} becomes "
@@ -211,7 +211,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         description="Swirl added where fuel burns, on top of Vorticity: the flames curl into "
                     "licking tongues while the smoke above them stays smooth (as Mantaflow's "
                     "Flame Vorticity: its 0.5 at 24 fps is about 12 here)")
-    # --- Flame Smoke (structural_flames.txt §6.3, flame_smoke.py) ---
+    # --- Flame Smoke ([Structural Flames] §6.3, flame_smoke.py) ---
     flame_smoke: BoolProperty(
         name="Flame Smoke", default=False,
         description="Emit smoke above every baked structural flame (Bake Flames first): at the "
@@ -233,7 +233,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         name="Smoke Temperature", default=0.0, soft_min=0.0, soft_max=10.0,
         description="Temperature of the smoke above ambient; 0 = automatic: the temperature "
                     "whose buoyancy β |g| (T − T_amb) equals the flames' eq. 2 buoyancy")
-    # --- Streak surfaces (smoke_surfaces.txt §3.2-3.4) ---
+    # --- Streak surfaces ([Smoke Surfaces] §3.2-3.4) ---
     pathlines: BoolProperty(
         name="Record Pathlines", default=False,
         description="Record pathline groups during this fire bake for Flow-Graph Fire: "
@@ -328,7 +328,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         name="Velocity Everywhere", default=False,
         description="Store the velocity in every cell of each frame, not only where there is "
                     "smoke: for a domain used as a flame Wind Domain (larger files)")
-    # --- Toon smoke (cartoon_smoke.txt, plume.toon_build) ---
+    # --- Toon smoke ([Cartoon Smoke], plume.toon_build) ---
     toon: PointerProperty(type=PlumeToonSettings, name="Toon Smoke")
-    # --- Flow-graph fire (graph_fire_synthesis.txt, plume.flowgraph_build / fire_synthesize) ---
+    # --- Flow-graph fire ([Graph Fire Synthesis], plume.flowgraph_build / fire_synthesize) ---
     flowgraph: PointerProperty(type=PlumeFlowGraphSettings, name="Flow-Graph Fire")

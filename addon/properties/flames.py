@@ -1,4 +1,4 @@
-"""Structural flames settings (structural_flames.txt): ``obj.plume.flame`` on a Flame Source and
+"""Structural flames settings ([Structural Flames]): ``obj.plume.flame`` on a Flame Source and
 ``scene.plume_flames`` for the whole bake, read frame by frame by plume.flames_bake, so every
 number is keyable. Soft limits only: the bake validates with messages naming the setting and its
 range (flames.validate_*)."""

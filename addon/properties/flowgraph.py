@@ -1,5 +1,5 @@
 """``obj.plume.domain.flowgraph``: flow-graph fire settings of the domain that holds the graph
-(graph_fire_synthesis.txt §4.3-5.2), read by plume.flowgraph_build and plume.fire_synthesize.
+([Graph Fire Synthesis] §4.3-5.2), read by plume.flowgraph_build and plume.fire_synthesize.
 Soft limits only: the operators validate with messages naming the setting and its range."""
 
 import bpy

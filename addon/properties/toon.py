@@ -1,4 +1,4 @@
-"""``obj.plume.domain.toon``: the toon smoke settings of a domain (cartoon_smoke.txt §2.1-2.3),
+"""``obj.plume.domain.toon``: the toon smoke settings of a domain ([Cartoon Smoke] §2.1-2.3),
 read by plume.toon_build; the look settings (stretch, colours, γ, outline) update a built toon
 smoke at once (build/toon_look.py). Soft limits only: the operator validates with messages naming the
 setting and its range (toon.validate and the native ToonParams.validate)."""

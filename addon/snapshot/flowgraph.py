@@ -1,4 +1,4 @@
-"""Scene -> flow-graph fire settings (graph_fire_synthesis.txt): the pathlines a fire bake
+"""Scene -> flow-graph fire settings ([Graph Fire Synthesis]): the pathlines a fire bake
 records, the states and settings of Build Flow Graph, and the settings and per-frame inputs
 (target states, wind, turbulence force fields) of Synthesize Fire."""
 

@@ -127,7 +127,7 @@ def mesh_arrays(obj, depsgraph):
 def vertex_group_of_vertices(obj, depsgraph):
     """The vertex group each vertex of the evaluated mesh belongs to most (its index, -1 for
     none), int64 (N,), or None when the object has no vertex groups: hand-made candidate
-    groups of point sources (smoke_surfaces.txt §3.3)."""
+    groups of point sources ([Smoke Surfaces] §3.3)."""
     if not obj.vertex_groups:
         return None
     ob = obj.evaluated_get(depsgraph)
@@ -193,7 +193,7 @@ def emitter_snapshots(context, domain, frame_start, frame_end):
 
 def point_source_vertices(context, objs, snaps, frame_start):
     """Fills the point_source_mesh of each Source snapshot whose source has one: the world
-    positions of the evaluated mesh's vertices at frame_start (smoke_surfaces.txt §3.2, one point
+    positions of the evaluated mesh's vertices at frame_start ([Smoke Surfaces] §3.2, one point
     source per vertex). The current frame is restored."""
     picked = [(o.plume.source.point_source_mesh, snap) for o, snap in zip(objs, snaps)
               if o.plume.role == 'SOURCE' and o.plume.source.point_source_mesh is not None]

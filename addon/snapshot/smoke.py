@@ -74,7 +74,7 @@ def take_snapshot(context, addon_version="0.1.0"):
 
 
 def flame_smoke_settings(domain, scene):
-    """The domain's Flame Smoke settings (structural_flames.txt §6.3) and the scene's flames
+    """The domain's Flame Smoke settings ([Structural Flames] §6.3) and the scene's flames
     cache folder; None when off. The flames cache is read by BakeRunner.prepare()."""
     d = domain.plume.domain
     if not d.flame_smoke:

@@ -1,4 +1,4 @@
-"""Scene -> the streak-surface settings (smoke_surfaces.txt): the tracers' settings of a bake and
+"""Scene -> the streak-surface settings ([Smoke Surfaces]): the tracers' settings of a bake and
 the density-map and sheet settings of Build Surfaces."""
 
 from ..settings import BakeError, StreakSettings

@@ -1,4 +1,4 @@
-"""Scene -> toon.ToonSettings (cartoon_smoke.txt §2): a domain's toon settings."""
+"""Scene -> toon.ToonSettings ([Cartoon Smoke] §2): a domain's toon settings."""
 
 import bpy
 

@@ -1,4 +1,4 @@
-"""Physics tab panels of structural flames (structural_flames.txt): "Flame Source" on a
+"""Physics tab panels of structural flames ([Structural Flames]): "Flame Source" on a
 FLAME_SOURCE object (obj.plume.flame) and "Flames" (scene.plume_flames, Bake / Free), the same
 scene settings also in the Scene tab."""
 

@@ -172,7 +172,7 @@ class PHYSICS_PT_plume_combustion(PlumeDomainPanel, bpy.types.Panel):
         for name in ("burn_rate", "soot_yield", "heat_yield", "conductivity", "cooling_rate",
                      "max_temperature", "expansion", "flame_vorticity"):
             layout.prop(d, name)
-        # Pathline groups for flow-graph fire (graph_fire_synthesis.txt §4.2).
+        # Pathline groups for flow-graph fire ([Graph Fire Synthesis] §4.2).
         layout.prop(d, "pathlines")
         col = layout.column()
         col.active = d.pathlines

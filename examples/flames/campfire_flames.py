@@ -1,4 +1,4 @@
-"""A campfire of structural flames (structural_flames.txt, the CAMPFIRE profile of Figure 3).
+"""A campfire of structural flames ([Structural Flames], the CAMPFIRE profile of Figure 3).
 
     blender -b --factory-startup --python examples/flames/campfire_flames.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""One candle flame in a dark room (structural_flames.txt §4.3-4.4, the CANDLE profile of
+"""One candle flame in a dark room ([Structural Flames] §4.3-4.4, the CANDLE profile of
 Figure 3).
 
     blender -b --factory-startup --python examples/flames/candle.py -- OUT_DIR [FRAMES]

@@ -1,4 +1,4 @@
-"""Dragon's breath: Figure 5 of structural_flames.txt, five flames splitting into dozens.
+"""Dragon's breath: Figure 5 of [Structural Flames], five flames splitting into dozens.
 
     blender -b --factory-startup --python examples/flames/dragon_breath.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""Flames spreading over a board from a greyscale activation map: §6.2 of structural_flames.txt.
+"""Flames spreading over a board from a greyscale activation map: §6.2 of [Structural Flames].
 
     blender -b --factory-startup --python examples/flames/flame_spread.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""Flames around a simple obstacle: Figure 7 of structural_flames.txt (§6.1).
+"""Flames around a simple obstacle: Figure 7 of [Structural Flames] (§6.1).
 
     blender -b --factory-startup --python examples/flames/flames_obstacles.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""A burning torch waved through the air: Figure 1 of structural_flames.txt.
+"""A burning torch waved through the air: Figure 1 of [Structural Flames].
 
     blender -b --factory-startup --python examples/flames/torch_swing.py -- OUT_DIR [FRAMES]
 

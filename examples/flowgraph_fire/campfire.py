@@ -1,5 +1,5 @@
 """A campfire in three wind strengths, synthesized for as long as you like: the campfire of
-graph_fire_synthesis.txt (Table 1, Figure 1).
+[Graph Fire Synthesis] (Table 1, Figure 1).
 
     blender -b --factory-startup --python examples/flowgraph_fire/campfire.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""Figure 6 of graph_fire_synthesis.txt as numbers: how the traversal strategy (§5.1) and the
+"""Figure 6 of [Graph Fire Synthesis] as numbers: how the traversal strategy (§5.1) and the
 block size B (§4.3) shape a synthesized fire's walk, on a real flow graph.
 
     /usr/bin/python3 examples/flowgraph_fire/figure6.py OUT_DIR GRAPH_NPZ [NATIVE_DIR]

@@ -1,5 +1,5 @@
 """A burning blade swung through the air, trailing fire: the fire blade of
-graph_fire_synthesis.txt (Table 1: "the fire source is attached on a dynamic mesh").
+[Graph Fire Synthesis] (Table 1: "the fire source is attached on a dynamic mesh").
 
     blender -b --factory-startup --python examples/flowgraph_fire/fire_blade.py -- OUT_DIR [FRAMES]
 

@@ -1,5 +1,5 @@
 """A tall plume of fire going from low to high turbulence: the fire plume of
-graph_fire_synthesis.txt (Table 1: three states, 200 x 400 x 200), synthesized from three short
+[Graph Fire Synthesis] (Table 1: three states, 200 x 400 x 200), synthesized from three short
 bakes.
 
     blender -b --factory-startup --python examples/flowgraph_fire/fire_plume.py -- OUT_DIR [FRAMES]

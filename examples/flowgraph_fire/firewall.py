@@ -1,4 +1,4 @@
-"""A wall of fire going from low to high turbulence: the fire wall of graph_fire_synthesis.txt
+"""A wall of fire going from low to high turbulence: the fire wall of [Graph Fire Synthesis]
 (§5.4, Table 1), synthesized from two short bakes.
 
     blender -b --factory-startup --python examples/flowgraph_fire/firewall.py -- OUT_DIR [FRAMES]

@@ -1,4 +1,4 @@
-"""The flow-graph fire examples' kit (graph_fire_synthesis.txt): the states' fire domains and
+"""The flow-graph fire examples' kit ([Graph Fire Synthesis]): the states' fire domains and
 fuel feeds, their bakes, Build Flow Graph, keyed target states, Synthesize Fire, and
 flowgraph_example, which runs a whole example from the command line. Scene, render and
 strip helpers are scene_kit's."""

@@ -1,6 +1,6 @@
 """What the paper's Table 1 grids would cost here: each flow-graph example's first state baked
 (with Record Pathlines) at two small resolutions, the cost per frame fitted as a power of the
-resolution and extrapolated to Table 1's grid (graph_fire_synthesis.txt, Table 1).
+resolution and extrapolated to Table 1's grid ([Graph Fire Synthesis], Table 1).
 
     blender -b --factory-startup --python examples/flowgraph_fire/table1_cost.py -- OUT_DIR [N1 N2 ...]
 

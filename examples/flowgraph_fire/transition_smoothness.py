@@ -1,5 +1,5 @@
 """Transitions look smooth, measured: how much a synthesized fire's image changes from one frame
-to the next across a transition of the walk, against within a state (graph_fire_synthesis.txt
+to the next across a transition of the walk, against within a state ([Graph Fire Synthesis]
 §5.4: "the transitions appear smooth"; Figure 6 shows frames).
 
     blender -b --factory-startup --python examples/flowgraph_fire/transition_smoothness.py -- CAMPFIRE_DIR [FIRST LAST [WIDTH SAMPLES [reuse]]]

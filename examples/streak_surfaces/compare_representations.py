@@ -1,4 +1,4 @@
-"""Figure 9 of smoke_surfaces.txt: the same incense smoke shown five ways, side by side.
+"""Figure 9 of [Smoke Surfaces]: the same incense smoke shown five ways, side by side.
 
     blender -b --factory-startup --python examples/streak_surfaces/compare_representations.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""The three clusterings of Figure 3 of smoke_surfaces.txt, on the incense set-up of Figure 1.
+"""The three clusterings of Figure 3 of [Smoke Surfaces], on the incense set-up of Figure 1.
 
     blender -b --factory-startup --python examples/streak_surfaces/figure3_clustering.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""How compare_representations.py renders the alternatives of Figure 9 of smoke_surfaces.txt
+"""How compare_representations.py renders the alternatives of Figure 9 of [Smoke Surfaces]
 fairly: a Principled Volume lit by the scene, particles as a particle artist draws them (small
 soft semi-transparent glowing specks, fading with the density they carry), each rendered for at
 least the time the sheets take (render_matched), and what a compositor sees in a panel

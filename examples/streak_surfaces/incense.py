@@ -1,4 +1,4 @@
-"""Incense smoke as streak surfaces: the setup of Figure 1 of smoke_surfaces.txt.
+"""Incense smoke as streak surfaces: the setup of Figure 1 of [Smoke Surfaces].
 
     blender -b --factory-startup --python examples/streak_surfaces/incense.py -- OUT_DIR [FRAMES]
 

@@ -1,4 +1,4 @@
-"""A close-up of a streak sheet at 1920 x 1080 (smoke_surfaces.txt Figure 7: a NURBS sheet stays
+"""A close-up of a streak sheet at 1920 x 1080 ([Smoke Surfaces] Figure 7: a NURBS sheet stays
 smooth as the camera comes close, where a volume or particles break up).
 
     blender -b --factory-startup --python examples/streak_surfaces/sheet_closeup.py -- OUT_DIR [BEFORE]

@@ -1,4 +1,4 @@
-"""Rising smoke hits a sphere: Figure 10 of smoke_surfaces.txt as streak surfaces.
+"""Rising smoke hits a sphere: Figure 10 of [Smoke Surfaces] as streak surfaces.
 
     blender -b --factory-startup --python examples/streak_surfaces/sphere_collision.py -- OUT_DIR [FRAMES]
 

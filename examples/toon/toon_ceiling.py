@@ -1,4 +1,4 @@
-"""Toon smoke rushing up into a ceiling: Figure 7 of cartoon_smoke.txt.
+"""Toon smoke rushing up into a ceiling: Figure 7 of [Cartoon Smoke].
 
     blender -b --factory-startup --python examples/toon/toon_ceiling.py -- OUT_DIR [FRAMES]
 

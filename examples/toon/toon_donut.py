@@ -1,4 +1,4 @@
-"""Two puffs of smoke propelled at each other form a donut: Figure 5 of cartoon_smoke.txt.
+"""Two puffs of smoke propelled at each other form a donut: Figure 5 of [Cartoon Smoke].
 
     blender -b --factory-startup --python examples/toon/toon_donut.py -- OUT_DIR [FRAMES]
 

@@ -1,5 +1,5 @@
 """An explosion that propels smoke sideways until it cools and falls: Figure 6 of
-cartoon_smoke.txt, darkness from speed.
+[Cartoon Smoke], darkness from speed.
 
     blender -b --factory-startup --python examples/toon/toon_explosion.py -- OUT_DIR [FRAMES]
 

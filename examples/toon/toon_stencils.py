@@ -1,4 +1,4 @@
-"""The three stencils of Figure 3 of cartoon_smoke.txt: circle, puffy cloud and hairy cloud, and
+"""The three stencils of Figure 3 of [Cartoon Smoke]: circle, puffy cloud and hairy cloud, and
 the same puff of smoke drawn with each.
 
     blender -b --factory-startup --python examples/toon/toon_stencils.py -- OUT_DIR [FRAMES]

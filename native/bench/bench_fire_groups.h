@@ -1,6 +1,6 @@
 #pragma once
 /// \file bench_fire_groups.h
-/// Fire-like pathline groups for the synthesis benchmarks (graph_fire_synthesis.txt §5.2).
+/// Fire-like pathline groups for the synthesis benchmarks ([Graph Fire Synthesis] §5.2).
 
 #include "core/rng.h"
 #include "flowgraph/pathline_group.h"

@@ -1,4 +1,4 @@
-// Benchmark of the structure of structural flames (structural_flames.txt §7): one step of
+// Benchmark of the structure of structural flames ([Structural Flames] §7): one step of
 // FlameSystem (evolution by eq. 1, spine fitting and re-sampling, breakaway, obstacles none) for
 // the torch of Figure 1 (5 flames, n = 16; the paper: 0.2 s "dynamic simulation" + part of the
 // 2.0 s "B-spline fitting" per frame) and the dragon breath of Figure 5 (5 flames split into 80+;

@@ -1,4 +1,4 @@
-// Benchmark of the shape stage of structural flames (structural_flames.txt §4.4–4.5, §5):
+// Benchmark of the shape stage of structural flames ([Structural Flames] §4.4–4.5, §5):
 // sampling, flow noise, spine mapping, Kolmogorov noise, merging, incandescence for one frame of
 // the torch (5 flames × 9,000 particles; budget ≤ 10 ms per frame including structure; the
 // paper: 2.7 s) and of the dragon breath (80 flames, 1.5 M particles, merging off as in the

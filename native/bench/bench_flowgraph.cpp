@@ -1,4 +1,4 @@
-// Benchmark of flow-graph fire synthesis (graph_fire_synthesis.txt §5.2, Table 1):
+// Benchmark of flow-graph fire synthesis ([Graph Fire Synthesis] §5.2, Table 1):
 // - synthesis per step at 3,200 pathlines per node with L = 48 (budget: <= 1 ms; the paper's
 //   campfire, 3,217 pathlines per node: 35 ms), with a uniform and with a field u_ext (the
 //   emitted group prepared at every step), and the gather of all live particles (positions,

@@ -1,5 +1,5 @@
 /// \file bench_flowgraph_graph.cpp
-/// Benchmark of the flow-graph build (graph_fire_synthesis.txt §4.3): the cost matrix of eq. 9-10
+/// Benchmark of the flow-graph build ([Graph Fire Synthesis] §4.3): the cost matrix of eq. 9-10
 /// and the graph (block candidates, ε, pruning) for 1,000 nodes of synthetic groups at
 /// |Ω| = 3200 pathlines and L = 48 samples (the paper's campfire: 3217 pathlines per node), with
 /// every group in memory (BM_CostMatrix, what the add-on did before) and streamed from pathline

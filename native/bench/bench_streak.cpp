@@ -1,4 +1,4 @@
-// Benchmarks of the streak-surface pipeline (smoke_surfaces.txt §3.3–3.4).
+// Benchmarks of the streak-surface pipeline ([Smoke Surfaces] §3.3–3.4).
 //  * Figure 1's scale: 20 point sources × 300 frames; what "Build Surfaces" does in the native core (h,
 //    clusters, order, then per frame the NURBS and density map of every surface).
 //  * An artist's scale: clustering that scales. 20,000 streaklines × 60 frames (N(t) = t + 1, so 60

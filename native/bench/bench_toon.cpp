@@ -1,4 +1,4 @@
-// Benchmark of the toon pipeline (cartoon_smoke.txt): the particle update of one frame for 10^5
+// Benchmark of the toon pipeline ([Cartoon Smoke]): the particle update of one frame for 10^5
 // particles (budget: <= 5 ms), with and without the birth spacing, and the depth-differences
 // filter at 1920x1080 (budget: <= 1 ms).
 // Run: build/native/plume_bench_toon

@@ -1,5 +1,5 @@
 /// \file flowgraph_sweep.cpp
-/// Figure 7's data (graph_fire_synthesis.txt §5.2): for every pathlines-per-node count |Ω|,
+/// Figure 7's data ([Graph Fire Synthesis] §5.2): for every pathlines-per-node count |Ω|,
 /// - "build": the graph build the add-on runs (α, β streamed, C streamed, FlowGraph::build) for
 ///   every node count N, on synthetic groups (tests/flowgraph_groups.h) written to pathline
 ///   files of 100 nodes per state; wall seconds of each part, the peak resident set, reads;

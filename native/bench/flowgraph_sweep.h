@@ -1,6 +1,6 @@
 #pragma once
 /// \file flowgraph_sweep.h
-/// Figure 7 of graph_fire_synthesis.txt ("comparison of the time cost between simulation and
+/// Figure 7 of [Graph Fire Synthesis] ("comparison of the time cost between simulation and
 /// synthesis on different problem scales") as data: `plume_bench_flowgraph_graph --sweep`.
 
 namespace plume::bench {

@@ -1,6 +1,6 @@
 /// \file bind_flames_bake.cpp
 /// What the add-on's flame bake needs beyond the flame core's own bindings: obstacles voxelized
-/// into a signed-distance grid (structural_flames.txt §6.1) for GridSdf.
+/// into a signed-distance grid ([Structural Flames] §6.1) for GridSdf.
 
 #include "bindings/bindings.h"
 #include "bindings/convert.h"

@@ -1,5 +1,5 @@
 /// \file bind_flames_shape.cpp
-/// Structural flames, shape and render side (structural_flames.txt §4.4–4.5, §5): profiles,
+/// Structural flames, shape and render side ([Structural Flames] §4.4–4.5, §5): profiles,
 /// the camera, the shaper (samples, noises, mapping, merging, incandescence, lights) and the
 /// flame VDB. Flames are dicts: points (N, 3) base to tip, optional velocities (N, 3), ages (N,),
 /// radius, intensity, temperature, id, source, separated. Conversions and docstrings only;

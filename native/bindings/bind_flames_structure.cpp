@@ -1,5 +1,5 @@
 /// \file bind_flames_structure.cpp
-/// Structural flames, structure side (structural_flames.txt §4.1–4.3, §6.1–6.2): FlameParams,
+/// Structural flames, structure side ([Structural Flames] §4.1–4.3, §6.1–6.2): FlameParams,
 /// FlameSource, wind fields, obstacle distance fields, FlameSystem and spine helpers. Conversions
 /// and docstrings only; FlameSystem.step releases the GIL.
 

@@ -1,5 +1,5 @@
 /// \file bind_flowgraph_graph.cpp
-/// The flow graph for Python (graph_fire_synthesis.txt §4.3-5.1): FlowGraphParams, the cost
+/// The flow graph for Python ([Graph Fire Synthesis] §4.3-5.1): FlowGraphParams, the cost
 /// matrix of eq. 9-10 from PathlineGroup objects (bind_pathline_group.cpp), the graph with its
 /// pruning, random walks and the Figure 4 picture. Conversions and docstrings only; long calls
 /// release the GIL. std::invalid_argument becomes ValueError.

@@ -1,5 +1,5 @@
 /// \file bind_flowgraph_pathlines.cpp
-/// Flow-graph fire, recording side (graph_fire_synthesis.txt §4.2): the pathline settings, the
+/// Flow-graph fire, recording side ([Graph Fire Synthesis] §4.2): the pathline settings, the
 /// pathline recorder of a fire bake with the file it writes, and complete pathline files read
 /// node by node. Conversions and docstrings only; frames, file reads and writes release the GIL.
 

@@ -1,5 +1,5 @@
 /// \file bind_flowgraph_synth.cpp
-/// Flow-graph fire, synthesis side (graph_fire_synthesis.txt §5.2-5.3): the synthesizer with
+/// Flow-graph fire, synthesis side ([Graph Fire Synthesis] §5.2-5.3): the synthesizer with
 /// uniform or grid external velocity, its cache of prepared groups, and rasterization into frame
 /// VDBs (the pathline recorder and files it reads are in bind_flowgraph_pathlines.cpp).
 /// Conversions and docstrings only; steps, file reads and writes and rasterization release the GIL.

@@ -1,5 +1,5 @@
 /// \file bind_mantaflow.cpp
-/// Streaklines driven by a baked Blender Mantaflow cache (smoke_surfaces.txt §3.2):
+/// Streaklines driven by a baked Blender Mantaflow cache ([Smoke Surfaces] §3.2):
 /// the Mantaflow grid's placement, its VDB frames, the volume frames written from them and the
 /// tracer that runs through them. Conversions and docstrings only; file reads, writes and
 /// frames release the GIL.

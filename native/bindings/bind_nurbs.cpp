@@ -1,5 +1,5 @@
 /// \file bind_nurbs.cpp
-/// Streak-surface NURBS (smoke_surfaces.txt §3.3-3.4) for Python: interpolation on Blender's
+/// Streak-surface NURBS ([Smoke Surfaces] §3.3-3.4) for Python: interpolation on Blender's
 /// knots, evaluation, Blender's tessellation, the density map and the OpenSubdiv mesh export.
 /// A "surface" is the dict interpolate_surface() returns (control_points, nu, nv, order_u,
 /// order_v, endpoint_u, endpoint_v); the add-on can build one from a Blender spline too.

@@ -1,5 +1,5 @@
 /// \file bind_nurbs_fit.cpp
-/// The least-squares streak surface (smoke_surfaces.txt §3.3 with a control net an artist can
+/// The least-squares streak surface ([Smoke Surfaces] §3.3 with a control net an artist can
 /// edit) for Python: one frame's fit, a whole shot's fit with the net size chosen for a
 /// tolerance, and the local frames at the control points that hand edits are kept in.
 

@@ -1,5 +1,5 @@
 /// \file bind_pathline_group.cpp
-/// PathlineLayout and PathlineGroup (flowgraph/pathline_group.h, graph_fire_synthesis.txt §4.3
+/// PathlineLayout and PathlineGroup (flowgraph/pathline_group.h, [Graph Fire Synthesis] §4.3
 /// eq. 7), the node type shared by the flow-graph bindings (bind_flowgraph_*.cpp). The arrays are
 /// NumPy views into the group (alive as long as any view is).
 

@@ -139,7 +139,7 @@ void bindSmokeSolver(py::module_& m) {
       },
       py::arg("positions"), py::arg("radii"), py::arg("density_rates"), py::arg("velocities"),
       py::arg("temperatures"),
-      "Replaces the point emitters (structural_flames.txt §6.3 smoke): centres (N, 3) m, sphere "
+      "Replaces the point emitters ([Structural Flames] §6.3 smoke): centres (N, 3) m, sphere "
       "radii (N,) m (at least one cell is used), mass rates (N,) in density x m^3 per second, "
       "face velocities (N, 3) m/s, temperatures (N,) above ambient. Applied every step until "
       "replaced or clear_emitters(); ValueError on bad shapes or values.");

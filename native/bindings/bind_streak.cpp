@@ -1,5 +1,5 @@
 /// \file bind_streak.cpp
-/// Streaklines for Python (smoke_surfaces.txt §3.2): point sources, the tracer and the
+/// Streaklines for Python ([Smoke Surfaces] §3.2): point sources, the tracer and the
 /// per-frame streak files (their clustering, §3.3, is in bind_streak_clusters.cpp).
 /// Conversions and docstrings only; long calls release the GIL.
 

@@ -1,5 +1,5 @@
 /// \file bind_streak_clusters.cpp
-/// Clustering of streaklines for Python (smoke_surfaces.txt §3.3): shared frames, the sparse
+/// Clustering of streaklines for Python ([Smoke Surfaces] §3.3): shared frames, the sparse
 /// distances h of a candidate group, the default threshold h0, clusters, the Figure 4 counts and
 /// the greedy order. Conversions and docstrings only; long calls release the GIL.
 

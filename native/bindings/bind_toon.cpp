@@ -1,5 +1,5 @@
 /// \file bind_toon.cpp
-/// Toon smoke (cartoon_smoke.txt) settings and inputs for Python: ToonParams with its enums and
+/// Toon smoke ([Cartoon Smoke]) settings and inputs for Python: ToonParams with its enums and
 /// the fields of a frame, from NumPy arrays or a Plume volume frame (the particles, billboards,
 /// outlines and toon files are in bind_toon_particles.cpp). Conversions and docstrings only;
 /// file reads release the GIL.

@@ -1,5 +1,5 @@
 /// \file bind_toon_particles.cpp
-/// Toon smoke (cartoon_smoke.txt) for Python: ToonParticles driven by ToonFields or by Plume
+/// Toon smoke ([Cartoon Smoke]) for Python: ToonParticles driven by ToonFields or by Plume
 /// volume frames, stencil billboards (Figure 4), the depth-differences reference filter (§2.2)
 /// and the toon cache files. Conversions and docstrings only; frames, file reads and writes,
 /// billboards and the filter release the GIL.

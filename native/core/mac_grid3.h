@@ -1,7 +1,7 @@
 #pragma once
 /// \file mac_grid3.h
 /// Staggered (MAC) velocity grid: u on x-faces, v on y-faces, w on z-faces (Harlow & Welch;
-/// the layout of smoke_surfaces.txt §3.1 and Stam 1999).
+/// the layout of [Smoke Surfaces] §3.1 and Stam 1999).
 
 #include "core/grid3.h"
 

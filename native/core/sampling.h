@@ -1,7 +1,7 @@
 #pragma once
 /// \file sampling.h
 /// Trilinear and monotonic cubic sampling of a grid (Fedkiw, Stam & Jensen 2001, §5;
-/// smoke_surfaces.txt §3.1 uses it to keep small rolling features).
+/// [Smoke Surfaces] §3.1 uses it to keep small rolling features).
 
 #include "core/grid3.h"
 #include "core/mac_grid3.h"

@@ -2,7 +2,7 @@
 /// \file fire_raster.h
 /// Particles into VDB grids `density`, `temperature` and `flame`, shared by the two fire
 /// pipelines: flow-graph fire rasterizes its synthesized particles with it
-/// (graph_fire_synthesis.txt §5.3; DESIGN.md: "rasterization of particles into VDB grids with
+/// ([Graph Fire Synthesis] §5.3; DESIGN.md: "rasterization of particles into VDB grids with
 /// OpenVDB's point tools"), structural flames its scalar grids (flames/flame_raster.cpp). On the
 /// bake's voxels, written as a frame VDB (io/vdb_grids.h).
 ///

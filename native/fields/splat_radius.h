@@ -1,7 +1,7 @@
 #pragma once
 /// \file splat_radius.h
 /// The splat radius of every particle from the local particle spacing (fields/fire_raster.h):
-/// particles are seeded at Δx/2 (graph_fire_synthesis.txt §4.2) and spread apart as they rise,
+/// particles are seeded at Δx/2 ([Graph Fire Synthesis] §4.2) and spread apart as they rise,
 /// so a kernel of one voxel leaves gaps between old particles (speckle, detached blobs). The
 /// radius grows with the spacing so that neighbouring kernels overlap as on the seeding lattice.
 ///

@@ -1,7 +1,7 @@
 #pragma once
 /// \file velocity_extend.h
 /// A velocity grid extended beyond the voxels that hold it, for volume motion blur. Cycles blurs
-/// a volume by looking every grid up at x − τ u(x) over the shutter τ (structural_flames.txt
+/// a volume by looking every grid up at x − τ u(x) over the shutter τ ([Structural Flames]
 /// §5.3: "motion blurred using the instantaneous velocities"): where u is 0 — just outside the
 /// flame — nothing is displaced, so a fast flame's outline would not blur at all. Extending u
 /// by the distance the flame moves during the shutter lets the blur reach past it.

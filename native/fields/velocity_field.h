@@ -1,7 +1,7 @@
 #pragma once
 /// \file velocity_field.h
 /// External velocity fields shared by flow-graph fire and structural flames: the interface
-/// u_ext(x, t) the synthesizer moves particles with (graph_fire_synthesis.txt §5.2, eq. 13:
+/// u_ext(x, t) the synthesizer moves particles with ([Graph Fire Synthesis] §5.2, eq. 13:
 /// "velocity introduced by (optional) external forces, useful for fire deformation"), and its
 /// grid form, which flames' GridWind (flames/wind.h) reads too. The add-on evaluates Blender's
 /// Wind and Turbulence force fields at cell centres once per frame.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file blackbody.h
-/// The colour of a blackbody (structural_flames.txt §5.1: "hotter regions are bluer"), the
+/// The colour of a blackbody ([Structural Flames] §5.1: "hotter regions are bluer"), the
 /// fallback base colour of a flame particle when no colour image is given: Planck's law
 /// integrated against the CIE 1931 2° colour-matching functions (the multi-lobe Gaussian fit of
 /// Wyman, Sloan and Shirley 2013) from 380 to 780 nm, converted to linear Rec. 709 (Blender's

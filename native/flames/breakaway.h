@@ -1,6 +1,6 @@
 #pragma once
 /// \file breakaway.h
-/// Flickering and separation as a statistical process (structural_flames.txt §4.3).
+/// Flickering and separation as a statistical process ([Structural Flames] §4.3).
 ///
 /// The text: "From its creation a flame develops until it reaches H_i. At that point we
 /// periodically test a random number against the probability function D(h) [eq. 3] ... The

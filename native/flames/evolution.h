@@ -1,6 +1,6 @@
 #pragma once
 /// \file evolution.h
-/// Flame evolution (structural_flames.txt §4.2): each structural particle p moves by eq. 1,
+/// Flame evolution ([Structural Flames] §4.2): each structural particle p moves by eq. 1,
 ///   dx_p/dt = w(x_p, t) + v_K(x_p, t) + d(T_p) + V_p + c(T_p, t),
 /// wind, the Kolmogorov noise field ("we add rotational components in the form of simulated wind
 /// fields and a noise field generated from a Kolmogorov spectrum", spine_noise.h), Brownian

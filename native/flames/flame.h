@@ -1,6 +1,6 @@
 #pragma once
 /// \file flame.h
-/// The data every stage of the structural-flames pipeline (structural_flames.txt) shares: one
+/// The data every stage of the structural-flames pipeline ([Structural Flames]) shares: one
 /// flame is its spine, the n points an interpolating B-spline passes through (§4.1), from the
 /// base on the burning surface (index 0) to the tip (index n-1), with what each point carries
 /// for eq. 1 and the later stages. Structure (spine, evolution, breakaway: §4.1–4.3) produces

@@ -1,6 +1,6 @@
 #pragma once
 /// \file flame_params.h
-/// The artist's settings of the flame structure (structural_flames.txt §4.1–4.3) and of one flame
+/// The artist's settings of the flame structure ([Structural Flames] §4.1–4.3) and of one flame
 /// source (§4.2 moving sources, §6.2 spread maps: activation time, duration, intensity, diameter,
 /// height). Units: metres, seconds; Blender Z up.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file flame_raster.h
-/// Flame particles into the VDB grids of a frame (structural_flames.txt §5.3: "ideally, the
+/// Flame particles into the VDB grids of a frame ([Structural Flames] §5.3: "ideally, the
 /// deformed flames should be volume rendered directly"), for Blender's Principled Volume:
 ///   emission     Σ U P_i c_i w_i(v) / Δx³, vec3, W/m³ in Blender's light units (U =
 ///                emissionScale, the light unit; c_i the §5.1 colour, mean luminance 1): eq. 6's

@@ -1,6 +1,6 @@
 #pragma once
 /// \file flame_sampler.h
-/// Monte-Carlo sampling of a flame's density (structural_flames.txt §4.4, §5.3): how many
+/// Monte-Carlo sampling of a flame's density ([Structural Flames] §4.4, §5.3): how many
 /// samples ("super-sample the profile with sufficient density for complete coverage": the
 /// flame's projected area on the camera times particles per pixel, about ten in the paper, or a
 /// fixed count), and the samples themselves, fresh every frame, seeded per flame and particle so

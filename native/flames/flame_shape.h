@@ -1,6 +1,6 @@
 #pragma once
 /// \file flame_shape.h
-/// The shape and render stage of structural flames for one frame (structural_flames.txt
+/// The shape and render stage of structural flames for one frame ([Structural Flames]
 /// §4.4–4.5, §5): for every flame, Monte-Carlo samples of eq. 4 in its profile, the buoyancy
 /// flow noise, the cylindrical mapping of Figure 4, the Kolmogorov noise, merging, base colour
 /// and incandescence (eq. 5–6), and one light per flame.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file flame_system.h
-/// The structure of structural flames over time (structural_flames.txt §4.1–4.3, §6.1–6.2):
+/// The structure of structural flames over time ([Structural Flames] §4.1–4.3, §6.1–6.2):
 /// sources release particles into the wind every step, spines evolve by eq. 1, are fitted and
 /// re-sampled, break by the statistical process of §4.3, separated pieces die after A·i³, and
 /// control points are pushed out of obstacles. Deterministic for a seed at any thread count:

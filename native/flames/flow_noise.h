@@ -1,6 +1,6 @@
 #pragma once
 /// \file flow_noise.h
-/// Buoyancy noise of structural_flames.txt §4.5: Flow Noise (Perlin & Neyret 2001) — gradient
+/// Buoyancy noise of [Structural Flames] §4.5: Flow Noise (Perlin & Neyret 2001) — gradient
 /// noise whose lattice gradients rotate over time — displacing the samples in canonical profile
 /// space, propagating up the profile with the spine's structural points.
 ///

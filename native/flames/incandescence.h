@@ -1,6 +1,6 @@
 #pragma once
 /// \file incandescence.h
-/// Rendering data of structural_flames.txt §5: base colour from a reference image mapped on the
+/// Rendering data of [Structural Flames] §5: base colour from a reference image mapped on the
 /// 2-D profile (§5.1), the flame's energy (eq. 5), each particle's incandescence (eq. 6) and
 /// the light standing for a flame (§5.2: an emitting sphere of radius h/3 at its centre).
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file kolmogorov_noise.h
-/// Turbulent detail of structural_flames.txt §4.5: a world-space vector field with a Kolmogorov
+/// Turbulent detail of [Structural Flames] §4.5: a world-space vector field with a Kolmogorov
 /// energy spectrum E(k) ∝ k^(−5/3) (Stam & Fiume 1993), displacing every flame's samples after
 /// the spine mapping. One field for all flames, so neighbouring (merging) flames move alike.
 ///

@@ -1,6 +1,6 @@
 #pragma once
 /// \file merging.h
-/// Flame merging (structural_flames.txt §4.5): after all transformations, a particle inside a
+/// Flame merging ([Structural Flames] §4.5): after all transformations, a particle inside a
 /// neighbouring flame's transformed profile and outside its own region (eq. 4's surface: it was
 /// sampled in its flame's outer glow) is not rendered, so the glow of one flame does not show
 /// inside another and the two read as one. Can be switched off (the paper's dragon did).

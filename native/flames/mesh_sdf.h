@@ -1,6 +1,6 @@
 #pragma once
 /// \file mesh_sdf.h
-/// Obstacles of structural flames as voxels (structural_flames.txt §6.1: "we approximate the
+/// Obstacles of structural flames as voxels ([Structural Flames] §6.1: "we approximate the
 /// object as a series of solid voxels"): the signed distance φ of a closed mesh on a dense
 /// cell-centred grid, from OpenVDB's mesh-to-volume, for GridSdf (obstacle_sdf.h).
 

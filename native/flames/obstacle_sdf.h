@@ -1,6 +1,6 @@
 #pragma once
 /// \file obstacle_sdf.h
-/// Stationary objects for flame interaction (structural_flames.txt §6.1): "after their positions
+/// Stationary objects for flame interaction ([Structural Flames] §6.1): "after their positions
 /// are modified they are tested against the object volume and moved outside if there's a
 /// conflict". An obstacle is a signed distance φ (negative inside, metres); control points with
 /// φ < margin are pushed along ∇φ.

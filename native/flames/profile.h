@@ -1,6 +1,6 @@
 #pragma once
 /// \file profile.h
-/// Normalized 2D flame profiles (structural_flames.txt §4.4, Figure 3): the silhouette r(s) of a
+/// Normalized 2D flame profiles ([Structural Flames] §4.4, Figure 3): the silhouette r(s) of a
 /// flame, s ∈ [0, 1] from the base to the tip along the spine, whose surface of revolution
 /// around the spine bounds the visible (oxidization) region.
 ///

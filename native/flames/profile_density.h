@@ -1,6 +1,6 @@
 #pragma once
 /// \file profile_density.h
-/// The light density of a flame (structural_flames.txt §4.4, eq. 4) in canonical profile space
+/// The light density of a flame ([Structural Flames] §4.4, eq. 4) in canonical profile space
 /// (profile.h), and its Monte-Carlo sampling:
 ///   d(x) = I / (1 + |x_f(x) − x|² / ℓ²)   outside the surface,   d(x) = I inside it
 /// x_f(x) the closest point to x on the surface of revolution of the profile. Eq. 4 defines "the

@@ -1,6 +1,6 @@
 #pragma once
 /// \file spine.h
-/// The base curve of a flame (structural_flames.txt §4.1): "an interpolating B-Spline curve ...
+/// The base curve of a flame ([Structural Flames] §4.1): "an interpolating B-Spline curve ...
 /// fitted so that it passes through all the points. This curve is then parametrically re-sampled,
 /// generating a new set of n points (always keeping the first and last unchanged)."
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file spine_mapping.h
-/// The cylindrical mapping of Figure 4 (structural_flames.txt §4.5): a point of canonical profile
+/// The cylindrical mapping of Figure 4 ([Structural Flames] §4.5): a point of canonical profile
 /// space (x, y, z) — z along the axis in widest radii, s = z / aspect — lands at
 ///   X = C(s · L) + R · (x N(s) + y B(s))
 /// with C the spine curve, L its arc length, R the flame's radius, and (T, N, B) a

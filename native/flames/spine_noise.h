@@ -1,6 +1,6 @@
 #pragma once
 /// \file spine_noise.h
-/// The Kolmogorov velocity of eq. 1 (structural_flames.txt §4.2: "we add rotational components in
+/// The Kolmogorov velocity of eq. 1 ([Structural Flames] §4.2: "we add rotational components in
 /// the form of simulated wind fields and a noise field generated from a Kolmogorov spectrum";
 /// §7, the torch: "the control points are influenced by thermal buoyancy and Kolmogorov noise").
 /// A term v_K(x, t) added to the velocity of every structural particle, next to w, d, V_p and c.

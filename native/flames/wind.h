@@ -1,6 +1,6 @@
 #pragma once
 /// \file wind.h
-/// The controlling wind field w(x_p, t) of eq. 1 (structural_flames.txt §4.2, §6: "global motion
+/// The controlling wind field w(x_p, t) of eq. 1 ([Structural Flames] §4.2, §6: "global motion
 /// is dictated by the summation of different kinds of wind field"): small fields summed by a
 /// CompositeWind — uniform wind (Blender's Wind force field: direction · strength), a vortex
 /// (Blender's Vortex), divergence-free turbulence (Blender's Turbulence), and a velocity grid

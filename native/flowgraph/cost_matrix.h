@@ -1,6 +1,6 @@
 #pragma once
 /// \file cost_matrix.h
-/// The transition cost matrix C = (c_ij) of a flow graph (graph_fire_synthesis.txt §4.3,
+/// The transition cost matrix C = (c_ij) of a flow graph ([Graph Fire Synthesis] §4.3,
 /// eq. 9-10) between every pair of nodes of every state: all groups of all states in one matrix,
 /// ordered state by state and chronologically inside a state (stateNodeCounts()).
 

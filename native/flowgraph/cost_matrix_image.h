@@ -1,6 +1,6 @@
 #pragma once
 /// \file cost_matrix_image.h
-/// A picture of the cost matrix like Figure 4 of graph_fire_synthesis.txt (§4.3): grey-scale
+/// A picture of the cost matrix like Figure 4 of [Graph Fire Synthesis] (§4.3): grey-scale
 /// costs (darker = lower), blue marks on the filtered candidates, yellow marks on the kept
 /// transitions, thin red lines between states.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file cost_matrix_stream.h
-/// The cost matrix C of eq. 9-10 (graph_fire_synthesis.txt §4.3) streamed from the states'
+/// The cost matrix C of eq. 9-10 ([Graph Fire Synthesis] §4.3) streamed from the states'
 /// pathline files: the groups are read block by block, so the build holds a bounded number of
 /// groups (not all N, 3 GB for 1,000 nodes of 3,200 pathlines × 48 samples).
 

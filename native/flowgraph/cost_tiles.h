@@ -1,6 +1,6 @@
 #pragma once
 /// \file cost_tiles.h
-/// One tile of node pairs of the cost matrix of eq. 9-10 (graph_fire_synthesis.txt §4.3): the
+/// One tile of node pairs of the cost matrix of eq. 9-10 ([Graph Fire Synthesis] §4.3): the
 /// kernel shared by the in-memory build (cost_matrix.cpp, every group at hand) and the streamed
 /// one (cost_matrix_stream.cpp, the groups of two blocks at a time). An entry c_ij depends on
 /// groups i and j only and is summed in one fixed order whatever tile holds it, so both builds

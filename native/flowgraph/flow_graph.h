@@ -1,6 +1,6 @@
 #pragma once
 /// \file flow_graph.h
-/// The flow graph G = (V, E) of graph_fire_synthesis.txt §4.3: one node per pathline group
+/// The flow graph G = (V, E) of [Graph Fire Synthesis] §4.3: one node per pathline group
 /// (state, step), temporal edges k → k+1 inside a state (eq. 8) and the kept transition edges
 /// (eq. 11), with every node that cannot continue forever, or from which a walk could never
 /// come back to the main part of the graph, pruned: a random walk (§5.1) never ends nor gets

@@ -1,6 +1,6 @@
 #pragma once
 /// \file flow_graph_params.h
-/// Settings of the flow graph (graph_fire_synthesis.txt §4.3): the weights α, β of the
+/// Settings of the flow graph ([Graph Fire Synthesis] §4.3): the weights α, β of the
 /// transition cost (eq. 9), the block size B of the candidate search, the threshold ε of
 /// eq. 11 and the temporal gap below which two nodes of one state are never connected.
 

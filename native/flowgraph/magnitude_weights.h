@@ -1,6 +1,6 @@
 #pragma once
 /// \file magnitude_weights.h
-/// The "same order of magnitude" weights α, β of eq. 9 (graph_fire_synthesis.txt §4.3), from
+/// The "same order of magnitude" weights α, β of eq. 9 ([Graph Fire Synthesis] §4.3), from
 /// groups in memory or streamed from the states' pathline files.
 
 #include "flowgraph/node_files.h"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file node_files.h
-/// The nodes of a flow graph read from its states' pathline files (graph_fire_synthesis.txt
+/// The nodes of a flow graph read from its states' pathline files ([Graph Fire Synthesis]
 /// §4.2-4.3) instead of held in memory: node n is group k of state s in the order of
 /// stateNodeCounts() (state by state, chronologically), read when it is needed.
 

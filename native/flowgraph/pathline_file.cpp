@@ -1,5 +1,5 @@
 /// \file pathline_file.cpp
-/// Pathline files (graph_fire_synthesis.txt §4.2): incremental writer and lazy reader.
+/// Pathline files ([Graph Fire Synthesis] §4.2): incremental writer and lazy reader.
 
 #include "flowgraph/pathline_file.h"
 

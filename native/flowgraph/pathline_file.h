@@ -1,6 +1,6 @@
 #pragma once
 /// \file pathline_file.h
-/// The pathline file of one fire bake (graph_fire_synthesis.txt §4.2: "compact storage", one
+/// The pathline file of one fire bake ([Graph Fire Synthesis] §4.2: "compact storage", one
 /// file per state, `pathlines.bin` in the bake folder), written group by group while the bake
 /// runs and read one node at a time.
 ///

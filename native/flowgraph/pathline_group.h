@@ -1,6 +1,6 @@
 #pragma once
 /// \file pathline_group.h
-/// A node of the flow graph (graph_fire_synthesis.txt §4.2-4.3, eq. 7): the pathlines of the
+/// A node of the flow graph ([Graph Fire Synthesis] §4.2-4.3, eq. 7): the pathlines of the
 /// particles seeded in the fuel-injection region Ω at node step k of one fire bake ("state"),
 /// with velocity U_k, soot density R_k and temperature T_k sampled at L equally spaced times
 /// over the lifetime [0, t_max].

@@ -1,6 +1,6 @@
 #pragma once
 /// \file pathline_integrator.h
-/// Pathlines p(x0, t0, t) = x0 + ∫ u(p(τ), τ) dτ (graph_fire_synthesis.txt §4.2, eq. 6)
+/// Pathlines p(x0, t0, t) = x0 + ∫ u(p(τ), τ) dτ ([Graph Fire Synthesis] §4.2, eq. 6)
 /// integrated with RK4 through one solver substep. Plume's solver holds the velocity only at
 /// the start and the end of a substep, so u(x, t) inside [t0, t0 + dt] is the linear
 /// interpolation in time of the two fields, each read trilinearly per MAC component.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file pathline_recorder.h
-/// Records the pathline groups of a fire bake (graph_fire_synthesis.txt §4.2-4.3, eqs. 6-7)
+/// Records the pathline groups of a fire bake ([Graph Fire Synthesis] §4.2-4.3, eqs. 6-7)
 /// while SmokeSolver::advanceFrame() runs: a StepObserver that follows every substep.
 ///
 /// Timeline. Node steps are Δt_n = frame_dt / nodes_per_frame apart (pathline_group.h); node n

@@ -1,6 +1,6 @@
 #pragma once
 /// \file prepared_group.h
-/// A pathline group in the form the synthesis emits (graph_fire_synthesis.txt §5.2, eq. 13):
+/// A pathline group in the form the synthesis emits ([Graph Fire Synthesis] §5.2, eq. 13):
 /// the pathline part of every particle's position at each of its L samples, summed once by the
 /// trapezoid rule, with density and temperature, sample-major ([age][particle]) so that the
 /// steps and gather() stream. It does not depend on u_ext, so it is immutable once made and

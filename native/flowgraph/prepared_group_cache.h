@@ -1,7 +1,7 @@
 #pragma once
 /// \file prepared_group_cache.h
 /// The prepared groups (prepared_group.h) of recently visited nodes, kept between visits of the
-/// random walk (graph_fire_synthesis.txt §5.1-5.2): a walk revisits nodes (600 campfire frames
+/// random walk ([Graph Fire Synthesis] §5.1-5.2): a walk revisits nodes (600 campfire frames
 /// visit each of its 453 nodes about four times), and reading a group from its pathline file
 /// and preparing it (eq. 13's trapezoid sums) costs far more than emitting a prepared one,
 /// which is a pointer copy. Least recently used first out, within a byte budget.

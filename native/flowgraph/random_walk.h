@@ -1,6 +1,6 @@
 #pragma once
 /// \file random_walk.h
-/// Random walks on a flow graph (graph_fire_synthesis.txt §5.1): from the first node of a
+/// Random walks on a flow graph ([Graph Fire Synthesis] §5.1): from the first node of a
 /// state, one edge per node step, uniform, with temporal bias γ (eq. 12), or steered to a
 /// target state; seeded, so the same seed gives the same walk.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file state_nodes.h
-/// The node order of a flow graph (graph_fire_synthesis.txt §4.3): the pathline groups of every
+/// The node order of a flow graph ([Graph Fire Synthesis] §4.3): the pathline groups of every
 /// state, state by state, each state's groups chronologically ("we order the nodes
 /// chronologically"), all sharing one PathlineLayout so that eq. 10 compares like with like.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file synthesizer.h
-/// Fire synthesis from a walk on the flow graph (graph_fire_synthesis.txt §5.2, eq. 13,
+/// Fire synthesis from a walk on the flow graph ([Graph Fire Synthesis] §5.2, eq. 13,
 /// Algorithm 1): each visited node emits its group's particles at their start positions; every
 /// particle then follows its own pathline's velocity samples plus an external velocity,
 ///   x_{k+1} = x_k + ∫_{t_k}^{t_k + Δt_n} [u(t) + u_ext(t)] dt,              (13)

@@ -1,6 +1,6 @@
 #pragma once
 /// \file target_distance.h
-/// How far a walk is from a target state (graph_fire_synthesis.txt §5.1: "the edge
+/// How far a walk is from a target state ([Graph Fire Synthesis] §5.1: "the edge
 /// probabilities are computed depending on how far the current visited node is from the target
 /// state"), counting the transition state of §5: after a transition the walk must follow
 /// temporal edges for H node steps (random_walk.h). The distance is taken on the walk's own

@@ -1,6 +1,6 @@
 #pragma once
 /// \file transitions.h
-/// Transition edges of a flow graph (graph_fire_synthesis.txt §4.3): the minimum of each B×B
+/// Transition edges of a flow graph ([Graph Fire Synthesis] §4.3): the minimum of each B×B
 /// block of the cost matrix is a candidate; candidates with c < ε are kept (eq. 11), ε between
 /// a = min and b = max of the candidates' costs, (2a + b)/3 by default.
 

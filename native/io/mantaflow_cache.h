@@ -1,7 +1,7 @@
 #pragma once
 /// \file mantaflow_cache.h
 /// One frame of a Blender (3.4) Mantaflow gas cache, `<cache>/data/fluid_data_####.vdb`, read
-/// as the fields that carry streakline tracers (smoke_surfaces.txt §3.2: particles "advected by
+/// as the fields that carry streakline tracers ([Smoke Surfaces] §3.2: particles "advected by
 /// the velocity field"), and written back as a Plume volume frame.
 ///
 /// What Blender 3.4 writes (checked on real bakes, see the add-on's mantaflow_trace.py):

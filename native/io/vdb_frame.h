@@ -13,7 +13,7 @@ namespace plume {
 /// Writes the solver's current state to `path` as a VDB with fog-volume float grids `density`
 /// (smoke density + soot), `temperature`, `flame` (only when params().combustion) and a
 /// cell-centred vec3 grid `velocity` (only in voxels with density or flame, or in every voxel
-/// when `velocityEverywhere`: a domain read as a wind field, structural_flames.txt §6.1). Voxel
+/// when `velocityEverywhere`: a domain read as a wind field, [Structural Flames] §6.1). Voxel
 /// (i,j,k) is centred at origin + (i+½, j+½, k+½) Δx in
 /// world space. Zero voxels are not stored. Written to `path + ".tmp"` and renamed, so a killed
 /// bake never leaves a half file. Throws std::runtime_error with the path on failure.

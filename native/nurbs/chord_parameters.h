@@ -1,6 +1,6 @@
 #pragma once
 /// \file chord_parameters.h
-/// Parameters of the particles for the least-squares streak surface (smoke_surfaces.txt §3.3,
+/// Parameters of the particles for the least-squares streak surface ([Smoke Surfaces] §3.3,
 /// fitted instead of interpolated): averaged chord length (Piegl & Tiller, The NURBS Book,
 /// eq. 9.5-9.6 and §9.2.5), so that the control points of a uniform knot vector spread evenly
 /// along the smoke instead of evenly over particle indices.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file density_map.h
-/// The density (opacity) map of a streak surface (smoke_surfaces.txt §3.4, Figures 8 and 10):
+/// The density (opacity) map of a streak surface ([Smoke Surfaces] §3.4, Figures 8 and 10):
 /// the simulated density sampled on the surface at supersampling rates k_u, k_v between the
 /// particles, with the solver's interpolation, as a float image in (u, v).
 

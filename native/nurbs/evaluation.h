@@ -1,6 +1,6 @@
 #pragma once
 /// \file evaluation.h
-/// Points, derivatives and normals of a streak surface (smoke_surfaces.txt §3.3-3.4: the opacity
+/// Points, derivatives and normals of a streak surface ([Smoke Surfaces] §3.3-3.4: the opacity
 /// p = d·e^(−|n·v|) needs the normal n), and the vertex grid Blender 3.4 tessellates.
 /// Parameters are Blender's knot parameters; they are clamped to the drawn domain
 /// (surfaceDomain()), where Blender's own sampling stays.

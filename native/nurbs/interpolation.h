@@ -1,6 +1,6 @@
 #pragma once
 /// \file interpolation.h
-/// The NURBS surface through every particle of a streakline cluster (smoke_surfaces.txt §3.3,
+/// The NURBS surface through every particle of a streakline cluster ([Smoke Surfaces] §3.3,
 /// Figure 6): tensor-product B-spline interpolation on Blender's knots.
 
 #include "nurbs/surface.h"

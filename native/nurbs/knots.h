@@ -1,7 +1,7 @@
 #pragma once
 /// \file knots.h
 /// Blender 3.4's own knot vectors and parameter rules for one NURBS direction
-/// (smoke_surfaces.txt §3.3: "each particle in the streaklines serves as a knot" — we interpolate
+/// ([Smoke Surfaces] §3.3: "each particle in the streaklines serves as a knot" — we interpolate
 /// the particles on Blender's knots so that the surface Blender draws is the one we compute).
 ///
 /// Read from blender/source/blender/blenkernel/intern/curve.cc (3.4):

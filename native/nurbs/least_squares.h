@@ -1,6 +1,6 @@
 #pragma once
 /// \file least_squares.h
-/// One direction of the least-squares streak surface (smoke_surfaces.txt §3.3, with fewer
+/// One direction of the least-squares streak surface ([Smoke Surfaces] §3.3, with fewer
 /// control points than particles so the net stays on the smoke): a B-spline curve on Blender's
 /// knots fitted to data at given parameters (Piegl & Tiller, The NURBS Book §9.4.1) with a small
 /// penalty on the control polygon's second divided differences, which keeps the normal

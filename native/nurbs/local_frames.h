@@ -1,7 +1,7 @@
 #pragma once
 /// \file local_frames.h
 /// Local frames of a streak surface at its control points, for hand edits that turn with the
-/// sheet (smoke_surfaces.txt §5, Figure 13: the artist warps the NURBS surface; the add-on keeps
+/// sheet ([Smoke Surfaces] §5, Figure 13: the artist warps the NURBS surface; the add-on keeps
 /// the warp as offsets in these frames and applies them on every frame).
 
 #include "nurbs/surface.h"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file near_particles.h
-/// How far control points are from the smoke (smoke_surfaces.txt §3.3 with an editable net:
+/// How far control points are from the smoke ([Smoke Surfaces] §3.3 with an editable net:
 /// a control point an artist grabs should sit among the particles it shapes): distances from
 /// query points to the nearest of a set of particles, through a uniform bucket grid.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file shot_fit.h
-/// The streak surface of a whole shot (smoke_surfaces.txt §3.3): Blender keeps one control-net
+/// The streak surface of a whole shot ([Smoke Surfaces] §3.3): Blender keeps one control-net
 /// topology per object, so the counts nu × nv are chosen once, as the smallest that fit every
 /// frame within a tolerance, and every frame is fitted with them (fitSurface()).
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file subdivision_export.h
-/// Mesh export of a streak surface (smoke_surfaces.txt §3.3 notes that subdivision modelling
+/// Mesh export of a streak surface ([Smoke Surfaces] §3.3 notes that subdivision modelling
 /// could also give a smooth surface once a base mesh exists — the control net is that mesh):
 /// the NURBS control net refined with OpenSubdiv (Catmull-Clark, boundary EDGE_AND_CORNER)
 /// into a smooth quad mesh carrying the §3.4 density as a per-vertex attribute.

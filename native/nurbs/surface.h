@@ -1,6 +1,6 @@
 #pragma once
 /// \file surface.h
-/// The NURBS surface of one streakline cluster (smoke_surfaces.txt §3.3, Figure 6) as plain data,
+/// The NURBS surface of one streakline cluster ([Smoke Surfaces] §3.3, Figure 6) as plain data,
 /// laid out exactly like a Blender SURFACE spline so the add-on copies it with one foreach_set.
 
 #include "nurbs/knots.h"

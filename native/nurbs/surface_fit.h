@@ -1,6 +1,6 @@
 #pragma once
 /// \file surface_fit.h
-/// The streak surface of one frame as a least-squares fit (smoke_surfaces.txt §3.3, Figure 6):
+/// The streak surface of one frame as a least-squares fit ([Smoke Surfaces] §3.3, Figure 6):
 /// a B-spline surface on Blender's endpoint knots with a given control net nu × nv, usually
 /// smaller than the particles, passing within a tolerance of every particle it is fitted to
 /// while its control points stay on the smoke (an interpolating net through hundreds of

@@ -1,6 +1,6 @@
 #pragma once
 /// \file combustion.h
-/// The combustion model of graph_fire_synthesis.txt §4.1: fuel burnt into soot and heat
+/// The combustion model of [Graph Fire Synthesis] §4.1: fuel burnt into soot and heat
 /// (eqs. 3-5), cooling, conduction, and the divergence φ of the reaction zone (eq. 1).
 
 #include "core/grid3.h"

@@ -1,7 +1,7 @@
 #pragma once
 /// \file point_emitters.h
 /// Small spherical emitters given by a point, not a mesh: the smoke of structural flames
-/// (structural_flames.txt §6.3: "smoke as particles above the tip of each flame", introduced
+/// ([Structural Flames] §6.3: "smoke as particles above the tip of each flame", introduced
 /// into the gas simulator with the velocity of the top control point and a temperature that
 /// keeps the buoyancy of eq. 2). Unlike a Source, which holds its cells at a set density, a
 /// point emitter adds a mass per second, so the smoke a flame gives off follows its radiation

@@ -13,7 +13,7 @@
 
 namespace plume {
 
-/// Semi-Lagrangian (Stam 1999), BFECC (Kim et al. 2005, smoke_surfaces.txt §3.1) or MacCormack
+/// Semi-Lagrangian (Stam 1999), BFECC (Kim et al. 2005, [Smoke Surfaces] §3.1) or MacCormack
 /// (Selle et al. 2008: BFECC's accuracy with two interpolation passes instead of three).
 enum class Advection { SemiLagrangian, Bfecc, MacCormack };
 
@@ -23,7 +23,7 @@ enum class Advection { SemiLagrangian, Bfecc, MacCormack };
 /// an exact average of 2 or 4 faces and needs no interpolation (Mantaflow's default trace).
 enum class Trace { Midpoint, Euler };
 
-/// A side of the domain is open (smoke_surfaces.txt's default) or a wall (Closed: no flow
+/// A side of the domain is open ([Smoke Surfaces]'s default) or a wall (Closed: no flow
 /// through it, u·n = 0; scalars and tangential velocity zero-gradient).
 /// Open: the ambient air lies beyond it (inflow.h). p = 0 outside; what flows out leaves with
 /// zero gradient; what flows in is ambient air: ρ = F = S = 0, T = T_amb, velocity 0 (or the
@@ -88,7 +88,7 @@ struct SmokeParams {
   float pressureTolerance = 1e-4f;  ///< relative residual |r|/|b| at which MGPCG stops
   int maxPressureIterations = 200;
 
-  // --- Combustion (graph_fire_synthesis.txt eqs. 1-5) ---
+  // --- Combustion ([Graph Fire Synthesis] eqs. 1-5) ---
   bool combustion = false;
   float burnRate = 4.f;         ///< r: fuel burnt per second, dF/dt = -r F
   float sootYield = 0.5f;       ///< k_S: soot made per unit fuel burnt

@@ -26,7 +26,7 @@ struct SourceSettings {
   float density = 1.f;      ///< ρ set in source cells (the larger of this and what is there)
   float temperature = 1.f;  ///< T - T_amb set in source cells
   float fuel = 0.f;         ///< F set in source cells (combustion)
-  glm::vec3 velocity{0.f};  ///< initial velocity, m/s (smoke_surfaces.txt §3.2)
+  glm::vec3 velocity{0.f};  ///< initial velocity, m/s ([Smoke Surfaces] §3.2)
   float motionFactor = 1.f; ///< share of the source object's own motion added to its velocity
   SourceNoise fuelNoise;    ///< flicker: patches of thinner fuel (source_noise.h)
   /// breakup: patches of thinner smoke and heat, for a source that burns no fuel (source_noise.h)
@@ -48,7 +48,7 @@ struct StepStats {
 class SmokeSolver;
 class AdaptiveDomain;
 
-/// Follows a simulation step by step, e.g. the streakline tracers of smoke_surfaces.txt §3.2,
+/// Follows a simulation step by step, e.g. the streakline tracers of [Smoke Surfaces] §3.2,
 /// whose particles move with the velocity of every step, not only of every frame.
 class StepObserver {
  public:
@@ -76,7 +76,7 @@ class SmokeSolver {
   void clearEmitters();  ///< sources, obstacles and point emitters
   void addSource(const CellSet& cells, const SourceSettings& settings);
   void addObstacle(const CellSet& cells, Slip slip);
-  /// Replaces the point emitters (structural_flames.txt §6.3 smoke) applied every step from now
+  /// Replaces the point emitters ([Structural Flames] §6.3 smoke) applied every step from now
   /// on; validates each (std::invalid_argument), radius at most the domain's longest side.
   void setPointEmitters(std::vector<PointEmitter> emitters);
   const std::vector<PointEmitter>& pointEmitters() const { return mPointEmitters; }

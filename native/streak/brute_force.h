@@ -1,6 +1,6 @@
 #pragma once
 /// \file brute_force.h
-/// The reference of §3.3 (smoke_surfaces.txt) over all pairs: the dense n × n matrix of h, the
+/// The reference of §3.3 ([Smoke Surfaces]) over all pairs: the dense n × n matrix of h, the
 /// mean, union-find over every pair, and the greedy order reading the matrix. O(n²) memory, so
 /// only for tests and benchmarks: the sparse path (clustering.h) must reproduce it exactly.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file candidate_pairs.h
-/// The pairs of a candidate group that can share a surface (smoke_surfaces.txt §3.3), found
+/// The pairs of a candidate group that can share a surface ([Smoke Surfaces] §3.3), found
 /// without visiting all n²/2 pairs: a uniform grid over three projected coordinates proposes
 /// neighbours, the projection bound discards most, exact h decides the rest.
 

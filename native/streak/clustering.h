@@ -1,6 +1,6 @@
 #pragma once
 /// \file clustering.h
-/// Surface reconstruction from streaklines (smoke_surfaces.txt §3.3): clustering of a candidate
+/// Surface reconstruction from streaklines ([Smoke Surfaces] §3.3): clustering of a candidate
 /// group with the threshold h0 (default: the mean of h), the counts of Figure 4, and the whole
 /// path from frames to ordered surfaces. Works on sparse distances (StreakDistances): exact for
 /// every h0 up to their reach, never an n × n matrix.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file disjoint_sets.h
-/// Union-find for the single-linkage clustering of §3.3 (smoke_surfaces.txt): the sources joined
+/// Union-find for the single-linkage clustering of §3.3 ([Smoke Surfaces]): the sources joined
 /// transitively by pairs with h(α,β) < h0.
 
 #include <numeric>

@@ -1,6 +1,6 @@
 #pragma once
 /// \file greedy_order.h
-/// The order of a surface's streaklines across the surface (smoke_surfaces.txt §3.3, Figure 5):
+/// The order of a surface's streaklines across the surface ([Smoke Surfaces] §3.3, Figure 5):
 /// the greedy approximation of the minimum-length connection, from sparse distances.
 
 #include "streak/streak_distances.h"

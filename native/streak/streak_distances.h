@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_distances.h
-/// The distances h(α,β) of one candidate group (smoke_surfaces.txt §3.3), sparse: every pair
+/// The distances h(α,β) of one candidate group ([Smoke Surfaces] §3.3), sparse: every pair
 /// with h below a reach (by default the default threshold h0, the mean of h), exactly, in
 /// O(pairs) memory instead of an n × n matrix; h of any other pair on demand.
 

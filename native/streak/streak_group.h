@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_group.h
-/// The streaklines of one candidate group as the distance of §3.3 (smoke_surfaces.txt) sees
+/// The streaklines of one candidate group as the distance of §3.3 ([Smoke Surfaces]) sees
 /// them: p(α,t,i) read in place from frames shared by every group of a shot, and h(α,β) itself,
 /// computed one way only so that every clustering path agrees bit for bit.
 

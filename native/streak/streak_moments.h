@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_moments.h
-/// The default threshold h0 of §3.3 (smoke_surfaces.txt), "the average value of h", without
+/// The default threshold h0 of §3.3 ([Smoke Surfaces]), "the average value of h", without
 /// visiting the pairs: Σ_{α<β} |p_α − p_β|² = n Σ_α |p_α − m|² for every (t, i), with m the mean
 /// of the group's particles (t, i). O(n · particles · frames) instead of O(n² · ...).
 

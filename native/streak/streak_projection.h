@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_projection.h
-/// A cheap lower bound of §3.3's h(α,β) (smoke_surfaces.txt) to prune pairs. h is a squared
+/// A cheap lower bound of §3.3's h(α,β) ([Smoke Surfaces]) to prune pairs. h is a squared
 /// Euclidean distance, h(α,β) = |x_α − x_β|², where x_α lists p(α,t,i)/√N(t) over every used
 /// frame t and particle i (D = 3 Σ_t N(t) coordinates). For orthonormal directions V,
 /// |Vᵀ(x_α − x_β)|² <= h(α,β) (Bessel). V holds the leading principal directions of the group

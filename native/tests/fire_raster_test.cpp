@@ -1,6 +1,6 @@
 /// \file fire_raster_test.cpp
 /// Particle rasterization shared by flow-graph fire and flames (fields/fire_raster.h,
-/// graph_fire_synthesis.txt §5.3): mass conservation, the flame map, one particle at a voxel
+/// [Graph Fire Synthesis] §5.3): mass conservation, the flame map, one particle at a voxel
 /// centre, splats sized by the particle spacing (no gaps between sparse particles),
 /// determinism at any thread count and the frame VDB.
 

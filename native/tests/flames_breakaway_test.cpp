@@ -1,4 +1,4 @@
-// The break point of §4.3 (structural_flames.txt): over many separations the split height h has
+// The break point of §4.3 ([Structural Flames]): over many separations the split height h has
 // the prose's normal distribution, mean H_p + (H_i − H_p)/2 and standard deviation (H_i − H_p)/4,
 // as clamped by breakaway.cpp to [max(H_p, H_i/100), H_i] (= μ ± 2σ here).
 #include "flames/breakaway.h"

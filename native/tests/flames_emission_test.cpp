@@ -1,4 +1,4 @@
-// Emission of structural flames (structural_flames.txt §5.1–5.3): blackbody colours, each
+// Emission of structural flames ([Structural Flames] §5.1–5.3): blackbody colours, each
 // particle's power (eq. 6 as a share of eq. 5's E), the colour normalization, the light's colour,
 // and the emission / opacity grids.
 

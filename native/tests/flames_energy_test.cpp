@@ -1,4 +1,4 @@
-// Eq. 5 of structural_flames.txt §5.2 checked against the printed formula itself: flames whose
+// Eq. 5 of [Structural Flames] §5.2 checked against the printed formula itself: flames whose
 // spines have known control-point velocities v_c, radius r and length h go through the
 // FlameShaper, and its per-flame energy is compared with E = ½ k · 0.3 m · H_c · 2 A_f r³ / h,
 // m = |v_c| r², written out here as literal arithmetic (not by calling flameEnergy()).

@@ -1,6 +1,6 @@
 #pragma once
 /// \file flames_scenes.h
-/// The structural-flame set-ups of the paper's results (structural_flames.txt §7) shared by the
+/// The structural-flame set-ups of the paper's results ([Structural Flames] §7) shared by the
 /// tests and the benchmark: the torch of Figure 1 (5 flames waved through the air) and the
 /// dragon breath of Figure 5 (5 flames splitting into 80+).
 

@@ -1,4 +1,4 @@
-// Shape and render data of structural flames (structural_flames.txt §4.4–4.5, §5): eq. 4 against
+// Shape and render data of structural flames ([Structural Flames] §4.4–4.5, §5): eq. 4 against
 // brute-force closest points, the eq. 5/6 energy balance, the Figure 4 mapping, Kolmogorov
 // spectrum, flow noise in time, merging, determinism.
 #include "flames/flame_shape.h"

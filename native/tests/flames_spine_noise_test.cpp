@@ -1,4 +1,4 @@
-// The Kolmogorov velocity on the spine's control points (structural_flames.txt §4.2, §7 torch):
+// The Kolmogorov velocity on the spine's control points ([Structural Flames] §4.2, §7 torch):
 // its 1-D energy spectrum along straight lines falls as k^(−5/3), its RMS is the amplitude, it
 // moves the spine (off: the flame of eq. 2 alone), and a seed gives the same flames on 1 or 2
 // threads.

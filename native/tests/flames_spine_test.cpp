@@ -1,4 +1,4 @@
-// Structural flames, the pieces (structural_flames.txt §4.1–4.3, §6.1): spines (interpolation,
+// Structural flames, the pieces ([Structural Flames] §4.1–4.3, §6.1): spines (interpolation,
 // arc-length re-sampling), wind fields, obstacle distance fields, the breakaway draws and the
 // settings' checks.
 #include "flames/breakaway.h"

@@ -1,4 +1,4 @@
-// Structural flames over time (structural_flames.txt §4.1–4.3, §6.1–6.2): buoyancy, moving
+// Structural flames over time ([Structural Flames] §4.1–4.3, §6.1–6.2): buoyancy, moving
 // sources (−V, Figure 1), the breakaway process (rate f, life A/4), obstacles, activation times and
 // per-source scales, determinism, dragon breath (Figure 5).
 #include "core/parallel.h"

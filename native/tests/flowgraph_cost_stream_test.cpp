@@ -1,5 +1,5 @@
 /// \file flowgraph_cost_stream_test.cpp
-/// The cost matrix of eq. 9-10 and the weights α, β (graph_fire_synthesis.txt §4.3) streamed
+/// The cost matrix of eq. 9-10 and the weights α, β ([Graph Fire Synthesis] §4.3) streamed
 /// from pathline files: the same bits as with every group in memory, at 1 and 2 threads and
 /// any block size; each group read once as a row and once per row block before it as a column.
 

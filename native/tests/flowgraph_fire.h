@@ -1,6 +1,6 @@
 #pragma once
 /// \file flowgraph_fire.h
-/// A small fire (graph_fire_synthesis.txt §4.1: combustion with a fuel-injection region) shared
+/// A small fire ([Graph Fire Synthesis] §4.1: combustion with a fuel-injection region) shared
 /// by the flow-graph synthesis tests and benchmark: a cubic domain, a square burner of fuel
 /// cells near the closed floor, open elsewhere.
 

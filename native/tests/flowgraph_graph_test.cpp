@@ -1,5 +1,5 @@
 /// \file flowgraph_graph_test.cpp
-/// The flow graph of graph_fire_synthesis.txt §4.3-5.1: the cost matrix (eq. 9-10) against a
+/// The flow graph of [Graph Fire Synthesis] §4.3-5.1: the cost matrix (eq. 9-10) against a
 /// brute-force double implementation and across thread counts, the block candidates and ε
 /// (eq. 11), pruning of dead ends, the Figure 4 picture and the errors on bad input (the walks:
 /// flowgraph_walk_test.cpp).

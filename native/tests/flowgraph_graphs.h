@@ -1,6 +1,6 @@
 #pragma once
 /// \file flowgraph_graphs.h
-/// Shared by the flow-graph graph and walk tests (graph_fire_synthesis.txt §4.3-5.1): the
+/// Shared by the flow-graph graph and walk tests ([Graph Fire Synthesis] §4.3-5.1): the
 /// build settings, a three-state graph with many transitions, and the bad-input check.
 
 #include "flowgraph/flow_graph.h"

@@ -1,7 +1,7 @@
 #pragma once
 /// \file flowgraph_group_files.h
 /// The synthetic groups of flowgraph_groups.h written to one pathline file per state
-/// (graph_fire_synthesis.txt §4.2), one group at a time: a graph far larger than memory can be
+/// ([Graph Fire Synthesis] §4.2), one group at a time: a graph far larger than memory can be
 /// written, then streamed (cost_matrix_stream.h).
 
 #include "flowgraph/pathline_file.h"

@@ -1,7 +1,7 @@
 #pragma once
 /// \file flowgraph_groups.h
 /// Synthetic pathline groups and cost matrices for the flow-graph tests and benchmark
-/// (graph_fire_synthesis.txt §4.2-4.3): each state's groups oscillate with a state-specific
+/// ([Graph Fire Synthesis] §4.2-4.3): each state's groups oscillate with a state-specific
 /// period, so that nodes a period apart are alike (the recurrences transitions are made of).
 
 #include "core/parallel.h"

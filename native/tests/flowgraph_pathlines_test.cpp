@@ -1,5 +1,5 @@
 /// \file flowgraph_pathlines_test.cpp
-/// Flow-graph pathlines (graph_fire_synthesis.txt §4.2): RK4 integration (eq. 6) on fields with
+/// Flow-graph pathlines ([Graph Fire Synthesis] §4.2): RK4 integration (eq. 6) on fields with
 /// known solutions, the seeds of a fuel cell and the pathline settings. Their files and the
 /// synthesizer are in flowgraph_synth_test.cpp.
 

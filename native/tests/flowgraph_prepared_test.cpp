@@ -1,5 +1,5 @@
 /// \file flowgraph_prepared_test.cpp
-/// Prepared groups and their cache in the synthesis (graph_fire_synthesis.txt §5.2, eq. 13):
+/// Prepared groups and their cache in the synthesis ([Graph Fire Synthesis] §5.2, eq. 13):
 /// emitting a node from the cache of prepared groups, or sharing one prepared group between two
 /// live slots, gives bit for bit the particles of emitting a fresh copy of the group read from
 /// its file, at any thread count; the cache keeps its byte budget, least recently used out.

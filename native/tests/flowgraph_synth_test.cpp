@@ -1,5 +1,5 @@
 /// \file flowgraph_synth_test.cpp
-/// Flow-graph fire synthesis (graph_fire_synthesis.txt §4.2, §5.2): the pathline file, the
+/// Flow-graph fire synthesis ([Graph Fire Synthesis] §4.2, §5.2): the pathline file, the
 /// synthesizer (eq. 13) and grid external velocities. RK4 pathlines are in
 /// flowgraph_pathlines_test.cpp, the rasterization in fire_raster_test.cpp, the reproduction of
 /// a real bake by a temporal walk in flowgraph_reproduction_test.cpp.

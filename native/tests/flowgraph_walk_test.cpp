@@ -1,5 +1,5 @@
 /// \file flowgraph_walk_test.cpp
-/// Random walks on the flow graph (graph_fire_synthesis.txt §5.1): eq. 12 against its formula,
+/// Random walks on the flow graph ([Graph Fire Synthesis] §5.1): eq. 12 against its formula,
 /// uniform and target-state walks, the transition state (§5: no transition until the particles
 /// of the last one have died), seeds and the errors on bad input.
 

@@ -124,7 +124,7 @@ TEST(VdbFrame, RoundTripValuesAndTransform) {
 }
 
 TEST(VdbFrame, VelocityEverywhereKeepsClearAir) {
-  // structural_flames.txt §6.1: a domain read as a wind field needs its velocity in clear air.
+  // [Structural Flames] §6.1: a domain read as a wind field needs its velocity in clear air.
   const fs::path dir = scratchDir("velocity_everywhere");
   SmokeSolver s(smallParams(false));
   fillPattern(s, 2.f);

@@ -1,5 +1,5 @@
 /// \file mantaflow_test.cpp
-/// Streaklines driven by a Mantaflow cache (smoke_surfaces.txt §3.2): synthetic
+/// Streaklines driven by a Mantaflow cache ([Smoke Surfaces] §3.2): synthetic
 /// fluid_data VDB files laid out as Blender 3.4 writes them (staggered velocity in cells per
 /// Mantaflow time unit, uniform voxel size, no translation, voxels only where there is smoke)
 /// read onto the world grid, every mismatch rejected with the file name, the volume frames

@@ -1,5 +1,5 @@
 // Unit tests of the order along the streaklines of the least-squares streak surface
-// (smoke_surfaces.txt §3.3 with a control net an artist can edit): where the lines scatter
+// ([Smoke Surfaces] §3.3 with a control net an artist can edit): where the lines scatter
 // (consecutive particles cells apart, zig-zagging, as at the top of the Figure-1 plume late in
 // its shot) the net keeps order 4 with one control point per particle, the control points being
 // the particles (the particle net: C², no facets in a close-up, Figure 7), the sheet cutting the

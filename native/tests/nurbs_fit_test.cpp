@@ -1,4 +1,4 @@
-// Unit tests of the least-squares streak surface (smoke_surfaces.txt §3.3 with a control net an
+// Unit tests of the least-squares streak surface ([Smoke Surfaces] §3.3 with a control net an
 // artist can edit): chord-length parameters, the penalised curve fit, the surface and shot fits
 // (tolerance, control points on the smoke, local support, thread count), local frames at the
 // control points, and the density map's zero outside the grid (§3.4).

@@ -1,4 +1,4 @@
-// Unit tests of the streak-surface NURBS (smoke_surfaces.txt §3.3-3.4): Blender's knots and
+// Unit tests of the streak-surface NURBS ([Smoke Surfaces] §3.3-3.4): Blender's knots and
 // parameter rules, interpolation through every particle, Blender's tessellation, the density
 // map's convergence (Figure 8) and the OpenSubdiv export.
 #include "core/parallel.h"

@@ -1,4 +1,4 @@
-// Tests of the point emitters (structural_flames.txt §6.3 smoke): the mass they add per second is
+// Tests of the point emitters ([Structural Flames] §6.3 smoke): the mass they add per second is
 // the requested rate, it lands around the requested place, and an empty list changes nothing.
 #include "solver/point_emitters.h"
 #include "solver/smoke_solver.h"

@@ -1,5 +1,5 @@
 /// \file streak_cluster_test.cpp
-/// The sparse clustering of §3.3 (smoke_surfaces.txt) against the brute force over all pairs, on
+/// The sparse clustering of §3.3 ([Smoke Surfaces]) against the brute force over all pairs, on
 /// random shots (clustered, uniform and coincident layouts, frames with N(t) = 0, several seeds):
 /// the same pairs below the reach with bit-identical h, the same default h0 to 1e-12, the same
 /// clusters, counts and greedy orders, at any thread count.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_shots.h
-/// Streak frames for the tests of §3.3 (smoke_surfaces.txt): random clouds, clustered plumes,
+/// Streak frames for the tests of §3.3 ([Smoke Surfaces]): random clouds, clustered plumes,
 /// coincident streaklines and straight parallel lines, each from a seed.
 
 #include "core/rng.h"

@@ -1,5 +1,5 @@
 /// \file streak_test.cpp
-/// Streak surfaces §3.3 (smoke_surfaces.txt): h and the default h0 against the paper's formula on
+/// Streak surfaces §3.3 ([Smoke Surfaces]): h and the default h0 against the paper's formula on
 /// random data, the brute-force reference (clusters by transitive closure, threshold rules,
 /// Figure 5), the greedy order on shuffled parallel streaklines, whole surfaces per candidate
 /// group, the streak file format, and the time of 20 sources × 300 frames.

@@ -1,5 +1,5 @@
 /// \file toon_birth_test.cpp
-/// Birth with a spacing (cartoon_smoke.txt §2.3, toon/birth_spacing.h): newborns keep their
+/// Birth with a spacing ([Cartoon Smoke] §2.3, toon/birth_spacing.h): newborns keep their
 /// distance σ s(ρ) from every particle, a rejected cell really was crowded, the paper's rule is
 /// spacing 0, and the result is bit-identical at one and two threads.
 

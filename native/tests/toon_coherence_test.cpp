@@ -1,5 +1,5 @@
 /// \file toon_coherence_test.cpp
-/// Temporal coherence of the toon outlines (cartoon_smoke.txt §2.3: "choosing [the in-plane
+/// Temporal coherence of the toon outlines ([Cartoon Smoke] §2.3: "choosing [the in-plane
 /// rotation] randomly per frame produces temporal incoherence. Instead, we orient the stencil in
 /// the velocity direction"). A steady plume is advanced frame by frame, its particles are drawn
 /// into a depth buffer as stretched, rotated stencils seen from the side, and the outlines of

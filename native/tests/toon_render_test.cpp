@@ -1,5 +1,5 @@
 /// \file toon_render_test.cpp
-/// The rendering side of toon smoke (cartoon_smoke.txt §2.2-2.3): the depth-differences filter
+/// The rendering side of toon smoke ([Cartoon Smoke] §2.2-2.3): the depth-differences filter
 /// against the per-pixel formula, stencil orientation and stretch (Figure 4), and the volume
 /// frames that drive the particles.
 

@@ -1,5 +1,5 @@
 /// \file toon_test.cpp
-/// Toon particles (cartoon_smoke.txt §2.1-2.3): bounded size changes, shrink before death, birth
+/// Toon particles ([Cartoon Smoke] §2.1-2.3): bounded size changes, shrink before death, birth
 /// in empty dense cells, the particle budget, determinism, parameter checks and the toon file.
 
 #include "toon/toon_file.h"

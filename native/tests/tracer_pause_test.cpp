@@ -1,5 +1,5 @@
 /// \file tracer_pause_test.cpp
-/// Pausing particle emission (smoke_surfaces.txt §3.2, Figure 10: "particle emission was turned
+/// Pausing particle emission ([Smoke Surfaces] §3.2, Figure 10: "particle emission was turned
 /// off" for 60 frames): a paused tracer adds no particles at its emission instants, the particles
 /// already emitted keep moving exactly as before, and emission resumes on the next instant.
 

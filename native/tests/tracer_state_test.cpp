@@ -1,5 +1,5 @@
 /// \file tracer_state_test.cpp
-/// Tracer checkpoints (smoke_surfaces.txt §3.2; tracers/tracer_state_file.h): a tracer restored from
+/// Tracer checkpoints ([Smoke Surfaces] §3.2; tracers/tracer_state_file.h): a tracer restored from
 /// a checkpoint continues bit for bit like the one that was saved, and truncated, corrupt or
 /// mismatched files are refused by name, leaving the tracer untouched.
 

@@ -1,5 +1,5 @@
 /// \file tracer_test.cpp
-/// Streakline tracers (smoke_surfaces.txt §3.2): point sources in cells, exact transport in a
+/// Streakline tracers ([Smoke Surfaces] §3.2): point sources in cells, exact transport in a
 /// uniform field, second-order convergence in a rotating field, emission counts, boundaries,
 /// the frame driver against SmokeSolver::advanceFrame, determinism across thread counts.
 

@@ -1,5 +1,5 @@
 /// \file billboard.cpp
-/// Stencil rotation and stretch from the projected velocity (cartoon_smoke.txt Figure 4).
+/// Stencil rotation and stretch from the projected velocity ([Cartoon Smoke] Figure 4).
 
 #include "toon/billboard.h"
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file billboard.h
-/// Orientation and squash/stretch of the toon stencils (cartoon_smoke.txt §2.3, Figure 4): the
+/// Orientation and squash/stretch of the toon stencils ([Cartoon Smoke] §2.3, Figure 4): the
 /// stencil faces the camera, its in-plane rotation follows the particle's velocity projected on
 /// the image plane, and it stretches along that direction in proportion to the projected speed.
 /// Both depend on the camera, so they are computed when the scene is built, not stored.

@@ -1,5 +1,5 @@
 /// \file birth_spacing.cpp
-/// Birth spacing (cartoon_smoke.txt §2.3, see birth_spacing.h): a cell list of the particles,
+/// Birth spacing ([Cartoon Smoke] §2.3, see birth_spacing.h): a cell list of the particles,
 /// then the candidate cells block by block in eight phases.
 
 #include "toon/birth_spacing.h"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file birth_spacing.h
-/// Birth with a spacing (cartoon_smoke.txt §2.2 last paragraph, §2.3): the paper gives a new
+/// Birth with a spacing ([Cartoon Smoke] §2.2 last paragraph, §2.3): the paper gives a new
 /// particle to every empty cell denser than ρ_birth, so on a grid finer than the stencils the
 /// newborns overlap into one smooth blob. With birthSpacing σ > 0 a candidate cell c keeps its
 /// newborn only when no particle (survivor, emitted this frame or born before it) lies closer than

@@ -1,5 +1,5 @@
 /// \file depth_differences.cpp
-/// Row-parallel depth-differences filter (cartoon_smoke.txt §2.2). Every horizontal difference is
+/// Row-parallel depth-differences filter ([Cartoon Smoke] §2.2). Every horizontal difference is
 /// shared by the two pixels beside it, and every vertical one by the two rows beside it, so each
 /// is computed once per block of rows.
 

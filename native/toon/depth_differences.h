@@ -1,6 +1,6 @@
 #pragma once
 /// \file depth_differences.h
-/// The depth-differences outline test of cartoon_smoke.txt §2.2 (after Deussen & Strothotte
+/// The depth-differences outline test of [Cartoon Smoke] §2.2 (after Deussen & Strothotte
 /// 2000), as a reference for the compositor node group: pixel (i, j) is drawn in the outline
 /// colour when any of its four one-sided depth differences, divided by the pixel size, exceeds γ:
 ///   |z(i+1,j) - z(i,j)| / Δx > γ  or  |z(i,j) - z(i-1,j)| / Δx > γ  or

@@ -1,5 +1,5 @@
 /// \file field_sampler.cpp
-/// Four- and eight-lane trilinear samples of the toon fields (cartoon_smoke.txt §2.1), both
+/// Four- and eight-lane trilinear samples of the toon fields ([Cartoon Smoke] §2.1), both
 /// equal to sampleLinear / sampleVelocity lane by lane (see the header).
 
 #include "toon/field_sampler.h"

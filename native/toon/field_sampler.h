@@ -1,6 +1,6 @@
 #pragma once
 /// \file field_sampler.h
-/// The trilinear samples a toon particle takes (cartoon_smoke.txt §2.1: "position, velocity, and
+/// The trilinear samples a toon particle takes ([Cartoon Smoke] §2.1: "position, velocity, and
 /// density are linearly interpolated from the simulation grid"), for a group of kToonLanes
 /// particles at a time: the clamped split of each coordinate is computed once per position and
 /// shared by every field (the cell-centred density and temperature, and the three staggered

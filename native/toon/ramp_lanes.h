@@ -1,6 +1,6 @@
 #pragma once
 /// \file ramp_lanes.h
-/// The per-particle rules of cartoon_smoke.txt §2.3 on four SSE lanes, for the toon particles'
+/// The per-particle rules of [Cartoon Smoke] §2.3 on four SSE lanes, for the toon particles'
 /// sample stage: the size ramp (0 below ρ_death), the colour ramp and the bounded size step. Each
 /// lane gives exactly the scalar forms of ToonParams (rampSize, colorParameter, unitRamp) and of
 /// the step in toon_particles.h: the same IEEE operations (division, not a reciprocal) in the

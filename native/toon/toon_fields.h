@@ -1,6 +1,6 @@
 #pragma once
 /// \file toon_fields.h
-/// The baked fields of one frame that drive the toon particles (cartoon_smoke.txt §2.1: "we
+/// The baked fields of one frame that drive the toon particles ([Cartoon Smoke] §2.1: "we
 /// require only the output of a smoke simulator"): density and temperature at cell centres and
 /// face velocities in m/s, on the domain grid of the bake.
 

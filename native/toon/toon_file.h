@@ -1,6 +1,6 @@
 #pragma once
 /// \file toon_file.h
-/// Per-frame toon particle cache `toon_####.bin` (cartoon_smoke.txt §2.3: the particles and the
+/// Per-frame toon particle cache `toon_####.bin` ([Cartoon Smoke] §2.3: the particles and the
 /// flow quantities that drive their size, colour, rotation and stretch): a versioned binary file
 /// holding one ToonParticleState, sizes checked against the file size before anything is
 /// allocated. Angle and stretch depend on the camera and are computed when the scene is built.

@@ -1,5 +1,5 @@
 /// \file toon_params.cpp
-/// ToonParams checks and ramps (cartoon_smoke.txt §2.3: "simple linear interpolation ramps").
+/// ToonParams checks and ramps ([Cartoon Smoke] §2.3: "simple linear interpolation ramps").
 
 #include "toon/toon_params.h"
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file toon_params.h
-/// Settings of the cartoon-smoke particles (cartoon_smoke.txt §2.1 and §2.3): emission at the
+/// Settings of the cartoon-smoke particles ([Cartoon Smoke] §2.1 and §2.3): emission at the
 /// source, birth and death thresholds on density, the size and colour ramps, the largest size
 /// change per frame (temporal coherence), the particle budget, integration and squash/stretch.
 

@@ -1,5 +1,5 @@
 /// \file toon_particles.cpp
-/// Toon particle evolution (cartoon_smoke.txt §2.1-2.3); the stages are listed in the header.
+/// Toon particle evolution ([Cartoon Smoke] §2.1-2.3); the stages are listed in the header.
 
 #include "toon/toon_particles.h"
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file toon_particles.h
-/// Cartoon-smoke particles driven frame by frame by a baked cache (cartoon_smoke.txt §2.1-2.3).
+/// Cartoon-smoke particles driven frame by frame by a baked cache ([Cartoon Smoke] §2.1-2.3).
 ///
 /// One frame (advanceFrame) is a list of named stages:
 ///   1. advect   - every particle through the frame with the velocity linear in time between the

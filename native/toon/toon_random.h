@@ -1,6 +1,6 @@
 #pragma once
 /// \file toon_random.h
-/// The random positions of the toon particles (cartoon_smoke.txt §2.1 emission, §2.3 birth):
+/// The random positions of the toon particles ([Cartoon Smoke] §2.1 emission, §2.3 birth):
 /// one generator per (seed, frame, stage, index), so that a particle's position depends neither
 /// on the thread that creates it nor on the other particles.
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file toon_volume.h
 /// A Plume volume frame (`volume_####.vdb`, io/vdb_frame.h) read back as the fields that drive
-/// the toon particles (cartoon_smoke.txt §2.1: the particles need only the simulator's output),
+/// the toon particles ([Cartoon Smoke] §2.1: the particles need only the simulator's output),
 /// so the add-on never copies grids through Python.
 
 #include "toon/toon_fields.h"

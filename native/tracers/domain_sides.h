@@ -1,7 +1,7 @@
 #pragma once
 /// \file domain_sides.h
-/// What the sides of the domain do to a massless particle (streaklines, smoke_surfaces.txt §3.2;
-/// pathlines, graph_fire_synthesis.txt §4.2): a closed side holds it, an open side lets it out.
+/// What the sides of the domain do to a massless particle (streaklines, [Smoke Surfaces] §3.2;
+/// pathlines, [Graph Fire Synthesis] §4.2): a closed side holds it, an open side lets it out.
 
 #include "solver/smoke_params.h"
 

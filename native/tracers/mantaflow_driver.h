@@ -1,7 +1,7 @@
 #pragma once
 /// \file mantaflow_driver.h
 /// Streaklines driven by a baked Blender Mantaflow cache instead of the Plume solver
-/// (smoke_surfaces.txt §3.2: the particles are "advected by the velocity field"; any velocity
+/// ([Smoke Surfaces] §3.2: the particles are "advected by the velocity field"; any velocity
 /// field will do, so an artist's existing Mantaflow bake can drive them).
 ///
 /// Time. The cache holds the fields at frame ends only. Over one frame of length T from frame

@@ -1,6 +1,6 @@
 #pragma once
 /// \file point_sources.h
-/// Point sources of streaklines placed at random inside source cells (smoke_surfaces.txt §3.2:
+/// Point sources of streaklines placed at random inside source cells ([Smoke Surfaces] §3.2:
 /// "10–20 point sources are placed randomly in a source cell").
 
 #include <glm/glm.hpp>
@@ -14,7 +14,7 @@ struct CellSet;
 
 /// `pointsPerCell` world positions uniform inside each cell of `cells` (linear indices
 /// i + nx*(j + ny*k) of a grid of `resolution` cells of size `cellSize` whose minimum corner is
-/// `origin`), smoke_surfaces.txt §3.2. Point n lies in cells.cells[n / pointsPerCell]. One
+/// `origin`), [Smoke Surfaces] §3.2. Point n lies in cells.cells[n / pointsPerCell]. One
 /// Rng(seed, stream) is consumed in cell order, three draws per point, so the result depends only
 /// on the arguments. Throws std::invalid_argument naming the setting for a bad resolution,
 /// cell size, point count or a cell index outside the grid.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_file.h
-/// Per-frame streakline cache `streaks_####.bin` (smoke_surfaces.txt §3.2: particle positions
+/// Per-frame streakline cache `streaks_####.bin` ([Smoke Surfaces] §3.2: particle positions
 /// and densities "are stored at every time step"): a versioned binary file holding one
 /// StreakFrame, sizes checked against the file size before anything is allocated.
 

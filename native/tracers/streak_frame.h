@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_frame.h
-/// One frame of streaklines (smoke_surfaces.txt §3.2, Figure 2): the particles of every point
+/// One frame of streaklines ([Smoke Surfaces] §3.2, Figure 2): the particles of every point
 /// source in birth order, with the density sampled at each, as stored in the cache every frame.
 
 #include <glm/glm.hpp>

@@ -1,6 +1,6 @@
 #pragma once
 /// \file streak_tracer.h
-/// Streaklines (smoke_surfaces.txt §3.2): massless particles emitted from point sources every
+/// Streaklines ([Smoke Surfaces] §3.2): massless particles emitted from point sources every
 /// emission period and carried by the solver's time-varying velocity, second order in time.
 ///
 /// Timeline. Emission happens at the instants t = s·Δt with s = 0, P, 2P, … (P = emission

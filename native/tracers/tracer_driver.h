@@ -1,6 +1,6 @@
 #pragma once
 /// \file tracer_driver.h
-/// Runs a solver frame with streakline tracers attached (smoke_surfaces.txt §3.2: particles are
+/// Runs a solver frame with streakline tracers attached ([Smoke Surfaces] §3.2: particles are
 /// advected with the simulation, their data stored every time step), without touching the solver.
 
 #include "solver/smoke_solver.h"

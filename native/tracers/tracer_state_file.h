@@ -1,6 +1,6 @@
 #pragma once
 /// \file tracer_state_file.h
-/// Streakline tracer checkpoint for resuming a traced bake (smoke_surfaces.txt §3.2): a versioned
+/// Streakline tracer checkpoint for resuming a traced bake ([Smoke Surfaces] §3.2): a versioned
 /// binary file holding a StreakTracer's settings and its whole StreakTracerState (point sources,
 /// particles, density, outside flags, exit velocities, emission count, steps, the pause switch of
 /// Figure 10 and the step of the youngest emission), written next to the

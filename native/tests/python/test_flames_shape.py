@@ -1,4 +1,4 @@
-"""Structural flames, shape and render side (structural_flames.txt §4.4-4.5, §5) through the
+"""Structural flames, shape and render side ([Structural Flames] §4.4-4.5, §5) through the
 bindings: profiles, sampling, lights, energy balance (eq. 5-6) and the flame VDB."""
 import math
 

@@ -1,4 +1,4 @@
-"""Structural flames, structure side, from Python (structural_flames.txt §4.1-4.3, §6.1-6.2):
+"""Structural flames, structure side, from Python ([Structural Flames] §4.1-4.3, §6.1-6.2):
 settings checks, spine fitting and re-sampling, wind fields (a grid from NumPy), obstacles,
 the flame system's arrays, determinism and the breakaway statistics."""
 import math

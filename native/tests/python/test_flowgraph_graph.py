@@ -1,4 +1,4 @@
-"""The flow graph from Python (graph_fire_synthesis.txt §4.3-5.1): cost_matrix against
+"""The flow graph from Python ([Graph Fire Synthesis] §4.3-5.1): cost_matrix against
 NumPy's eq. 9-10, FlowGraph.build (no dead ends, at most M² transitions, ε checks), RandomWalk
 (seeded, target states) and the Figure 4 picture, plus the errors on bad input."""
 import numpy as np

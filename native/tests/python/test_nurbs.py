@@ -1,4 +1,4 @@
-"""plume._native's streak-surface NURBS from Python (smoke_surfaces.txt §3.3-3.4)."""
+"""plume._native's streak-surface NURBS from Python ([Smoke Surfaces] §3.3-3.4)."""
 import numpy as np
 import pytest
 

@@ -1,4 +1,4 @@
-"""Toon smoke from Python (cartoon_smoke.txt): ToonParams, particles driven by NumPy
+"""Toon smoke from Python ([Cartoon Smoke]): ToonParams, particles driven by NumPy
 fields and by Plume volume frames, coherence (bounded size changes, shrink before death), birth,
 the particle budget, determinism, billboards (Figure 4), the depth-differences filter (§2.2) and
 toon files."""
