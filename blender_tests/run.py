@@ -70,7 +70,7 @@ SUBSET = [
 #: the tests' verdict is kept and the teardown is skipped; README "Tested Blenders" says so.
 EXIT_WITHOUT_TEARDOWN = {"4.2"}
 #: Files that need a window (Xvfb + the real executable): only the packaged Blender has one.
-WINDOWED = {"test_ui_jobs.py"}
+WINDOWED = {"test_ui_jobs.py", "test_ui_screenshots.py"}
 TIMEOUT_S = 1800
 
 _SUMMARY = re.compile(r"^(\d+) passed, (\d+) failed(?:, (\d+) skipped)?\s*$", re.M)

@@ -14,6 +14,7 @@ then quits; a recipe step that fails quits with status 1.
 import glob
 import importlib.util
 import os
+import shutil
 import sys
 import tempfile
 import traceback
@@ -95,7 +96,9 @@ def main():
     args = sys.argv[sys.argv.index("--") + 1:]
     out_root, names = os.path.abspath(args[0]), args[1:]
     todo = recipes(names)
-    cache = tempfile.mkdtemp(prefix="plume_screenshots_")
+    # A fixed cache folder: the panels that show it draw the same text on every run.
+    cache = os.path.join(tempfile.gettempdir(), "plume_screenshots")
+    shutil.rmtree(cache, ignore_errors=True)
     state = {"recipe": 0, "steps": None, "shot": None, "settle": 0}
 
     def quit_with(code):
