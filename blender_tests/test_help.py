@@ -190,6 +190,7 @@ class HelpButtonTest(unittest.TestCase):
                     bpy.ops.plume.manual_open(page=m.INDEX)
             finally:
                 m.MANUAL_DIR = real
+        self.assertIn("Edit › Preferences › Get Extensions › Install from Disk", str(cm.exception))
         self.assertIn("Edit › Preferences › Add-ons › Install", str(cm.exception))
         self.assertEqual(self.opened, [])
 

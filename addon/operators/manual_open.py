@@ -26,8 +26,9 @@ class PLUME_OT_manual_open(bpy.types.Operator):
 
     def execute(self, context):
         if not manual.installed():
-            self.report({'ERROR'}, "This copy of Plume has no manual: install Plume from its "
-                        "release zip (Edit › Preferences › Add-ons › Install…)")
+            self.report({'ERROR'}, "This copy of Plume has no manual: install Plume again from "
+                        "its release zip (Edit › Preferences › Get Extensions › Install from "
+                        "Disk; in Blender 3.4, Edit › Preferences › Add-ons › Install)")
             return {'CANCELLED'}
         open_in_browser(manual.url(self.page))
         return {'FINISHED'}
