@@ -33,6 +33,7 @@ STREAKS_EDITS = STREAKS + "#recipe-smoke-sheets-and-a-hand-edit"
 STREAKS_MANTAFLOW = STREAKS + "#from-a-mantaflow-bake"
 STREAKS_SOURCES = STREAKS + "#animated-sources"
 TOON_OUTLINE = TOON + "#outline-width"
+FARM = SMOKE + "#farm"
 
 # (pattern, page): Blender matches lower-case RNA ids ("bpy.ops.plume.bake",
 # "bpy.types.plumedomainsettings.resolution") with fnmatch, the first match wins.
@@ -46,6 +47,7 @@ PAGES = (
     ("bpy.ops.plume.flame*", FLAMES),  # flames_* and flame_preset
     ("bpy.ops.plume.cache_free", SMOKE_CACHE),
     ("bpy.ops.plume.manual_open", INDEX),
+    ("bpy.ops.plume.farm_*", FARM),
     ("bpy.ops.plume.*", SMOKE_USE),  # role_set, bake
     (_DOMAIN + "mantaflow_domain*", STREAKS_MANTAFLOW),
     (_DOMAIN + "motion_source*", STREAKS_MANTAFLOW),
@@ -71,6 +73,7 @@ PAGES = (
     ("bpy.types.plumeflowgraphsettings.*", FLOWGRAPH),
     ("bpy.types.plumeflamesourcesettings.*", FLAMES),
     ("bpy.types.plumeflamessettings.*", FLAMES),
+    ("bpy.types.plumefarmsettings.*", FARM),
 )
 
 

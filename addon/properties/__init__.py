@@ -1,6 +1,7 @@
 """Object and scene properties: ``obj.plume`` with ``role``, ``domain``, ``source``, ``obstacle``
 and ``flame``, and ``scene.plume_flames``; one module per pipeline (domain: a domain's grid bake
-with its streak and pathline settings; source: Sources and Obstacles; toon; flowgraph; flames).
+with its streak and pathline settings; source: Sources and Obstacles; toon; flowgraph; flames;
+farm: ``scene.plume_farm``).
 
 Numbers carry soft limits only: a script may set any value, and the bake validates it with a
 message naming the setting instead of Blender clamping it silently. Validated bounds come from
@@ -10,6 +11,7 @@ import bpy
 from bpy.props import EnumProperty, PointerProperty
 
 from .domain import PlumeDomainSettings
+from .farm import PlumeFarmSettings
 from .flames import PlumeFlameSourceSettings, PlumeFlamesSettings
 from .flowgraph import PlumeFlowGraphSettings
 from .source import PlumeObstacleSettings, PlumeSourceSettings
@@ -35,7 +37,7 @@ class PlumeObjectSettings(bpy.types.PropertyGroup):
 
 classes = (PlumeFlameSourceSettings, PlumeFlamesSettings, PlumeToonSettings,
            PlumeFlowGraphSettings, PlumeDomainSettings, PlumeSourceSettings,
-           PlumeObstacleSettings, PlumeObjectSettings)
+           PlumeObstacleSettings, PlumeObjectSettings, PlumeFarmSettings)
 
 
 def register():
@@ -43,9 +45,11 @@ def register():
         bpy.utils.register_class(cls)
     bpy.types.Object.plume = PointerProperty(type=PlumeObjectSettings, name="Plume")
     bpy.types.Scene.plume_flames = PointerProperty(type=PlumeFlamesSettings, name="Plume Flames")
+    bpy.types.Scene.plume_farm = PointerProperty(type=PlumeFarmSettings, name="Plume Farm")
 
 
 def unregister():
+    del bpy.types.Scene.plume_farm
     del bpy.types.Scene.plume_flames
     del bpy.types.Object.plume
     for cls in reversed(classes):
