@@ -106,11 +106,6 @@ def parse_wedge(text, domain):
         except ValueError:
             raise FarmError(f"Plume farm: Wedge Settings: the values of '{prop.name}' must be "
                             f"numbers separated by commas, not '{values.strip()}'") from None
-        if prop.type != 'BOOLEAN':
-            bad = [v for v in vals if not prop.hard_min <= v <= prop.hard_max]
-            if bad:
-                raise FarmError(f"Plume farm: Wedge Settings: '{prop.name}' must be "
-                                f"{prop.hard_min:g}–{prop.hard_max:g}; {bad[0]:g} is not")
         settings[name] = vals
     if not settings:
         raise FarmError(f"Plume farm: {PANEL} › Wedge Settings is empty: give at least one "
@@ -120,6 +115,30 @@ def parse_wedge(text, domain):
         raise FarmError("Plume farm: Wedge Settings: every setting needs the same number of "
                         f"values (one per variant); got {', '.join(f'{k} {len(v)}' for k, v in settings.items())}")
     return settings
+
+
+def check_variants(context, domain, settings):
+    """Each variant passes the bake's own checks (the ranges the bake would refuse), tried on
+    the domain and undone: FarmError naming the variant, the setting and its range."""
+    from .. import bake_runner, setting_paths
+    from ..native import _native
+    from ..settings import BakeError
+    from .smoke import take_snapshot
+    d = domain.plume.domain
+    kept = {name: getattr(d, name) for name in settings}
+    try:
+        for i in range(len(next(iter(settings.values())))):
+            for name, values in settings.items():
+                setattr(d, name, values[i])
+            try:
+                with context.temp_override(active_object=domain, object=domain):
+                    bake_runner.check_input(take_snapshot(bpy.context), _native)
+            except BakeError as e:
+                why = setting_paths.in_ui_words(str(e)).removeprefix("Plume: ")
+                raise FarmError(f"Plume farm: Wedge Settings, variant {i}: {why}") from None
+    finally:
+        for name, value in kept.items():
+            setattr(d, name, value)
 
 
 def seconds_per_frame(domain):
@@ -202,6 +221,7 @@ def plan(context):
             raise FarmError(f"Plume farm: choose the domain to vary in {PANEL} › Domain")
         check_time_limit(farm, [dom])
         settings = parse_wedge(farm.wedge_settings, dom)
+        check_variants(context, dom, settings)
         count = len(next(iter(settings.values())))
         wedge = {"settings": settings, "count": count, "frame": int(farm.wedge_frame),
                  "domain": dom.name}

