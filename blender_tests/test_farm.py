@@ -227,6 +227,106 @@ class FarmTest(unittest.TestCase):
         self.assertIn("variants", cli.stdout)
         self.assertIn("DONE", cli.stdout)
 
+    def test_a_requeued_task_resumes_bit_identical(self):
+        base = os.path.join(self.tmp, "requeue")
+        frames = 24
+        dom = shot(base, frames=frames)
+        farm = bpy.context.scene.plume_farm
+        farm.job, farm.wedge_domain, farm.wedge_frame = 'WEDGE', dom, frames
+        farm.wedge_settings = "vorticity = 0.3"
+        gate = os.path.join(base, "gate")
+        os.environ["PLUME_JOB_GATE"] = f"{gate}@8"  # the bake holds at frame 8 for a moment
+        try:
+            folder = self.submit()
+        finally:
+            del os.environ["PLUME_JOB_GATE"]
+        job = json.load(open(os.path.join(folder, "farm.json")))["variants"]["0"]
+        manifest = os.path.join(folder, "plume_cache", f"{dom.name}_wedge_0", dom.name,
+                                "manifest.json")
+        end = time.monotonic() + WAIT_S
+        last = 0
+        while time.monotonic() < end and last < 6:
+            try:
+                with open(manifest, encoding="utf-8") as f:
+                    last = json.load(f)["last_complete_frame"]
+            except (OSError, ValueError, KeyError):
+                pass
+            time.sleep(0.1)
+        self.assertGreaterEqual(last, 6, "the farm's bake did not reach frame 6")
+        subprocess.run(["scontrol", "requeue", f"{job}_0"], check=True, timeout=30)
+        t_requeue = time.monotonic()
+        # Slurm holds a requeued task about two minutes (its begin time); on this one-node
+        # cluster the test lets it start as soon as it is pending again.
+        while time.monotonic() - t_requeue < 60:
+            st = subprocess.run(["squeue", "-h", "-r", "-j", f"{job}_0", "-o", "%T"],
+                                capture_output=True, text=True).stdout.strip()
+            if st == "PENDING":
+                subprocess.run(["scontrol", "update", f"JobId={job}_0", "StartTime=now"],
+                               timeout=30)
+                break
+            time.sleep(0.2)
+        open(gate, "w").close()  # the restarted task runs through
+        states = wait_done(self, folder)
+        print(f"  requeued task done {time.monotonic() - t_requeue:.1f} s after the requeue")
+        self.assertEqual(states[0].summary, "DONE")
+        with open(os.path.join(folder, "logs", "variants.0.log"), encoding="utf-8") as f:
+            log = f.read()
+        print(f"  requeued at frame {last}; " +
+              "; ".join(line for line in log.splitlines() if "plume farm: variants" in line))
+        self.assertIn("restart 1", log)
+        with open(manifest, encoding="utf-8") as f:
+            run_info = json.load(f)["last_run"]
+        self.assertTrue(run_info["resumed"], run_info)
+        self.assertGreater(run_info["computed_frames"][0], 1)
+        here = os.path.join(base, "local")
+        local_bake(dom, here, vorticity=0.3)
+        assert_same_frames(self, frame_of(dom.name),
+                           os.path.dirname(os.path.dirname(manifest)), here,
+                           range(1, frames + 1), GRIDS)
+
+    def test_a_failed_task_stops_its_dependants_and_resubmit_runs_only_the_rest(self):
+        base = os.path.join(self.tmp, "failed")
+        dom = shot(base)
+        farm = bpy.context.scene.plume_farm
+        farm.job, farm.wedge_domain, farm.wedge_frame = 'WEDGE', dom, FRAMES
+        farm.wedge_settings = "vorticity = 0.2, 0.5"
+        os.environ["PLUME_JOB_FAULT"] = "exit@3"  # every bake's child exits 7 at frame 3
+        try:
+            folder = self.submit()
+        finally:
+            del os.environ["PLUME_JOB_FAULT"]
+        states = wait_done(self, folder)
+        self.assertEqual([ts.summary for ts in states], ["FAILED", "MISSING"])
+        tail = "\n".join(states[0].failures[0])
+        print("  a failed variant's log ends: " + states[0].failures[0][-1])
+        self.assertIn("Error", tail)
+        self.assertFalse(os.path.exists(os.path.join(folder, "wedge", "contact_sheet.png")))
+        self.assertEqual(bpy.ops.plume.farm_refresh(), {'FINISHED'})
+        _slurm, _status, farm_ops = farm_modules()
+        self.assertEqual(farm_ops.LAST["states"][0].summary, "FAILED")  # what the panel shows
+        self.assertEqual(bpy.ops.plume.farm_resubmit(), {'FINISHED'})
+        states = wait_done(self, folder)
+        self.assertEqual([ts.summary for ts in states], ["DONE", "DONE"])
+        record = json.load(open(os.path.join(folder, "farm.json")))
+        self.assertEqual(sorted(record), ["contact_sheet", "variants"])
+
+    def test_the_job_folder_runs_from_another_path(self):
+        if not hasattr(self, "wedge_folder"):
+            self.test_wedge_equals_local_bakes_and_makes_a_contact_sheet()
+        src = self.wedge_folder
+        copy = os.path.join(self.tmp, "elsewhere", "copy_of_job")
+        shutil.copytree(src, copy, ignore=shutil.ignore_patterns(
+            "plume_cache", "wedge", "state", "logs", "*.blend1"))
+        out = subprocess.run(["bash", os.path.join("scripts", "variants.sh")], cwd=copy,
+                             capture_output=True, text=True, timeout=WAIT_S,
+                             env=dict(os.environ, PLUME_TASK_INDEX="0"))
+        self.assertEqual(out.returncode, 0, out.stdout[-3000:] + out.stderr[-3000:])
+        self.assertTrue(os.path.exists(os.path.join(copy, "state", "variants.0.ok")))
+        name = f"{self.wedge_domain}_wedge_0"
+        assert_same_frames(self, frame_of(self.wedge_domain),
+                           os.path.join(copy, "plume_cache", name),
+                           os.path.join(src, "plume_cache", name), range(1, FRAMES + 1), GRIDS)
+
 
 if __name__ == "__main__":
     run(FarmTest)
