@@ -117,17 +117,20 @@ def parse_wedge(text, domain):
     return settings
 
 
-def check_variants(context, domain, settings):
-    """Each variant passes the bake's own checks (the ranges the bake would refuse), tried on
-    the domain and undone: FarmError naming the variant, the setting and its range."""
+def check_bakes(context, domain, settings=None):
+    """The bake's own checks on the domain, before anything is submitted (a node would only
+    fail later); with wedge `settings` on each variant, tried on the domain and undone.
+    FarmError naming the variant, the setting and its range."""
     from .. import bake_runner, setting_paths
     from ..native import _native
     from ..settings import BakeError
     from .smoke import take_snapshot
     d = domain.plume.domain
+    settings = settings or {}
     kept = {name: getattr(d, name) for name in settings}
+    variants = len(next(iter(settings.values()))) if settings else 1
     try:
-        for i in range(len(next(iter(settings.values())))):
+        for i in range(variants):
             for name, values in settings.items():
                 setattr(d, name, values[i])
             try:
@@ -135,7 +138,8 @@ def check_variants(context, domain, settings):
                     bake_runner.check_input(take_snapshot(bpy.context), _native)
             except BakeError as e:
                 why = setting_paths.in_ui_words(str(e)).removeprefix("Plume: ")
-                raise FarmError(f"Plume farm: Wedge Settings, variant {i}: {why}") from None
+                where = f"Wedge Settings, variant {i}" if settings else f"domain '{domain.name}'"
+                raise FarmError(f"Plume farm: {where}: {why}") from None
     finally:
         for name, value in kept.items():
             setattr(d, name, value)
@@ -207,6 +211,8 @@ def plan(context):
                             "Physics › Plume › Flow-Graph Fire › Record Pathlines on it and on "
                             "each state")
         check_time_limit(farm, states)
+        for dom in states:
+            check_bakes(context, dom)
         names = [o.name for o in states]
         tasks = [Task("states", run + ["bake_one", "{index}", *names], count=len(names),
                       cpus=cpus, label=f"bake the {len(names)} states"),
@@ -221,7 +227,7 @@ def plan(context):
             raise FarmError(f"Plume farm: choose the domain to vary in {PANEL} › Domain")
         check_time_limit(farm, [dom])
         settings = parse_wedge(farm.wedge_settings, dom)
-        check_variants(context, dom, settings)
+        check_bakes(context, dom, settings)
         count = len(next(iter(settings.values())))
         wedge = {"settings": settings, "count": count, "frame": int(farm.wedge_frame),
                  "domain": dom.name}
