@@ -391,6 +391,38 @@ class FarmTest(unittest.TestCase):
                            os.path.join(base, "plume_cache"), range(1, GRAPH_FRAMES + 1),
                            ("density", "temperature"))
 
+    def test_path_mapping_and_the_panels_background_poll(self):
+        """The farm sees the storage at another path (a symbolic link stands for the farm's
+        mount): the tasks run there, every file lands in the folder the artist sees, and the
+        panel's background poll reads the same states as the terminal."""
+        base = os.path.join(self.tmp, "mapped")
+        here = os.path.join(base, "projects")
+        mount = os.path.join(base, "mnt_projects")
+        dom = shot(os.path.join(here, "shotA"))
+        os.symlink(here, mount)
+        farm = bpy.context.scene.plume_farm
+        farm.path_here, farm.path_farm = here + "/", mount + "/"
+        farm.job, farm.wedge_domain, farm.wedge_frame = 'WEDGE', dom, FRAMES
+        farm.wedge_settings = "seed = 3"
+        folder = self.submit()
+        with open(os.path.join(folder, "scripts", "variants.sh"), encoding="utf-8") as f:
+            script = f.read()
+        self.assertNotIn(here + "/", script.replace(mount, ""), "a path only this machine sees")
+        states = wait_done(self, folder)
+        self.assertEqual([ts.summary for ts in states], ["DONE", "DONE"])
+        with open(os.path.join(folder, "cluster.json"), encoding="utf-8") as f:
+            farm_root = json.load(f)["farm_root"]  # where sbatch was told to run the tasks
+        self.assertEqual(farm_root, os.path.join(mount, os.path.relpath(folder, here)))
+        self.assertTrue(os.path.isfile(os.path.join(folder, "wedge", "contact_sheet.png")))
+        _slurm, status, _ops = farm_modules()
+        poll, end = status.Poll(folder), time.monotonic() + 30
+        polled = poll.result()
+        while polled is None and time.monotonic() < end:
+            time.sleep(0.05)
+            polled = poll.result()
+        self.assertEqual([(ts.name, ts.states) for ts in polled],
+                         [(ts.name, ts.states) for ts in status.read(folder)])
+
 
 if __name__ == "__main__":
     run(FarmTest)
