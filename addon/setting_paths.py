@@ -8,7 +8,7 @@ import re
 
 from .properties import PlumeDomainSettings, PlumeSourceSettings
 
-TAB = "Physics Properties › Plume"
+from .ui_words import TAB  # one definition of the tab's path
 
 #: The domain's panels (ui/panels.py) and the settings each draws (the messages' own names).
 DOMAIN_PANELS = (
