@@ -32,8 +32,8 @@ SUBSTEPS_RANGE = RANGES["flames.substeps"]
 STOPS_RANGE = (-40.0, 40.0)
 #: Samples per flame when the scene has no camera (no projected area to size them from).
 FIXED_PARTICLES = 4000
-NO_SOURCE = ("Plume: the scene has no Flame Source: select a mesh and press Flame Source in "
-             f"{TAB}")
+NO_SOURCE = ("Plume: the scene has no Flame Source: select a mesh and press "
+             f"{TAB} › Flame Source")
 
 
 def volume_path(folder, frame):

@@ -146,8 +146,8 @@ class MessagesTest(unittest.TestCase):
         scn = bpy.context.scene
         op = bpy.ops.plume.flames_bake
         f = scn.plume_flames
-        self.refusal(op, f"the scene has no Flame Source: select a mesh and press Flame Source "
-                         f"in {TAB}")
+        self.refusal(op, f"the scene has no Flame Source: select a mesh and press {TAB} › "
+                         "Flame Source")
         bpy.ops.mesh.primitive_cylinder_add(radius=0.002, depth=0.01, location=(0, 0, 0.005))
         src = bpy.context.active_object
         src.name = "Candle"
