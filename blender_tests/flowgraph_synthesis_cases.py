@@ -137,5 +137,6 @@ class SynthesisCases:
         g.fire_source = bpy.context.active_object
         select_only(self.windy)
         assert_reports_error(self, bpy.ops.plume.fire_synthesize,
-                             r"Fire Source 'Empty' must be a mesh \(its type is EMPTY\)", self.state)
+                             r"Fire Source \(Physics Properties › Plume › Flow-Graph Fire\) "
+                             r"'Empty' must be a mesh \(its type is Empty\)", self.state)
         g.fire_source = None

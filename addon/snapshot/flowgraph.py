@@ -84,7 +84,7 @@ def fire_source(domain, owner):
         return None
     if ob.type != 'MESH':
         raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'fire_source')} '{ob.name}' must be "
-                        f"a mesh (it is a {ob.type.lower()} object): choose a mesh object, the "
+                        f"a mesh (its type is {ob.type.title()}): choose a mesh object, the "
                         "fire is attached to it, or clear the setting")
     return ob
 
