@@ -17,7 +17,7 @@ import bpy  # noqa: E402
 
 from helpers import enable_addon, run  # noqa: E402
 
-# A file name in a tooltip: "smoke_surfaces.txt", "notes.md", "smoke_script.h", ...
+# A file name in a tooltip: "paper.txt", "notes.md", "smoke_script.h", ...
 FILE_NAME = re.compile(r"\b[\w-]+\.(txt|md|pdf|py|json|toml|h|cpp)\b")
 SNAKE = re.compile(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b")
 CAPS = re.compile(r"\b[A-Z][A-Z0-9]*(?:_[A-Z0-9]+)*\b")
