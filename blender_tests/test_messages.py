@@ -9,6 +9,8 @@ Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 
          --python blender_tests/test_messages.py
 """
 
+import contextlib
+import io
 import os
 import re
 import sys
@@ -18,8 +20,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import bpy  # noqa: E402
 
-from helpers import (add_domain, add_sphere_source, reset_scene, rmtree, run,  # noqa: E402
-                     select_only, temp_dir)
+from helpers import (add_domain, add_sphere_source, compat, flame_studio,  # noqa: E402
+                     reset_scene, rmtree, run, select_only, temp_dir)
 from test_roles_ui import draw_panel  # noqa: E402
 from test_tooltips import SNAKE, python_names, python_words  # noqa: E402
 
@@ -179,6 +181,20 @@ class MessagesTest(unittest.TestCase):
         self.assertEqual(op(), {'FINISHED'})
         self.refusal(auto, "add a camera (Add › Camera) and make it the scene's camera "
                            "(Scene Properties › Scene › Camera)")
+        # In EEVEE the film exposure it sets does nothing: a warning says what to set instead,
+        # naming the engine as Render Properties › Render Engine shows it.
+        flame_studio(scn, (0.0, -0.3, 0.03), 64, 64, 1)
+        scn.render.engine = compat.eevee_engine()
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            self.assertEqual(auto(), {'FINISHED'})
+        sys.stdout.write(out.getvalue())
+        warning = next(line for line in out.getvalue().splitlines() if "Auto Exposure" in line)
+        self.assertIn("Warning", warning)
+        self.assertIn("Render Properties › Film › Exposure), metered on", warning)
+        self.assertRegex(warning, r"Film Exposure is Cycles' only; in (EEVEE|Eevee) set Render "
+                                  r"Properties › Color Management › Exposure to [+-]\d")
+        self.assertEqual(python_words(warning, self.names), [], warning)
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ from ..snapshot.flames import flames_snapshot
 from ..jobs.operator import JobOperator
 from ..jobs import JobRunner, folder_lock, registry
 from ..settings import BakeError
-from ..ui_words import FLAMES, ui
+from ..ui_words import FLAMES, in_ui_words, ui
 
 #: The registry key of the scene's flames bake (one at a time).
 FLAMES_KEY = ("flames",)
@@ -83,7 +83,9 @@ class FlamesJob(JobRunner):
         return ('WARNING' if result.cancelled else 'INFO'), text
 
     def error_text(self, exc):
-        return f"Plume: flames bake failed: {exc}"
+        if isinstance(exc, BakeError):  # names the setting and what to do already
+            return str(exc)
+        return f"Plume: flames bake failed: {in_ui_words('flames', str(exc))}"
 
     def busy_text(self):
         return "Plume: flames are already baking"
