@@ -1,12 +1,12 @@
 """The flames manual's recipe "a campfire", performed by its own steps
 (`examples/flames/recipe_campfire.py`, which the screenshots run too): a new General scene
 without its cube, a 4 m ground plane, a log (cylinder r 5 cm, 55 cm long, lying along X at
-y -0.09 m) made a Flame Source from Preset › Campfire, copied (Shift+D) into a second log 18 cm
-beside it, both copied 10 cm up and turned 90° about Z, Bake Flames over frames 1-24, the camera
-at (0, -3, 0.8) m turned (84°, 0, 0) with a 40 mm lens, a black world, Cycles, frame 24, Auto
+y -0.09 m) made a Flame Source from Preset › Campfire (Flames › End 24), copied (Shift+D) into a
+second log 18 cm beside it, both copied 10 cm up and turned 90° about Z, Bake Flames, the camera
+at (0, -3.8, 0.95) m turned (86°, 0, 0) with a 35 mm lens, a black world, Cycles, frame 24, Auto
 Exposure, render. The picture the recipe promises: several warm flames standing over the logs
-(neither black nor white), wider than the logs and rising over a metre, lighting the
-ground, under the Blender's own view transform. Only the render's size and samples are set
+(neither black nor white), wider than the logs and rising over a metre, lighting the ground,
+under the Blender's own view transform. Only the render's size and samples are set
 here: 480 x 270, 32 samples.
 
 Run: python3 blender_tests/run.py --blender 5.3 test_recipe_campfire.py
