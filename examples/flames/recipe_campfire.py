@@ -15,7 +15,7 @@ LOG = dict(radius=0.05, depth=0.55, location=(0.0, -0.09, 0.05),
            rotation=(0.0, math.radians(90.0), 0.0))
 SECOND_LOG = (0.0, 0.18, 0.0)        # Shift+D, Y 0.18
 UPPER_LAYER = (0.0, 0.0, 0.1)        # both logs: Shift+D, Z 0.1, then R Z 90
-FRAME_END = 24
+FRAME_END = 20
 CAMERA_LOCATION, CAMERA_ROTATION_DEG, LENS = (0.0, -3.8, 0.95), (86.0, 0.0, 0.0), 35.0
 
 
@@ -30,7 +30,7 @@ def steps(cache_dir):
     press(bpy.ops.plume.flame_preset, preset='CAMPFIRE')    #    Preset › Campfire
     scene = bpy.context.scene
     flames = scene.plume_flames
-    flames.frame_end = FRAME_END                            #    Flames › End 24
+    flames.frame_end = FRAME_END                            #    Flames › End 20
     flames.cache_directory = cache_dir
     yield Shot("ui_campfire_preset.png")
     press(bpy.ops.object.duplicate_move,                    # 5. the second log: Shift+D, Y 0.18
@@ -47,6 +47,6 @@ def steps(cache_dir):
     world = scene.world.node_tree.nodes["Background"]       # 9. World › Surface › Color: black
     world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     scene.render.engine = 'CYCLES'                          # 10. Render Engine: Cycles,
-    scene.frame_set(FRAME_END)                              #     frame 24, Auto Exposure
+    scene.frame_set(FRAME_END)                              #     frame 20, Auto Exposure
     press(bpy.ops.plume.flames_auto_exposure)
     return [ob for ob in scene.objects if ob.plume.role == 'FLAME_SOURCE']
