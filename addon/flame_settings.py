@@ -11,6 +11,7 @@ import numpy as np
 
 from .ranges import RANGES, text
 from .settings import BakeError
+from .ui_words import TAB, label, ui
 
 PROFILES = ('CANDLE', 'TORCH', 'CAMPFIRE', 'CUSTOM')
 MANIFEST_NAME = "flames_manifest.json"
@@ -32,7 +33,7 @@ STOPS_RANGE = (-40.0, 40.0)
 #: Samples per flame when the scene has no camera (no projected area to size them from).
 FIXED_PARTICLES = 4000
 NO_SOURCE = ("Plume: the scene has no Flame Source: select a mesh and press "
-             "Physics Properties › Plume › Flame Source")
+             f"{TAB} › Flame Source")
 
 
 def volume_path(folder, frame):
@@ -177,89 +178,99 @@ def validate_settings(s: FlameSettings, frame):
     """BakeError naming the setting (the panel's name and the paper's symbol) and its range."""
     at = f"Flames (frame {frame}):"
     lo, hi = POINTS_RANGE
-    _check(lo <= s.points <= hi, f"{at} Control Points (n) must be in [{lo}, {hi}] "
+    _check(lo <= s.points <= hi, f"{at} {ui('flames', 'points')} must be in [{lo}, {hi}] "
                                  f"(got {s.points})")
     hp, hi_, hmax = s.height_persistent, s.height_intermittent, s.height_max
     _check(_finite(hp, hi_, hmax) and hp >= 0.0,
-           f"{at} Persistent Height (H_p) must be >= 0 (got {hp})")
-    _check(hp < hi_, f"{at} Persistent Height (H_p = {hp:g}) must be below Intermittent Height "
-                     f"(H_i = {hi_:g}): the intermittent region is [H_p, H_i] (§4.3)")
-    _check(hmax >= hi_, f"{at} Max Height (H_max = {hmax:g}) must be >= Intermittent Height "
-                        f"(H_i = {hi_:g})")
+           f"{at} {ui('flames', 'height_persistent')} must be >= 0 (got {hp:g})")
+    _check(hp < hi_, f"{at} {ui('flames', 'height_persistent')} must be below "
+                     f"{label('flames', 'height_intermittent')}: the intermittent region is "
+                     f"[H_p, H_i] (§4.3) (got H_p = {hp:g}, H_i = {hi_:g})")
+    _check(hmax >= hi_, f"{at} {ui('flames', 'height_max')} must be >= "
+                        f"{label('flames', 'height_intermittent')} (got H_max = {hmax:g}, "
+                        f"H_i = {hi_:g})")
     _check(_finite(s.lifespan_scale) and 1.0 / 24.0 - 1e-9 <= s.lifespan_scale <= 2.0,
-           f"{at} Lifespan Scale (A) must be in [1/24, 2] s (got {s.lifespan_scale})")
+           f"{at} {ui('flames', 'lifespan_scale')} must be in [1/24, 2] s "
+           f"(got {s.lifespan_scale:g})")
     _check(_finite(s.breakaway_frequency) and 0.0 <= s.breakaway_frequency <= 1000.0,
-           f"{at} Breakaway Frequency (f) must be in [0, 1000] Hz, 0 = automatic "
-           f"(got {s.breakaway_frequency})")
+           f"{at} {ui('flames', 'breakaway_frequency')} must be in [0, 1000] Hz, 0 = "
+           f"automatic (got {s.breakaway_frequency:g})")
     _check(_finite(s.buoyancy) and 0.0 <= s.buoyancy <= 100.0,
-           f"{at} Buoyancy (β) must be in [0, 100] (got {s.buoyancy})")
+           f"{at} {ui('flames', 'buoyancy')} must be in [0, 100] (got {s.buoyancy:g})")
     _check(_finite(s.diffusion) and 0.0 <= s.diffusion <= 10.0,
-           f"{at} Diffusion must be in [0, 10] m²/s (got {s.diffusion})")
+           f"{at} {ui('flames', 'diffusion')} must be in [0, 10] m²/s (got {s.diffusion:g})")
     _check(_finite(s.particles_per_pixel) and s.particles_per_pixel > 0.0,
-           f"{at} Particles per Pixel must be > 0 (got {s.particles_per_pixel})")
+           f"{at} {ui('flames', 'particles_per_pixel')} must be > 0 "
+           f"(got {s.particles_per_pixel:g})")
     _check(64 <= s.max_particles <= 10_000_000,
-           f"{at} Max Particles must be in [64, 10000000] (got {s.max_particles})")
+           f"{at} {ui('flames', 'max_particles')} must be in [64, 10000000] "
+           f"(got {s.max_particles})")
     _check(_finite(s.voxel_size) and s.voxel_size > 0.0,
-           f"{at} Voxel Size must be > 0 (got {s.voxel_size})")
-    for name, label, unit, open_low in NOISE_SETTINGS:
-        _check_noise(s, at, name, label, unit, open_low)
+           f"{at} {ui('flames', 'voxel_size')} must be > 0 (got {s.voxel_size:g})")
+    for name, unit, open_low in NOISE_SETTINGS:
+        _check_noise(s, at, name, unit, open_low)
     _check(_finite(s.temperature_scale) and 500.0 <= s.temperature_scale <= 40000.0,
-           f"{at} Temperature must be in [500, 40000] K (got {s.temperature_scale})")
+           f"{at} {ui('flames', 'temperature_scale')} must be in [500, 40000] K "
+           f"(got {s.temperature_scale:g})")
     _check(_finite(s.light_unit) and s.light_unit > 0.0,
-           f"{at} Light Unit (k of eq. 5) must be > 0 Blender watts per watt of E "
-           f"(got {s.light_unit}; the calibrated default is {LIGHT_UNIT:g})")
+           f"{at} {ui('flames', 'light_unit')} (k of eq. 5) must be > 0 Blender watts per "
+           f"watt of E (got {s.light_unit:g}; the calibrated default is {LIGHT_UNIT:g})")
     _check(_finite(s.opacity) and 0.0 <= s.opacity <= 1e4,
-           f"{at} Opacity must be in [0, 10000] (got {s.opacity})")
+           f"{at} {ui('flames', 'opacity')} must be in [0, 10000] (got {s.opacity:g})")
 
 
-#: The noise settings (§4.2, §4.5): (FlameSettings field, panel name with the paper's symbol,
-#: unit, whether 0 is excluded); their bounds are the core's (ranges.RANGES["flames.<field>"]).
+#: The noise settings (§4.2, §4.5): (FlameSettings field, unit, whether 0 is excluded); their
+#: bounds are the core's (ranges.RANGES["flames.<field>"]), their labels ui_words'.
 NOISE_SETTINGS = (
-    ("flow_noise", "Flow Noise", " widest radii", False),
-    ("flow_noise_scale", "Flow Noise Scale (λ)", " widest radii", True),
-    ("flow_noise_frequency", "Flow Noise Frequency (ν)", " Hz", False),
-    ("flow_noise_rotation", "Flow Noise Rotation (ω·2r)", " rad·m/s", False),
-    ("kolmogorov", "Kolmogorov Noise", " m", False),
-    ("kolmogorov_scale", "Kolmogorov Scale (Λ)", " m", True),
-    ("kolmogorov_frequency", "Kolmogorov Frequency (ν)", " Hz", False),
-    ("kolmogorov_drift", "Kolmogorov Drift (c)", " m/s per axis", False),
-    ("spine_noise", "Spine Noise", " m/s", False),
-    ("spine_noise_scale", "Spine Noise Scale (Λ)", " m", True),
-    ("spine_noise_frequency", "Spine Noise Frequency (ν)", " Hz", False),
-    ("spine_noise_drift", "Spine Noise Drift (c)", " m/s per axis", False),
+    ("flow_noise", " widest radii", False),
+    ("flow_noise_scale", " widest radii", True),
+    ("flow_noise_frequency", " Hz", False),
+    ("flow_noise_rotation", " rad·m/s", False),
+    ("kolmogorov", " m", False),
+    ("kolmogorov_scale", " m", True),
+    ("kolmogorov_frequency", " Hz", False),
+    ("kolmogorov_drift", " m/s per axis", False),
+    ("spine_noise", " m/s", False),
+    ("spine_noise_scale", " m", True),
+    ("spine_noise_frequency", " Hz", False),
+    ("spine_noise_drift", " m/s per axis", False),
 )
 
 
-def _check_noise(s, at, name, label, unit, open_low):
-    """BakeError "<label> must be in [lo, hi]<unit> (got v)" (a vector: every component)."""
+def _check_noise(s, at, name, unit, open_low):
+    """BakeError "<label> (<panel>) must be in [lo, hi]<unit> (got v)" (a vector: every
+    component)."""
     value = getattr(s, name)
     values = tuple(value) if isinstance(value, (tuple, list)) else (value,)
     lo, hi = RANGES[f"flames.{name}"]
     ok = all(_finite(v) and (v > lo if open_low else v >= lo) and v <= hi for v in values)
-    _check(ok, f"{at} {label} must be in {text(f'flames.{name}', open_low)}{unit} "
-               f"(got {value if len(values) > 1 else values[0]})")
+    _check(ok, f"{at} {ui('flames', name)} must be in {text(f'flames.{name}', open_low)}{unit} "
+               f"(got {value if len(values) > 1 else format(values[0], 'g')})")
 
 
 def validate_source_values(src: FlameSourceInput):
     lo, hi = STOPS_RANGE
     for i, (r, intensity, temp, stops) in enumerate(src.values):
         at = f"Flame Source '{src.name}'"
-        _check(_finite(r) and r > 0.0, f"{at}: Radius (r) must be > 0 (got {r})")
+        _check(_finite(r) and r > 0.0, f"{at}: {ui('flame_source', 'radius')} must be > 0 "
+                                       f"(got {r:g})")
         _check(_finite(intensity) and intensity >= 0.0,
-               f"{at}: Density (I) must be >= 0 (got {intensity})")
+               f"{at}: {ui('flame_source', 'intensity')} must be >= 0 (got {intensity:g})")
         _check(_finite(temp) and temp >= 0.0,
-               f"{at}: Temperature (T_p) must be >= 0 (got {temp})")
+               f"{at}: {ui('flame_source', 'temperature')} must be >= 0 (got {temp:g})")
         _check(_finite(stops) and lo <= stops <= hi,
-               f"{at}: Intensity must be in [{lo:g}, {hi:g}] stops (got {stops})")
+               f"{at}: {ui('flame_source', 'stops')} must be in [{lo:g}, {hi:g}] stops "
+               f"(got {stops:g})")
 
 
 def validate_snapshot(snap: FlameBakeSnapshot):
     _check(bool(snap.sources), NO_SOURCE[len("Plume: "):])
-    _check(snap.frame_end >= snap.frame_start, f"Flames: End ({snap.frame_end}) must be >= "
-                                               f"Start ({snap.frame_start})")
+    _check(snap.frame_end >= snap.frame_start, f"Flames: {ui('flames', 'frame_end')} must be "
+                                               f">= Start (got {snap.frame_start} to "
+                                               f"{snap.frame_end})")
     lo, hi = SUBSTEPS_RANGE
-    _check(lo <= snap.substeps <= hi, f"Flames: Substeps must be in [{lo}, {hi}] "
-                                      f"(got {snap.substeps})")
+    _check(lo <= snap.substeps <= hi, f"Flames: {ui('flames', 'substeps')} must be in "
+                                      f"[{lo}, {hi}] (got {snap.substeps})")
     for i, s in enumerate(snap.settings):
         validate_settings(s, snap.frame_start + i)
     for src in snap.sources:

@@ -23,6 +23,7 @@ import numpy as np
 
 from . import flame_palettes
 from .settings import BakeError
+from .ui_words import in_ui_words
 # The settings, validation and files of a flames bake, also reachable as flames.<name>.
 from .flame_files import (SMOKE_ARRAYS, SPINE_ARRAYS, buoyancy_lift, clear_folder,
                           read_manifest, read_spines, remove_frames_above, write_manifest,
@@ -178,7 +179,8 @@ class FlameBakeRunner:
                 try:
                     prof, img = self.build.profile(src), self.build.color_image(src)
                 except ValueError as e:
-                    raise BakeError(f"Plume: Flame Source '{src.name}': {e}") from None
+                    raise BakeError(f"Plume: Flame Source '{src.name}': "
+                                    f"{in_ui_words('flame_source', str(e))}") from None
                 self.profiles += [prof] * src.count
                 self.images += [img] * src.count
             for i, s in enumerate(snap.settings):  # every keyed shape setting is valid
@@ -189,7 +191,7 @@ class FlameBakeRunner:
                 o.vertices, o.triangles, OBSTACLE_VOXEL, padding=OBSTACLE_PADDING, name=o.name))
                 for o in snap.obstacles]
         except ValueError as e:
-            raise BakeError(f"Plume: Flames: {e}") from None
+            raise BakeError(f"Plume: Flames: {in_ui_words('flames', str(e))}") from None
 
     def _check_sources(self):
         """Every source at every frame through the core's own validation (ValueError naming
@@ -203,7 +205,8 @@ class FlameBakeRunner:
                         probe.add_source(self._source_at(src, k, i, 1.0, dt_frame))
                     except ValueError as e:
                         raise BakeError(f"Plume: Flame Source '{src.name}' (frame "
-                                        f"{self.snap.frame_start + i}): {e}") from None
+                                        f"{self.snap.frame_start + i}): "
+                                        f"{in_ui_words('flame_source', str(e))}") from None
 
     # --- per frame inputs ---
     def _source_at(self, src, k, index, alpha, dt_frame):

@@ -22,6 +22,7 @@ import numpy as np
 
 from . import cache, files
 from .settings import BakeError
+from .ui_words import FLOWGRAPH, TAB, in_ui_words
 # Build Flow Graph's and Synthesize Fire's settings, also reachable as flowgraph.<name>.
 from .flowgraph_files import (FIRE_FOLDER, WALK_NAME, points_path, preview_indices,
                               read_points, read_walk, transition_indices, walk_path,
@@ -84,14 +85,14 @@ def open_states(native, named_folders: Sequence[Tuple[str, str]]) -> List[State]
     if len(named_folders) < 2:
         raise BakeError("Plume: flow-graph fire needs at least two baked fire states (got "
                         f"{len(named_folders)}): select two or three fire domains baked with "
-                        "Record Pathlines (states in name order; the graph is kept with the "
-                        "active one)")
+                        f"Record Pathlines ({TAB} › Combustion), Shift-clicking them in the "
+                        "viewport (states in name order; the graph is kept with the active one)")
     states = []
     for name, folder in named_folders:
         path = cache.pathlines_path(folder)
         if not os.path.isfile(path):
             raise BakeError(f"Plume: domain '{name}' has no pathline file ({path}): turn on "
-                            "Combustion > Record Pathlines and bake it")
+                            f"Record Pathlines ({TAB} › Combustion) and bake it")
         try:
             states.append(State(name, folder, native.PathlineFile.open(path)))
         except RuntimeError as e:
@@ -167,7 +168,7 @@ def cost_matrix(native, states: List[State], s: FlowGraphSettings,
         params.validate()
         job = native.CostMatrixJob.of_files(pathline_files, params)
     except ValueError as e:
-        raise BakeError(f"Plume: flow graph: {e}") from None
+        raise BakeError(f"Plume: flow graph: {in_ui_words('flowgraph', str(e))}") from None
     if on_job is not None:
         on_job(job)
     if not job.run():
@@ -201,7 +202,8 @@ def build_graph(native, states: List[State], s: FlowGraphSettings, out_folder,
         eps, a, b, moments = threshold(native, cost, counts, params)
         graph = graph_of(native, cost, counts, params, eps)
     except ValueError as e:
-        raise BakeError(f"Plume: flow graph: {e}{_candidate_range(native, cost, counts, params)}"
+        raise BakeError(f"Plume: flow graph: {in_ui_words('flowgraph', str(e))}"
+                        f"{_candidate_range(native, cost, counts, params)}"
                         ) from None
     image = native.cost_matrix_image(cost, graph, size=min(512, max(64, len(cost))))
     t = graph.transitions()
@@ -257,8 +259,7 @@ def load_graph(native, folder, owner):
     path = graph_path(folder)
     if not os.path.isfile(path):
         raise BakeError(f"Plume: {owner} has no flow graph yet: select the fire states and "
-                        "press Build Flow Graph first (Physics Properties › Plume › Flow-Graph "
-                        "Fire)")
+                        f"press Build Flow Graph first ({FLOWGRAPH})")
     try:
         with np.load(path, allow_pickle=False) as data:
             cost = np.array(data["cost"])
@@ -287,7 +288,7 @@ def load_graph(native, folder, owner):
         graph = (native.FlowGraph.build(cost, counts, params) if used is None
                  else graph_of(native, cost, counts, params, used))
     except ValueError as e:
-        raise BakeError(f"Plume: {owner}: {e}") from None
+        raise BakeError(f"Plume: {owner}: {in_ui_words('flowgraph', str(e))}") from None
     return graph, states
 
 

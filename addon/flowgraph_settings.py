@@ -11,6 +11,7 @@ import numpy as np
 
 from .ranges import RANGES
 from .settings import BakeError
+from .ui_words import TAB, label, ui
 
 TRAVERSALS = ('UNIFORM', 'BIASED')
 #: The transition state of §5: hold for the pathlines' lifetime, for transition_hold_frames, or not.
@@ -66,19 +67,22 @@ class SynthesisSettings:
 
 def validate_graph_settings(s: FlowGraphSettings, owner):
     if s.block_size < 1:
-        raise BakeError(f"Plume: {owner}: block_size (B) must be >= 1 (got {s.block_size})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'block_size')} must be >= 1 "
+                        f"(got {s.block_size})")
     if s.min_node_gap < 0:
-        raise BakeError(f"Plume: {owner}: min_node_gap must be >= 0 (got {s.min_node_gap})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'min_node_gap')} must be >= 0 "
+                        f"(got {s.min_node_gap})")
     if s.startup_groups < -1:
-        raise BakeError(f"Plume: {owner}: startup_groups must be -1 (the pathline lifetime) or "
-                        f">= 0 (got {s.startup_groups})")
+        raise BakeError(f"Plume: {owner}: the start-up groups left out must be -1 (the pathline "
+                        f"lifetime) or >= 0 (got {s.startup_groups})")
     if not (math.isfinite(s.epsilon) and s.epsilon >= 0.0):
-        raise BakeError(f"Plume: {owner}: epsilon (ε) must be 0 (automatic: (2a+b)/3) or a "
-                        f"cost in [a, b] (got {s.epsilon})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'epsilon')} must be 0 (automatic: "
+                        f"(2a+b)/3) or a cost in [a, b] (got {s.epsilon:g})")
     for name in ("alpha", "beta"):
         v = getattr(s, name)
         if not s.auto_weights and not (math.isfinite(v) and v >= 0.0):
-            raise BakeError(f"Plume: {owner}: {name} must be >= 0 (got {v})")
+            raise BakeError(f"Plume: {owner}: {ui('flowgraph', name)} must be >= 0 (got {v:g}), "
+                            f"or turn on {label('flowgraph', 'auto_weights')}")
 
 
 def transition_hold_steps(s: SynthesisSettings, layout, nodes_per_frame, state_nodes, owner):
@@ -94,47 +98,51 @@ def transition_hold_steps(s: SynthesisSettings, layout, nodes_per_frame, state_n
     if hold > nodes - 1:
         what = ("the pathline lifetime" if s.transition_hold == 'LIFETIME'
                 else f"Hold Frames {s.transition_hold_frames:g}")
-        raise BakeError(f"Plume: {owner}: Transition Hold ({what} = {hold} node steps, "
-                        f"{hold / nodes_per_frame:.2f} frames) is longer than the bake of state "
-                        f"'{name}' ({nodes} node steps): choose at most "
-                        f"{(nodes - 1) / nodes_per_frame:.2f} Hold Frames, or bake the states "
-                        "longer")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'transition_hold')} ({what} = "
+                        f"{hold} node steps, {hold / nodes_per_frame:.2f} frames) is longer than "
+                        f"the bake of state '{name}' ({nodes} node steps): set Transition Hold to "
+                        f"Custom with at most {(nodes - 1) / nodes_per_frame:.2f} Hold Frames, or "
+                        "bake the states longer")
     return hold
 
 
 def validate_synthesis(s: SynthesisSettings, state_count, owner):
     if s.frame_end < s.frame_start:
-        raise BakeError(f"Plume: {owner}: synthesis frame_end must be >= frame_start "
-                        f"(got {s.frame_start}..{s.frame_end})")
+        raise BakeError(f"Plume: {owner}: Synthesis {ui('flowgraph', 'frame_end')} must be >= "
+                        f"{label('flowgraph', 'frame_start')} (got {s.frame_start} to "
+                        f"{s.frame_end})")
     if s.traversal not in TRAVERSALS:
-        raise BakeError(f"Plume: {owner}: traversal must be one of {', '.join(TRAVERSALS)}")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'traversal')} must be Random or "
+                        f"Temporal Bias (got {s.traversal!r})")
     if not (0.0 < s.gamma < 1.0):
-        raise BakeError(f"Plume: {owner}: gamma (γ) must be in (0, 1) (got {s.gamma})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'gamma')} must be in (0, 1) "
+                        f"(got {s.gamma:g})")
     if s.transition_hold not in TRANSITION_HOLDS:
-        raise BakeError(f"Plume: {owner}: transition_hold must be one of "
-                        f"{', '.join(TRANSITION_HOLDS)} (got {s.transition_hold!r})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'transition_hold')} must be "
+                        f"Lifetime, Custom or Off (got {s.transition_hold!r})")
     if s.transition_hold == 'CUSTOM' and not (math.isfinite(s.transition_hold_frames)
                                               and s.transition_hold_frames >= 0.0):
-        raise BakeError(f"Plume: {owner}: Hold Frames (transition_hold_frames) must be >= 0 "
-                        f"(got {s.transition_hold_frames})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'transition_hold_frames')} must be "
+                        f">= 0 (got {s.transition_hold_frames:g})")
     if not (0 <= s.start_state < state_count):
-        raise BakeError(f"Plume: {owner}: start_state must be in [0, {state_count - 1}] "
-                        f"(got {s.start_state})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'start_state')} must be in "
+                        f"[0, {state_count - 1}], one of the graph's states (got {s.start_state})")
     bad = [t for t in s.targets if not (-1 <= t < state_count)]
     if bad:
-        raise BakeError(f"Plume: {owner}: target_state must be -1 (none) or in [0, "
-                        f"{state_count - 1}] (got {bad[0]})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'target_state')} must be -1 (none) "
+                        f"or in [0, {state_count - 1}], one of the graph's states (got {bad[0]})")
     if not (0.0 <= s.ignition_temperature < s.max_temperature):
-        raise BakeError(f"Plume: {owner}: the fire needs 0 <= ignition temperature < max "
-                        f"temperature (got {s.ignition_temperature}, {s.max_temperature})")
+        raise BakeError(f"Plume: {owner}: the fire needs 0 <= ignition temperature < Max "
+                        f"Temperature (T_max) ({TAB} › Combustion) (got "
+                        f"{s.ignition_temperature}, {s.max_temperature})")
     lo, hi = PREVIEW_POINTS_RANGE
     if s.point_preview and not (lo <= s.preview_points <= hi):
-        raise BakeError(f"Plume: {owner}: preview_points must be in [{lo}, {hi}] "
-                        f"(got {s.preview_points})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'preview_points')} must be in "
+                        f"[{lo}, {hi}] (got {s.preview_points})")
     lo, hi = RANGES["flowgraph.group_cache"]
     if not (lo <= s.group_cache_mb <= hi):
-        raise BakeError(f"Plume: {owner}: group_cache must be in [{lo}, {hi}] MB "
-                        f"(got {s.group_cache_mb})")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'group_cache')} must be in "
+                        f"[{lo}, {hi}] (got {s.group_cache_mb})")
 
 
 def startup_groups(s: FlowGraphSettings, layout):

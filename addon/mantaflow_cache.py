@@ -44,6 +44,9 @@ BORDER_SETTINGS = ("use_collision_border_left", "use_collision_border_right",
                    "use_collision_border_front", "use_collision_border_back",
                    "use_collision_border_bottom", "use_collision_border_top")
 
+#: Where Blender's own fluid settings are.
+FLUID = "Physics Properties › Fluid"
+
 
 @dataclass
 class MantaflowSource:
@@ -168,12 +171,14 @@ def check_source(m, frame_start, frame_end):
         raise BakeError(f"{owner}: mantaflow_domain '{m.object_name}' is not a Blender fluid "
                         "domain of type Gas")
     if m.cache_data_format != "OPENVDB":
-        raise BakeError(f"{name}: cache_data_format is {m.cache_data_format}; streak tracing "
-                        "reads OpenVDB caches: set Cache > Format Volumes to OpenVDB and bake it "
+        fmt = {"UNI": "Uni Cache", "RAW": "Raw Cache"}.get(m.cache_data_format,
+                                                         m.cache_data_format.title())
+        raise BakeError(f"{name}: its volumes are cached as {fmt}; streak tracing reads OpenVDB "
+                        f"caches: set {FLUID} › Cache › Format Volumes to OpenVDB and bake it "
                         "again")
     if m.use_adaptive_domain:
-        raise BakeError(f"{name}: use_adaptive_domain is on; streak tracing needs the whole "
-                        "grid: turn Adaptive Domain off and bake it again")
+        raise BakeError(f"{name}: its Adaptive Domain is on; streak tracing needs the whole "
+                        f"grid: turn {FLUID} › Settings › Adaptive Domain off and bake it again")
     if frame_start < m.cache_frame_start or frame_end > m.cache_frame_end:
         raise BakeError(f"{owner}: frames {frame_start}-{frame_end} are outside the Mantaflow "
                         f"cache's frames {m.cache_frame_start}-{m.cache_frame_end} of "
@@ -185,7 +190,7 @@ def check_source(m, frame_start, frame_end):
             if not os.path.isfile(path):
                 raise BakeError(
                     f"{name} is not baked over frames {first}-{frame_end} ({path} is missing): "
-                    "bake it (Physics > Fluid > Cache > Bake Data, or play the frames of a "
+                    f"bake it ({FLUID} › Settings › Bake Data, or play the frames of a "
                     "Replay cache)")
     configs = {f: read_config(config_path(m.cache_directory, f)) for f in needed}
     ref = configs[first]
@@ -203,7 +208,8 @@ def check_source(m, frame_start, frame_end):
             length = 0.1 * (25.0 / m.fps) * m.time_scale
         if not (length > 0.0 and math.isfinite(length)):
             raise BakeError(f"{name}: frame {f} has a time step of {length} Mantaflow time units "
-                            "(time_scale 0?); bake it again with a time scale > 0")
+                            f"(Time Scale 0?); bake it again with {FLUID} › Settings › Time "
+                            "Scale > 0")
         frame_dts.append(length / TIME_UNITS_PER_SECOND)
     traced = range(frame_start, frame_end + 1)
     start = None  # the empty state before the cache

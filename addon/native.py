@@ -48,8 +48,9 @@ def explain_import_failure(folder, error, python=None):
     present = _pythons(glob.glob(os.path.join(folder, "_native*.so")))
     release, listed = _build_info(folder)
     shipped = _pythons(listed) if listed is not None else present
-    reinstall = (f"install plume-{release}-linux-x64.zip again (Edit > Preferences > Get "
-                 "Extensions > Install from Disk; in Blender 3.4 Add-ons > Install)")
+    reinstall = (f"install plume-{release}-linux-x64.zip again (Edit › Preferences › Get "
+                 "Extensions › Install from Disk; in Blender 3.4 Edit › Preferences › Add-ons › "
+                 "Install…)")
     if shipped and python not in shipped:
         supported = "; ".join(f"Python {a}.{b} ({BLENDERS_OF_PYTHON.get((a, b), 'Blender ?')})"
                               for a, b in shipped)

@@ -8,7 +8,7 @@ import re
 
 from .properties import PlumeDomainSettings, PlumeSourceSettings
 
-TAB = "Physics Properties › Plume"
+from .ui_words import TAB  # one definition of the tab's path
 
 #: The domain's panels (ui/panels.py) and the settings each draws (the messages' own names).
 DOMAIN_PANELS = (
@@ -47,6 +47,7 @@ OWNERS = {"domain": (PlumeDomainSettings, DOMAIN_PANELS),
 # "domain 'Smoke': vorticity must ...": the setting the message is about follows its owner.
 _SUBJECT = re.compile(r"\b(domain|source) '[^']*': ([a-z][a-z0-9_]*)\b")
 _SNAKE = re.compile(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b")
+_SYMBOL = re.compile(r" \(([^()\s]{1,8})\)")
 
 
 def setting_path(name, owner="domain"):
@@ -72,4 +73,8 @@ def in_ui_words(message):
         name = word.group(0)
         drawn = any(name in names for _panel, names in panels)
         return cls.bl_rna.properties[name].name if drawn else name
-    return message[:m.start(2)] + where + _SNAKE.sub(label, message[m.end():])
+    rest = message[m.end():]
+    symbol = _SYMBOL.match(rest)  # "pathline_lifetime (t_max)": the label carries the symbol
+    if symbol is not None and f"({symbol.group(1)})" in where:
+        rest = rest[symbol.end():]
+    return message[:m.start(2)] + where + _SNAKE.sub(label, rest)

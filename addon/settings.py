@@ -321,7 +321,7 @@ def physical_buoyancy(alpha, beta, units, longest_side):
     if units == 'PHYSICAL':
         return float(alpha), float(beta)
     if units != 'MANTAFLOW':
-        raise BakeError(f"buoyancy_units must be 'PHYSICAL' or 'MANTAFLOW' (got {units!r})")
+        raise BakeError(f"Buoyancy Units must be Physical or Mantaflow (got {units!r})")
     if not longest_side > 0.0:
         raise BakeError(f"the domain's longest side must be > 0 m (got {longest_side})")
     return float(alpha) / longest_side, float(beta) / longest_side

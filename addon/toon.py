@@ -17,6 +17,7 @@ import numpy as np
 
 from . import cache
 from .settings import BakeError
+from .ui_words import TAB, TOON, in_ui_words, label, ui
 
 #: Stencils (Figure 3); IMAGE uses the artist's image file.
 STENCILS = ('CIRCLE', 'PUFFY', 'HAIRY', 'IMAGE')
@@ -78,54 +79,56 @@ PARAM_FIELDS = ('emission_count', 'birth_density', 'birth_spacing', 'death_densi
 
 def _finite(name, value, where):
     if not math.isfinite(value):
-        raise BakeError(f"Plume: {where}toon {name} must be a finite number (got {value})")
+        raise BakeError(f"Plume: {where}{ui('toon', name)} must be a finite number (got {value:g})")
 
 
 def validate(s: ToonSettings, domain_name=""):
-    """BakeError naming the setting and its accepted range; the native validate() covers the
-    rest of the particle settings (see to_params)."""
+    """BakeError naming the setting as its panel shows it and its accepted range; the native
+    validate() covers the rest of the particle settings (see to_params)."""
     where = f"domain '{domain_name}': " if domain_name else ""
     for f in fields(s):
         v = getattr(s, f.name)
         if isinstance(v, float):
             _finite(f.name, v, where)
     if s.depth_threshold < 0.0:
-        raise BakeError(f"Plume: {where}toon depth_threshold (γ) must be >= 0 (depth difference "
-                        "per pixel above which a pixel is outlined, §2.2; got "
-                        f"{s.depth_threshold})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'depth_threshold')} must be >= 0, the depth "
+                        "difference per pixel above which a pixel is outlined (§2.2; got "
+                        f"{s.depth_threshold:g})")
     if s.death_density < 0.0 or s.birth_density <= s.death_density:
-        raise BakeError(f"Plume: {where}toon densities need 0 <= death_density (ρ_death) < "
-                        f"birth_density (ρ_birth) (got ρ_death = {s.death_density}, ρ_birth = "
-                        f"{s.birth_density})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'death_density')} must be >= 0 and below "
+                        f"{label('toon', 'birth_density')} (got {s.death_density:g} and "
+                        f"{s.birth_density:g})")
     if s.ramp_density_high <= s.ramp_density_low:
-        raise BakeError(f"Plume: {where}toon size ramp needs ramp_density_low (d0) < "
-                        f"ramp_density_high (d1) (got {s.ramp_density_low}, "
-                        f"{s.ramp_density_high})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'ramp_density_high')} must be above "
+                        f"{label('toon', 'ramp_density_low')} (got {s.ramp_density_high:g} and "
+                        f"{s.ramp_density_low:g})")
     if s.size_low < 0.0 or s.size_high < 0.0 or max(s.size_low, s.size_high) <= 0.0:
-        raise BakeError(f"Plume: {where}toon sizes s0, s1 must be >= 0 and not both 0 (m; got "
-                        f"{s.size_low}, {s.size_high})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'size_low')} and {label('toon', 'size_high')} "
+                        f"must be >= 0 m and not both 0 (got {s.size_low:g} and {s.size_high:g})")
     if s.color_high <= s.color_low:
-        raise BakeError(f"Plume: {where}toon colour ramp needs color_low < color_high (got "
-                        f"{s.color_low}, {s.color_high})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'color_high')} must be above "
+                        f"{label('toon', 'color_low')} (got {s.color_high:g} and {s.color_low:g})")
     if s.stencil not in STENCILS:
-        raise BakeError(f"Plume: {where}toon stencil must be one of {', '.join(STENCILS)} "
-                        f"(got {s.stencil!r})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'stencil')} must be Circle, Puffy Cloud, "
+                        f"Hairy Cloud or Image (got {s.stencil!r})")
     if s.stencil == 'IMAGE':
         if not s.stencil_image:
-            raise BakeError(f"Plume: {where}toon stencil is IMAGE but no stencil_image is set: "
-                            "pick an image file (its alpha is the cut-out)")
+            raise BakeError(f"Plume: {where}Stencil is Image but {ui('toon', 'stencil_image')} "
+                            "is empty: pick an image file (its alpha is the cut-out)")
         if not os.path.isfile(s.stencil_image):
-            raise BakeError(f"Plume: {where}toon stencil_image {s.stencil_image} does not exist")
+            raise BakeError(f"Plume: {where}{ui('toon', 'stencil_image')} {s.stencil_image} "
+                            "does not exist: pick an image file")
     if s.color_driver not in COLOR_DRIVERS:
-        raise BakeError(f"Plume: {where}toon color_driver must be one of "
-                        f"{', '.join(COLOR_DRIVERS)} (got {s.color_driver!r})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'color_driver')} must be Density, "
+                        f"Temperature or Speed (got {s.color_driver!r})")
     if s.integration not in INTEGRATIONS:
-        raise BakeError(f"Plume: {where}toon integration must be one of "
-                        f"{', '.join(INTEGRATIONS)} (got {s.integration!r})")
+        raise BakeError(f"Plume: {where}{ui('toon', 'integration')} must be Euler or Midpoint "
+                        f"(got {s.integration!r})")
 
 
 def to_params(native, s: ToonSettings, domain_name=""):
-    """_native.ToonParams of the settings, validated (BakeError with the native message)."""
+    """_native.ToonParams of the settings, validated (BakeError with the native message, the
+    setting it names as the panel shows it)."""
     p = native.ToonParams()
     for name in PARAM_FIELDS:
         v = getattr(s, name)
@@ -135,12 +138,13 @@ def to_params(native, s: ToonSettings, domain_name=""):
             v = getattr(native.ToonColorDriver, v)
         try:
             setattr(p, name, v)
-        except TypeError as e:  # e.g. a negative seed into an unsigned field
-            raise BakeError(f"Plume: domain '{domain_name}': toon {name}: {e}") from None
+        except TypeError:  # e.g. a negative seed into an unsigned field
+            raise BakeError(f"Plume: domain '{domain_name}': {ui('toon', name)} cannot be "
+                            f"{v!r}") from None
     try:
         p.validate()
     except ValueError as e:
-        raise BakeError(f"Plume: domain '{domain_name}': toon {e}") from None
+        raise BakeError(f"Plume: domain '{domain_name}': {in_ui_words('toon', str(e))}") from None
     return p
 
 
@@ -149,7 +153,7 @@ def toon_manifest(folder, domain_name):
     m = cache.read_manifest(folder)
     if m is None or m.get("last_complete_frame", -1) < m.get("frame_start", 0):
         raise BakeError(f"Plume: domain '{domain_name}' has no bake yet: bake it first "
-                        "(Physics Properties › Plume › Bake), then build the toon smoke")
+                        f"({TAB} › Bake), then build the toon smoke")
     first = cache.volume_path(folder, int(m["frame_start"]))
     if not os.path.isfile(first):
         raise BakeError(f"Plume: volume file {first} is missing: bake the domain again")
@@ -188,14 +192,14 @@ def check_bake(settings: ToonSettings, manifest, domain_name=""):
     if manifest.get("motion_source") == "mantaflow" and settings.color_driver == 'TEMPERATURE':
         raise BakeError(f"Plume: domain '{domain_name}' traces a Mantaflow cache, which carries "
                         "density and velocity only: set Colour Driver to Density or Speed "
-                        "(Physics Properties › Plume › Toon Smoke)")
+                        f"({TOON})")
 
 
 def frame_dt(manifest):
     """Seconds per frame of the bake (time scale / fps, as the solver used)."""
     dt = manifest.get("settings", {}).get("solver", {}).get("frame_dt")
     if dt is None or not math.isfinite(float(dt)) or float(dt) <= 0.0:
-        raise BakeError("Plume: the bake's manifest has no frame_dt: bake the domain again")
+        raise BakeError("Plume: the bake's manifest has no frame time: bake the domain again")
     return float(dt)
 
 
@@ -240,7 +244,7 @@ class ToonRunner:
         try:
             particles = native.ToonParticles(self.params, *self.grid.args())
         except ValueError as e:
-            raise BakeError(f"Plume: toon particles: {e}") from None
+            raise BakeError(f"Plume: toon particles: {in_ui_words('toon', str(e))}") from None
         result = ToonResult(frame_start=self.frame_start, last_frame=self.frame_start - 1)
         total = self.last_frame - self.frame_start + 1
         # Frames of an older build would mix with this one (a cancel keeps a prefix): remove them.

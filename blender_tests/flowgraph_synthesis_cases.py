@@ -83,8 +83,9 @@ class SynthesisCases:
         g.transition_hold = 'CUSTOM'
         g.transition_hold_frames = 40.0  # 80 node steps: each state holds 58 nodes
         assert_reports_error(self, bpy.ops.plume.fire_synthesize,
-                             r"Transition Hold \(Hold Frames 40 = 80 node steps.*longer than "
-                             r"the bake of state", self.state)
+                             r"Transition Hold \(Physics Properties › Plume › Flow-Graph "
+                             r"Fire\) \(Hold Frames 40 = 80 node steps.*longer than the bake of "
+                             r"state", self.state)
         g.transition_hold, g.traversal = 'LIFETIME', 'BIASED'
 
     def test_6_fire_source(self):
@@ -136,5 +137,6 @@ class SynthesisCases:
         g.fire_source = bpy.context.active_object
         select_only(self.windy)
         assert_reports_error(self, bpy.ops.plume.fire_synthesize,
-                             r"Fire Source 'Empty' must be a mesh \(its type is EMPTY\)", self.state)
+                             r"Fire Source \(Physics Properties › Plume › Flow-Graph Fire\) "
+                             r"'Empty' must be a mesh \(its type is Empty\)", self.state)
         g.fire_source = None

@@ -224,6 +224,29 @@ def lit_components(lit):
     return float(largest) / n, float((lit & (neighbours == 0)).sum()) / n
 
 
+
+def lit_extent(scene, lit, depth_y=0.0):
+    """(lowest z, highest z, width) in metres of the lit pixels of `lit` (a boolean image read
+    by image_pixels: row 0 at the bottom), measured in the plane y = `depth_y` that the scene
+    camera looks at (a flame standing at y = 0 before a camera looking along +y)."""
+    from bpy_extras.object_utils import world_to_camera_view
+    from mathutils import Vector
+    h, w = lit.shape
+    cam = scene.camera
+    rows, cols = np.nonzero(lit.any(axis=1))[0], np.nonzero(lit.any(axis=0))[0]
+    if not len(rows):
+        return float("nan"), float("nan"), 0.0
+    zs = np.linspace(-2.0, 4.0, 601)
+    at_z = [world_to_camera_view(scene, cam, Vector((cam.location.x, depth_y, z))).y * h - 0.5
+            for z in zs]
+    z0, z1 = (float(np.interp(r, at_z, zs)) for r in (rows[0], rows[-1] + 1))
+    xs = cam.location.x + np.linspace(-3.0, 3.0, 601)
+    z_mid = 0.5 * (z0 + z1)
+    at_x = [world_to_camera_view(scene, cam, Vector((x, depth_y, z_mid))).x * w - 0.5
+            for x in xs]
+    x0, x1 = (float(np.interp(c, at_x, xs)) for c in (cols[0], cols[-1] + 1))
+    return z0, z1, x1 - x0
+
 #: Smallest mean |rendered - rendered without the volume| over all pixels and RGB channels that
 #: counts as "the smoke shows". Both renders use the same Cycles seed, so pixels whose rays miss the
 #: volume are bit-identical and the mean is the smoke's alone. One 8-bit level is 1/255 = 0.0039;

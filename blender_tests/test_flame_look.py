@@ -228,7 +228,8 @@ class FlameLookTest(unittest.TestCase):
         fl.color_source = 'PROFILE'
         for bad in (0.0, -1.0):
             f.light_unit = bad
-            assert_reports_error(self, op, r"Light Unit \(k of eq. 5\) must be > 0", state)
+            assert_reports_error(self, op, r"Light Unit \(Physics Properties › Plume › Flames\) "
+                                 rf"\(k of eq\. 5\) must be > 0 .*\(got {bad:g};", state)
 
 
 def write_grey_png(path):

@@ -211,7 +211,8 @@ class FlamePresetsTest(unittest.TestCase):
         scn = bpy.context.scene
         # Nothing baked: refused, the film exposure untouched.
         assert_reports_error(self, bpy.ops.plume.flames_auto_exposure,
-                             r"bake them first \(Physics › Plume › Flames › Bake Flames\)",
+                             r"bake them first \(Physics Properties › Plume › Flames › Bake "
+                             r"Flames\)",
                              lambda: scn.cycles.film_exposure)
         self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})
         self.assertEqual(bpy.ops.plume.flames_auto_exposure(), {'FINISHED'})
@@ -225,7 +226,9 @@ class FlamePresetsTest(unittest.TestCase):
         cam = scn.camera
         scn.camera = None
         assert_reports_error(self, bpy.ops.plume.flames_auto_exposure,
-                             r"add a camera \(Add › Camera\)", lambda: scn.cycles.film_exposure)
+                             r"add a camera \(Add › Camera\) and make it the scene's camera "
+                             r"\(Scene Properties › Scene › Camera\)",
+                             lambda: scn.cycles.film_exposure)
         scn.camera = cam
 
     def test_bad_intensity(self):
@@ -236,8 +239,9 @@ class FlamePresetsTest(unittest.TestCase):
         for bad in (41.0, -41.0, float("nan")):
             src.plume.flame.stops = bad
             assert_reports_error(self, bpy.ops.plume.flames_bake,
-                                 r"Flame Source 'Cylinder': Intensity must be in \[-40, 40\] "
-                                 r"stops", state)
+                                 r"Flame Source 'Cylinder': Intensity \(Physics Properties › "
+                                 r"Plume › Flame Source\) must be in \[-40, 40\] stops "
+                                 rf"\(got {bad:g}\)", state)
 
 
 if __name__ == "__main__":

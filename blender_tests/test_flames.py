@@ -319,7 +319,8 @@ class FlamesTest(unittest.TestCase):
             return (len(bpy.data.objects), len(bpy.data.volumes), len(bpy.data.curves),
                     len(bpy.data.lights), tuple(tree_listing(self.tmp)))
         f.points = 1
-        assert_reports_error(self, op, r"Control Points \(n\) must be in \[2, 256\]", state)
+        assert_reports_error(self, op, r"Control Points \(n\) \(Physics Properties › Plume › "
+                             r"Flames\) must be in \[2, 256\] \(got 1\)", state)
         f.points = 16
         f.height_persistent = f.height_intermittent
         assert_reports_error(self, op, r"Persistent Height \(H_p.*below Intermittent Height",
@@ -330,14 +331,17 @@ class FlamesTest(unittest.TestCase):
         f.height_max = 0.08
         # The noises (§4.2, §4.5): named with the paper's symbol and the core's range.
         f.spine_noise_scale = 0.0
-        assert_reports_error(self, op, r"Spine Noise Scale \(Λ\) must be in \(0, 10000\] m", state)
+        assert_reports_error(self, op, r"Spine Noise Scale \(Λ\) \(Physics Properties › Plume › "
+                             r"Flames › Noise\) must be in \(0, 10000\] m \(got 0\)", state)
         f.spine_noise_scale = 0.25
         f.kolmogorov_drift = (0.0, 0.0, -5000.0)
-        assert_reports_error(self, op, r"Kolmogorov Drift \(c\) must be in \[-1000, 1000\] m/s",
-                             state)
+        assert_reports_error(self, op, r"Kolmogorov Drift \(c\) \(Physics Properties › Plume › "
+                             r"Flames › Noise\) must be in \[-1000, 1000\] m/s per axis "
+                             r"\(got \(0\.0, 0\.0, -5000\.0\)\)", state)
         f.kolmogorov_drift = (0.0, 0.0, 0.5)
         f.flow_noise_frequency = -1.0
-        assert_reports_error(self, op, r"Flow Noise Frequency \(ν\) must be in \[0, 1000\] Hz",
+        assert_reports_error(self, op, r"Flow Noise Frequency \(ν\) \(Physics Properties › "
+                             r"Plume › Flames › Noise\) must be in \[0, 1000\] Hz \(got -1\)",
                              state)
         f.flow_noise_frequency = 3.0
         src.plume.flame.profile = 'CUSTOM'

@@ -227,10 +227,13 @@ class FlowGraphFireTest(SynthesisCases, unittest.TestCase):
         select([self.calm, self.windy], self.windy)
         g = self.windy.plume.domain.flowgraph
         g.block_size = 0
-        assert_reports_error(self, op, r"block_size \(B\) must be >= 1", self.state)
+        assert_reports_error(self, op, r"Block Size \(B\) \(Physics Properties › Plume › "
+                             r"Flow-Graph Fire\) must be >= 1 \(got 0\)", self.state)
         g.block_size = 8
         g.epsilon = 1e9
-        assert_reports_error(self, op, r"epsilon.*\[", self.state)
+        assert_reports_error(self, op, r"Threshold \(ε\) \(Physics Properties › Plume › "
+                             r"Flow-Graph Fire\) must be in \[a, b\] = \[.*\(got 1000000000\)",
+                             self.state)
         g.epsilon = 0.0
         # A truncated pathline file, then a missing one.
         path = os.path.join(self.folder(self.calm), "pathlines.bin")

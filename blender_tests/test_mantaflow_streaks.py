@@ -217,13 +217,14 @@ class MantaflowStreaksTest(unittest.TestCase):
         # A new domain's cache is a Replay cache: Blender itself writes the frame it is shown
         # (frame 1 here), so the first missing file is a later one.
         self.expect_error(dom, "'Unbaked Gas' is not baked over frames 1-20", "is missing",
-                          "Bake Data")
+                          "Physics Properties › Fluid › Settings › Bake Data")
 
     def test_cache_format_not_openvdb(self):
         gas = unbaked_gas_domain(os.path.join(self.tmp, "uni"), "Uni Gas")
         fluid(gas).domain_settings.cache_data_format = 'UNI'
         dom = plume_domain("UniFormat", self.tmp, gas)
-        self.expect_error(dom, "cache_data_format is UNI", "OpenVDB")
+        self.expect_error(dom, "its volumes are cached as Uni Cache", "set Physics Properties › "
+                          "Fluid › Cache › Format Volumes to OpenVDB")
 
     def test_toon_smoke_follows_the_mantaflow_smoke(self):
         """Toon smoke from a Mantaflow cache. With streak surfaces off the bake only
@@ -280,7 +281,8 @@ class MantaflowStreaksTest(unittest.TestCase):
         adaptive = unbaked_gas_domain(os.path.join(self.tmp, "adaptive"), "Adaptive Gas")
         fluid(adaptive).domain_settings.use_adaptive_domain = True
         dom = plume_domain("Adaptive", self.tmp, adaptive)
-        self.expect_error(dom, "Adaptive Domain off")
+        self.expect_error(dom, "its Adaptive Domain is on", "turn Physics Properties › Fluid › "
+                          "Settings › Adaptive Domain off")
 
 
 if __name__ == "__main__":

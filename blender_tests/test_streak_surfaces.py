@@ -299,7 +299,8 @@ class StreakSurfacesTest(unittest.TestCase):
         d = bpy.data.objects["Domain"].plume.domain
         d.streak_threshold = -1.0
         try:
-            self.assert_error(r"streak_threshold \(h0\) must be >= 0")
+            self.assert_error(r"Threshold \(h0\) \(Physics Properties › Plume › Streak "
+                              r"Surfaces\) must be >= 0 \(0 = the mean .*; got -1(\.0)?\)")
         finally:
             d.streak_threshold = 0.0
 
@@ -307,7 +308,9 @@ class StreakSurfacesTest(unittest.TestCase):
         d = bpy.data.objects["Domain"].plume.domain
         d.density_k_u = -1
         try:
-            self.assert_error(r"density_k_u must be >= 0")
+            self.assert_error(r"Sampling u \(k_u\) \(Physics Properties › Plume › Streak "
+                              r"Surfaces\) must be >= 0 \(samples between particles, §3\.4; "
+                              r"got -1\)")
         finally:
             d.density_k_u = 4
 

@@ -1,6 +1,6 @@
 """What Blender shows an artist about Plume's settings and buttons: every tooltip (property,
-enum item, operator, panel) is written in artist words — none empty, none citing a file. Where
-help opens is test_help.py's.
+enum item, operator, panel) is written in artist words — none empty, none citing a file, none
+naming a setting by its Python name. Where help opens is test_help.py's.
 
 Run: BLENDER_USER_SCRIPTS=... blender -b --factory-startup --python-exit-code 1 \
          --python blender_tests/test_tooltips.py
@@ -17,8 +17,46 @@ import bpy  # noqa: E402
 
 from helpers import enable_addon, run  # noqa: E402
 
-# A file name in a tooltip: "[Smoke Surfaces]", "notes.md", ...
-FILE_NAME = re.compile(r"\b[\w-]+\.(txt|md|pdf|py|json|toml)\b")
+# A file name in a tooltip: "paper.txt", "notes.md", "smoke_script.h", ...
+FILE_NAME = re.compile(r"\b[\w-]+\.(txt|md|pdf|py|json|toml|h|cpp)\b")
+SNAKE = re.compile(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b")
+CAPS = re.compile(r"\b[A-Z][A-Z0-9]*(?:_[A-Z0-9]+)*\b")
+#: What an artist never types: Python paths of Blender data and Plume's operators.
+API = re.compile(r"\b(bpy|scene|obj|context|ob|self)\.[a-z_]|\bplume\.[a-z_]+\(|\.plume\b")
+
+
+def python_names():
+    """(snake_case names, enum identifiers) an artist's text must not show: every Plume
+    setting's and operator option's Python name, Mantaflow's (Blender's Fluid settings; the
+    tooltips compare with them) and the render engines'; each enum item's identifier in capitals
+    unless it is also its shown name ('BFECC')."""
+    groups, operators, _panels = plume_classes()
+    rnas = [cls.bl_rna for cls in groups]
+    for cls in operators:
+        module, name = cls.bl_idname.split(".")
+        rnas.append(getattr(getattr(bpy.ops, module), name).get_rna_type())
+    rnas += [bpy.types.FluidDomainSettings.bl_rna, bpy.types.FluidFlowSettings.bl_rna,
+             bpy.types.FluidEffectorSettings.bl_rna, bpy.types.RenderSettings.bl_rna]
+    snake, enums = set(), set()
+    for rna in rnas:
+        for prop in rna.properties:
+            if "_" in prop.identifier:
+                snake.add(prop.identifier)
+            if prop.type == 'ENUM':
+                enums |= {i.identifier for i in prop.enum_items if i.identifier != i.name}
+    enums |= {"CYCLES", "BLENDER_EEVEE", "BLENDER_EEVEE_NEXT", "BLENDER_WORKBENCH"}
+    snake |= {cls.bl_idname.split(".")[1] for cls in operators if "_" in cls.bl_idname}
+    return snake, enums
+
+
+def python_words(text, names):
+    """The Python names, API paths and enum identifiers in an artist's text (names: from
+    python_names())."""
+    snake, enums = names
+    found = [w for w in SNAKE.findall(text) if w in snake]
+    found += [w for w in CAPS.findall(text) if w in enums]
+    found += [m.group(0) for m in API.finditer(text)]
+    return found
 
 
 def plume_classes():
@@ -73,6 +111,17 @@ class TooltipTest(unittest.TestCase):
         bad = [f"{where}: {text!r}" for where, text in self.all_texts()
                if ".txt" in text or FILE_NAME.search(text)]
         self.assertEqual(bad, [], f"{len(bad)} tooltips cite a file:\n" + "\n".join(bad))
+
+    def test_no_python_names(self):
+        """No tooltip names a setting by its Python name (Plume's or Mantaflow's), an API path
+        ("bpy.", "scene.") or an enum item by its identifier ('IMAGE'): an artist sees labels."""
+        names = python_names()
+        self.assertIn("depth_threshold", names[0])
+        self.assertIn("use_adaptive_domain", names[0])  # Mantaflow's
+        self.assertIn("BLENDER_EEVEE", names[1])
+        bad = [f"{where}: {python_words(text, names)}: {text!r}"
+               for where, text in self.all_texts() if python_words(text, names)]
+        self.assertEqual(bad, [], f"{len(bad)} tooltips name Python:\n" + "\n".join(bad))
 
     def test_no_bare_section_sign(self):
         """A paper's section may stay in brackets after words, never as a tooltip's start."""

@@ -291,26 +291,34 @@ class ToonSmokeTest(unittest.TestCase):
         self.assertEqual(bpy.ops.plume.bake(), {'FINISHED'})
         select_only(dom)
         d.toon.depth_threshold = -0.1
-        assert_reports_error(self, op, r"depth_threshold \(γ\) must be >= 0",
+        assert_reports_error(self, op, r"Depth Threshold \(γ\) \(Physics Properties › Plume › "
+                             r"Toon Smoke\) must be >= 0, .* \(§2\.2; got -0\.1\)",
                              lambda: state(self.folder))
         d.toon.depth_threshold = GAMMA
         d.toon.stencil = 'IMAGE'
         d.toon.stencil_image = os.path.join(self.tmp, "no_such_stencil.png")
-        assert_reports_error(self, op, "stencil_image .* does not exist",
+        assert_reports_error(self, op, r"Stencil Image \(Physics Properties › Plume › Toon "
+                             r"Smoke\) .*no_such_stencil\.png does not exist: pick an image file",
                              lambda: state(self.folder))
         d.toon.stencil_image = ""
-        assert_reports_error(self, op, "no stencil_image is set", lambda: state(self.folder))
+        assert_reports_error(self, op, r"Stencil is Image but Stencil Image \(Physics "
+                             r"Properties › Plume › Toon Smoke\) is empty",
+                             lambda: state(self.folder))
         d.toon.stencil = 'CIRCLE'
         d.toon.birth_density = 0.01
-        assert_reports_error(self, op, "death_density", lambda: state(self.folder))
+        assert_reports_error(self, op, r"Death Density \(ρ_death\) \(Physics Properties › "
+                             r"Plume › Toon Smoke\) must be >= 0 and below Birth Density "
+                             r"\(ρ_birth\) \(got 0\.05 and 0\.01\)", lambda: state(self.folder))
         d.toon.birth_density = 0.3
         d.toon.birth_spacing = -0.5
-        assert_reports_error(self, op, r"birth_spacing must be in \[0, 10\] stencil sizes",
+        assert_reports_error(self, op, r"Birth Spacing \(σ\) \(Physics Properties › Plume › "
+                             r"Toon Smoke\) must be in \[0, 10\] stencil sizes.*\(got -0\.5\)",
                              lambda: state(self.folder))
         d.toon.birth_spacing = 0.5
         cam = bpy.context.scene.camera
         bpy.context.scene.camera = None
-        assert_reports_error(self, op, "has no camera.*add a camera \\(Add › Camera\\)",
+        assert_reports_error(self, op, r"has no camera.*add a camera \(Add › Camera\) and make "
+                             r"it the scene's camera \(Scene Properties › Scene › Camera\)",
                              lambda: state(self.folder))
         bpy.context.scene.camera = cam
         self.assertEqual(op(), {'FINISHED'})  # and with good input it builds

@@ -56,19 +56,29 @@ def viewport(window):
     return dict(window=window, screen=window.screen, area=area, region=region)
 
 
+#: Panels open_panels() opened: {class: its own bl_options}, restored for the next shot.
+_OPENED = {}
+
+
 def open_panels(names):
     """Panels an artist opened by a click on their header: registered again without
-    DEFAULT_CLOSED (panel states are not in Blender's Python API), so they draw open. The
-    add-on's panels after the first one are registered again too, so the order stays."""
+    DEFAULT_CLOSED (panel states are not in Blender's Python API), so they draw open; every
+    other panel a previous shot opened is closed again. The add-on's panels after the first one
+    changed are registered again too, so the order stays."""
     from plume import ui
-    closed = [c for c in ui.classes if c.__name__ in names and 'DEFAULT_CLOSED' in c.bl_options]
-    if not closed:
+    wanted = {}
+    for cls in ui.classes:
+        own = _OPENED.get(cls, set(getattr(cls, "bl_options", ())))
+        wanted[cls] = own - {'DEFAULT_CLOSED'} if cls.__name__ in names else own
+    changed = [c for c in ui.classes if set(getattr(c, "bl_options", ())) != wanted[c]]
+    if not changed:
         return
-    later = list(ui.classes[ui.classes.index(closed[0]):])
+    later = list(ui.classes[ui.classes.index(changed[0]):])
     for cls in reversed(later):
         bpy.utils.unregister_class(cls)
-    for cls in closed:
-        cls.bl_options = set(cls.bl_options) - {'DEFAULT_CLOSED'}
+    for cls in changed:
+        _OPENED.setdefault(cls, set(getattr(cls, "bl_options", ())))
+        cls.bl_options = wanted[cls]
     for cls in later:
         bpy.utils.register_class(cls)
 

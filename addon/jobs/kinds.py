@@ -105,7 +105,7 @@ def surfaces(spec, job):
     job.check_cancel()
     plans = ss.plan_surfaces(native, groups, h0)
     if not plans:
-        raise BakeError(f"Plume: threshold h0 = {h0} joins no two streaklines: raise "
+        raise BakeError(f"Plume: Threshold (h0) {h0:g} joins no two streaklines: raise "
                         "Threshold (h0) in Physics Properties › Plume › Streak Surfaces (0 = the "
                         "default mean of h)")
     anims = []

@@ -21,6 +21,13 @@ from ..snapshot import NOT_A_DOMAIN, active_domain, cache_folder_of, take_snapsh
 from .. import setting_paths
 
 
+def cache_setting(domain_or_directory):
+    """A domain's cache folder as a message names it: its Cache Directory setting, where."""
+    directory = (domain_or_directory if isinstance(domain_or_directory, str)
+                 else domain_or_directory.plume.domain.cache_directory)
+    return f"the Cache Directory '{directory}' ({setting_paths.TAB} › Cache)"
+
+
 def domain_key(name):
     """The registry key of a domain: one job (bake, surfaces, toon, graph, synthesis) at a time."""
     return ("domain", name)
@@ -49,8 +56,7 @@ class BakeJob(JobRunner):
         self.objects = (snap.domain_name,)
         self.unburnt_fuel = fuel_warning.unburnt_fuel(snap)  # a warning: the bake runs
         self.claim(domain_key(snap.domain_name))
-        self.lock_folder(snap.cache_folder, f"the Cache Directory '{snap.cache_directory}' "
-                                             "(Physics Properties › Plume › Cache)")
+        self.lock_folder(snap.cache_folder, cache_setting(snap.cache_directory))
         self.snapshot, self.folder = snap, snap.cache_folder
         self.set_progress(0, snap.frame_count, "frame")
 

@@ -10,6 +10,7 @@ from bpy.props import EnumProperty
 from .. import flame_meter, flame_presets, flames
 from ..native import _native
 from ..snapshot import flames_cache_folder
+from ..ui_words import ADD_CAMERA, FLAMES, ui
 
 #: Frames of the bake Auto Exposure reads (evenly spaced): the flames' level moves little
 #: between neighbouring frames, and each read is one VDB grid.
@@ -77,12 +78,11 @@ class PLUME_OT_flames_auto_exposure(bpy.types.Operator):
         f = scene.plume_flames
         if f.frames_baked < 1:
             self.report({'ERROR'}, "Plume: Auto Exposure meters baked flames: bake them first "
-                                   "(Physics › Plume › Flames › Bake Flames)")
+                                   f"({FLAMES} › Bake Flames)")
             return {'CANCELLED'}
         if scene.camera is None:
             self.report({'ERROR'}, "Plume: Auto Exposure meters the flames as the camera sees "
-                                   "them: add a camera (Add › Camera) and make it the scene's "
-                                   "(Scene Properties › Scene › Camera)")
+                                   f"them: {ADD_CAMERA}")
             return {'CANCELLED'}
         forward = scene.camera.matrix_world.to_3x3().col[2] * -1.0
         try:
@@ -90,23 +90,34 @@ class PLUME_OT_flames_auto_exposure(bpy.types.Operator):
                                     int(f.frames_baked), tuple(forward))
         except (RuntimeError, OSError, ValueError) as e:
             self.report({'ERROR'}, f"Plume: Auto Exposure cannot read the flames' cache "
-                                   f"(Flames › Cache '{f.cache_directory}'): {e}")
+                                   f"'{f.cache_directory}' ({ui('flames', 'cache_directory')}): "
+                                   f"{e}; bake the flames again")
             return {'CANCELLED'}
         stops = flame_meter.exposure_stops(levels)
         if stops is None:
-            self.report({'ERROR'}, "Plume: Auto Exposure found no lit flame in the baked frames "
-                                   "(is each Flame Source's Intensity far below 0 stops?)")
+            self.report({'ERROR'}, "Plume: Auto Exposure found no lit flame in the baked frames: "
+                                   "is each Flame Source's "
+                                   f"{ui('flame_source', 'stops')} far below 0 stops?")
             return {'CANCELLED'}
         scene.cycles.film_exposure = 2.0 ** stops
         text = (f"Plume: Auto Exposure: film exposure {2.0 ** stops:.3g} ({stops:+.1f} stops; "
                 f"Render Properties › Film › Exposure), metered on {len(levels)} frames")
         if scene.render.engine != 'CYCLES':
-            text += (f". Film Exposure is Cycles'; in {scene.render.engine} use Color "
-                     f"Management › Exposure {stops:+.1f}")
+            text += (f". Film Exposure is Cycles' only; in {engine_name(scene)} set Render "
+                     f"Properties › Color Management › Exposure to {stops:+.1f}")
             self.report({'WARNING'}, text)
         else:
             self.report({'INFO'}, text)
         return {'FINISHED'}
+
+
+def engine_name(scene):
+    """The render engine as Render Properties › Render Engine shows it ("EEVEE")."""
+    engine = scene.render.engine
+    item = scene.render.bl_rna.properties["engine"].enum_items.get(engine)
+    if item is not None and item.name:
+        return item.name
+    return engine.replace("BLENDER_", "").replace("_NEXT", "").replace("_", " ").title()
 
 
 classes = (PLUME_OT_flame_preset, PLUME_OT_flames_auto_exposure)

@@ -18,6 +18,7 @@ from ..snapshot.flames import flames_snapshot
 from ..jobs.operator import JobOperator
 from ..jobs import JobRunner, folder_lock, registry
 from ..settings import BakeError
+from ..ui_words import FLAMES, in_ui_words, ui
 
 #: The registry key of the scene's flames bake (one at a time).
 FLAMES_KEY = ("flames",)
@@ -37,9 +38,9 @@ class FlamesJob(JobRunner):
         self.claim(FLAMES_KEY)
         snap = flames_snapshot(context)
         flames.validate_snapshot(snap)
-        self.lock_folder(snap.folder, "the flames' Cache folder "
+        self.lock_folder(snap.folder, "the flames' cache folder "
                                       f"'{context.scene.plume_flames.cache_directory}' "
-                                      "(Physics Properties › Plume › Flames)")
+                                      f"({ui('flames', 'cache_directory')})")
         self.objects = tuple(dict.fromkeys(src.name for src in snap.sources))
         self.snap, self.folder = snap, snap.folder
         self.set_progress(0, snap.frame_count, "frame")
@@ -82,7 +83,9 @@ class FlamesJob(JobRunner):
         return ('WARNING' if result.cancelled else 'INFO'), text
 
     def error_text(self, exc):
-        return f"Plume: flames bake failed: {exc}"
+        if isinstance(exc, BakeError):  # names the setting and what to do already
+            return str(exc)
+        return f"Plume: flames bake failed: {in_ui_words('flames', str(exc))}"
 
     def busy_text(self):
         return "Plume: flames are already baking"
@@ -148,14 +151,17 @@ class PLUME_OT_flames_bake_spines_keyframes(bpy.types.Operator):
             self.report({'ERROR'}, "Plume: flames are baking; wait for the bake to finish")
             return {'CANCELLED'}
         if f.frames_baked < 1:
-            self.report({'ERROR'}, "Plume: no flames are baked (press Bake Flames first)")
+            self.report({'ERROR'}, "Plume: no flames are baked: press Bake Flames first "
+                                   f"({FLAMES})")
             return {'CANCELLED'}
         first = int(f.frame_start)
         try:
             objects, keys = flame_spine_keys.bake(scene, flames_cache_folder(scene), first,
                                                   first + int(f.frames_baked) - 1)
         except (OSError, ValueError) as e:
-            self.report({'ERROR'}, f"Plume: the flames cache cannot be read: {e}")
+            self.report({'ERROR'}, "Plume: the flames' cache folder "
+                                   f"({ui('flames', 'cache_directory')}) cannot be read: {e}; "
+                                   "bake the flames again")
             return {'CANCELLED'}
         self.report({'INFO'}, f"Plume: {len(objects)} flame spines keyed ({keys:,} keys) in "
                               f"collection '{flame_spine_keys.COLLECTION_NAME}'")

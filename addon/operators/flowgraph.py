@@ -20,7 +20,8 @@ from ..snapshot import active_domain, cache_folder_of
 from ..snapshot.flowgraph import (fire_source, frame_inputs,  # noqa: F401  (scripts)
                                  graph_settings, source_transforms, state_domains,
                                  synthesis_settings)
-from .bake import domain_key
+from .bake import cache_setting, domain_key
+from ..ui_words import FLOWGRAPH, in_ui_words, label
 
 #: Image datablock showing the cost matrix (Figure 4) in the panel.
 IMAGE_PREFIX = "Plume Flow Graph "
@@ -61,10 +62,11 @@ class FlowGraphJob(JobRunner):
         self.states = flowgraph.open_states(
             _native, [(d.name, cache_folder_of(d)) for d in domains])
         self.folder = cache_folder_of(domain)
-        self.lock_folder(self.folder)
+        self.lock_folder(self.folder, cache_setting(domain))
         error = cache.check_writable(self.folder)
         if error is not None:
-            raise BakeError(f"Plume: cache folder {self.folder} is not writable ({error})")
+            raise BakeError(f"Plume: {cache_setting(domain)} is not writable ({self.folder}: "
+                            f"{error})")
         self.set_progress(0, 0, "reading the pathlines")  # until the cost matrix reports
 
     def job_spec(self):
@@ -124,7 +126,7 @@ class SynthesisJob(JobRunner):
         self.folder = folder = cache_folder_of(domain)
         self.objects = (domain.name,)
         self.claim(domain_key(domain.name), SYNTHESIS_KEY)
-        self.lock_folder(folder)
+        self.lock_folder(folder, cache_setting(domain))
         graph, states = flowgraph.load_graph(_native, folder, owner)
         settings = synthesis_settings(domain)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)
@@ -171,14 +173,19 @@ class SynthesisJob(JobRunner):
             frame, state = result.unreachable_target
             return 'WARNING', (f"{text}; from frame {frame} the keyed Target State {state} "
                                "could not be reached: the flow graph does not lead back to it "
-                               "from where the walk was. Build the graph with a smaller Block "
-                               "Size or a larger ε, or bake longer states")
+                               "from where the walk was. Build the graph with a smaller "
+                               f"{label('flowgraph', 'block_size')} or a larger "
+                               f"{label('flowgraph', 'epsilon')} ({FLOWGRAPH}), or bake longer "
+                               "states")
         return 'INFO', text
 
     def error_text(self, exc):
         if isinstance(exc, BakeError):
             return str(exc)
-        return f"Plume: fire synthesis: {exc}"
+        return f"Plume: fire synthesis: {in_ui_words('flowgraph', str(exc))}"
+
+    def refusal_text(self, exc):  # a ValueError of the core names the setting by its name
+        return self.error_text(exc)
 
     def busy_text(self):
         return f"Plume: fire synthesis of domain '{self.domain_name}' is running (Esc cancels it)"

@@ -28,8 +28,11 @@ class PLUME_OT_role_set(bpy.types.Operator):
             targets += [o for o in context.selected_objects
                         if o is not active and o.type == 'MESH']
         if self.role != 'NONE' and active.type != 'MESH':
-            self.report({'ERROR'}, f"Plume: '{active.name}' is a {active.type.lower()}; "
-                                   f"the {self.role.lower()} role needs a mesh object")
+            role = next(item[1] for item in ROLE_ITEMS if item[0] == self.role)
+            self.report({'ERROR'}, f"Plume: '{active.name}' is not a mesh (its type is "
+                                   f"{active.type.title()}); "
+                                   f"the {role} role needs a mesh object: select one (or add one, "
+                                   "Add › Mesh)")
             return {'CANCELLED'}
         for ob in targets:
             previous = ob.plume.role

@@ -18,10 +18,11 @@ from .. import sheet_render, surfaces_forecast
 from ..build import surfaces as build
 from ..jobs.operator import JobOperator
 from ..jobs import Forecast, JobRunner
+from .. import setting_paths
 from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of
 from ..snapshot.streaks import sheet_settings
-from .bake import domain_key
+from .bake import cache_setting, domain_key
 
 #: h per candidate group, cached in memory for the panel's live count (never computed in draw):
 #: domain name -> (key of the cache state, {group: GroupDistances})
@@ -109,7 +110,7 @@ class SurfacesJob(JobRunner):
         self.folder = cache_folder_of(domain)
         self.objects = (domain.name,)
         self.claim(domain_key(domain.name))
-        self.lock_folder(self.folder)
+        self.lock_folder(self.folder, cache_setting(domain))
         self.manifest = ss.streak_manifest(self.folder, domain.name)
         size = surfaces_forecast.shot_size(_native, self.folder, self.manifest)
         if size is not None:
@@ -153,9 +154,9 @@ class SurfacesJob(JobRunner):
     def refusal_text(self, exc):
         return self.error_text(exc)
 
-    def error_text(self, exc):
+    def error_text(self, exc):  # the settings named as their panel shows them
         if isinstance(exc, BakeError):
-            return str(exc)
+            return setting_paths.in_ui_words(str(exc))
         return f"Plume: surfaces of '{self.domain_name}': {exc}"
 
     def busy_text(self):
@@ -192,8 +193,8 @@ class PLUME_OT_surfaces_pick_threshold(bpy.types.Operator):
         domain.plume.domain.streak_threshold = h0
         h0 = domain.plume.domain.streak_threshold  # as stored (float32; the pick is one)
         surfaces, lines = ss.summary(_native, groups, h0)
-        self.report({'INFO'}, f"Plume: h0 = {h0:.4g} gives {surfaces} surfaces from {lines} "
-                              "streaklines")
+        self.report({'INFO'}, f"Plume: Threshold (h0) {h0:.4g} gives {surfaces} surfaces from "
+                              f"{lines} streaklines")
         return {'FINISHED'}
 
 

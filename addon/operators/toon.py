@@ -18,7 +18,8 @@ from ..settings import BakeError
 from ..snapshot import active_domain, cache_folder_of, emitter_snapshots
 from ..snapshot.toon import toon_settings
 from ..toon_sources import ToonSourceCells
-from .bake import domain_key
+from ..ui_words import ADD_CAMERA
+from .bake import cache_setting, domain_key
 
 
 class ToonJob(JobRunner):
@@ -41,12 +42,10 @@ class ToonJob(JobRunner):
         toon.check_bake(settings, manifest, domain.name)
         if scene.camera is None:
             raise BakeError(f"Plume: scene '{scene.name}' has no camera: the billboards face "
-                            "the scene camera and the outlines need its Depth pass: add a camera "
-                            "(Add › Camera) and make it the scene's (Scene Properties › Scene "
-                            "› Camera)")
+                            f"the scene camera and the outlines need its Depth pass: {ADD_CAMERA}")
         self.objects = (domain.name, scene.camera.name)  # the billboards face the camera
         self.claim(domain_key(domain.name))
-        self.lock_folder(folder)
+        self.lock_folder(folder, cache_setting(domain))
         # The Sources over the bake's frames: their matrices per frame when they move, their
         # keyed Density / Emit Particles per frame (§2.1 emission follows both).
         frame_start, last = int(manifest["frame_start"]), int(manifest["last_complete_frame"])

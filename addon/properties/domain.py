@@ -63,16 +63,17 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
         name="Adaptive Domain", default=False,
         description="Simulate only the box around the smoke, heat and fuel, grown and shrunk every "
                     "step; outside it the air is at rest and at ambient temperature. The cache "
-                    "stays in place (Mantaflow: Adaptive Domain, use_adaptive_domain)")
+                    "stays in place (as Mantaflow's Adaptive Domain)")
     adaptive_margin: IntProperty(
         name="Margin", default=6, min=RANGES["adaptive_margin"][0], max=RANGES["adaptive_margin"][1],
         description="Cells of air kept around the smoke in the adaptive box; more follows the "
-                    "air the plume sets moving more closely (Mantaflow: Margin, adapt_margin)")
+                    "air the plume sets moving more closely (Mantaflow's Adaptive Domain › "
+                    "Margin)")
     adaptive_threshold: FloatProperty(
         name="Threshold", default=0.005, min=RANGES["adaptive_threshold"][0],
         max=RANGES["adaptive_threshold"][1], precision=4,
         description="Density, heat |T - T_amb|, fuel or soot above which a cell counts as smoke "
-                    "for the adaptive box (Mantaflow: Threshold, adapt_threshold)")
+                    "for the adaptive box (Mantaflow's Adaptive Domain › Threshold)")
     frame_start: IntProperty(name="Start", default=1, description="First frame of the bake")
     frame_end: IntProperty(name="End", default=50, description="Last frame of the bake")
     time_scale: FloatProperty(
@@ -104,8 +105,7 @@ class PlumeDomainSettings(bpy.types.PropertyGroup):
                                         "density 1 with the acceleration g"),
                ('MANTAFLOW', "Mantaflow", "α and β as in Mantaflow's Density and Heat: its "
                                           "buoyancy is g α ρ / L, L the domain's longest side "
-                                          "in metres (smoke_script.h: alpha / domain size), so "
-                                          "Plume bakes with α / L and β / L")))
+                                          "in metres, so Plume bakes with α / L and β / L")))
     ambient_temperature: FloatProperty(
         name="Ambient Temperature", default=0.0, soft_min=-10.0, soft_max=10.0,
         description="T_amb: temperature of the surrounding air (T_0 of the fire paper)")

@@ -107,7 +107,7 @@ class PlumeToonSettings(bpy.types.PropertyGroup):
                           description="Rendering primitive of each particle (Figure 3)")
     stencil_image: StringProperty(
         name="Stencil Image", subtype='FILE_PATH', default="",
-        description="Image file of the IMAGE stencil; its alpha channel is the cut-out")
+        description="Image file of the Image stencil; its alpha channel is the cut-out")
     depth_threshold: FloatProperty(
         name="Depth Threshold (γ)", default=0.15, soft_min=0.0, soft_max=10.0, precision=4,
         description="γ: a pixel is outlined when any of its four one-sided depth differences "

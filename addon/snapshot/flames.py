@@ -12,6 +12,12 @@ from .. import flame_placement as place
 from .. import flames
 from ..settings import BakeError
 from .scene import cache_folder_of, flames_cache_folder, mesh_arrays
+from ..ui_words import FLAME_SOURCE, ui
+
+
+def source_at(name):
+    """A Flame Source as a message names it: the object and the panel of its settings."""
+    return f"Plume: Flame Source '{name}' ({FLAME_SOURCE})"
 
 
 def flame_sources(scene):
@@ -31,11 +37,11 @@ def image_pixels(image, owner, setting):
     if image.source == 'FILE' and image.packed_file is None:
         path = bpy.path.abspath(image.filepath)
         if not os.path.isfile(path):
-            raise BakeError(f"Plume: Flame Source '{owner}': {setting} '{image.name}' cannot be "
+            raise BakeError(f"{source_at(owner)}: {setting} '{image.name}' cannot be "
                             f"read: no file {path}")
     w, h = image.size
     if w == 0 or h == 0 or not image.has_data and not image.pixels:
-        raise BakeError(f"Plume: Flame Source '{owner}': {setting} '{image.name}' cannot be "
+        raise BakeError(f"{source_at(owner)}: {setting} '{image.name}' cannot be "
                         f"read ({bpy.path.abspath(image.filepath) or 'no file'})")
     px = np.empty(w * h * image.channels, np.float32)
     image.pixels.foreach_get(px)
@@ -49,14 +55,14 @@ def color_image(image, owner):
     """§5.1: the Colour Image as (h, w, 3) scene-linear float32; BakeError naming the setting
     when it is empty, unreadable or not RGB."""
     if image is None:
-        raise BakeError(f"Plume: Flame Source '{owner}': Colour is Colour Image but Colour Image "
+        raise BakeError(f"{source_at(owner)}: Colour is Colour Image but Colour Image "
                         "is empty: pick an RGB image, or set Colour to Profile Colours")
     px = image_pixels(image, owner, "Colour Image")
     # Blender gives every image 4 channels in memory; the file's own are in its bit depth
     # (8 per channel, 32 for float): a greyscale file holds no colour.
     channels = image.depth // (32 if image.is_float else 8)
     if min(image.channels, channels) < 3:
-        raise BakeError(f"Plume: Flame Source '{owner}': Colour Image '{image.name}' must be RGB "
+        raise BakeError(f"{source_at(owner)}: Colour Image '{image.name}' must be RGB "
                         f"or RGBA (it has {min(image.channels, channels)} channel"
                         f"{'s' if min(image.channels, channels) != 1 else ''}: greyscale)")
     rgb = px[..., :3]
@@ -70,11 +76,11 @@ def curve_profile(ob, owner):
     """(k, 2) (radius, height) of the first spline of a curve object, base first (§4.4): local X
     the radius, the longer of local Y and Z the height."""
     if ob is None:
-        raise BakeError(f"Plume: Flame Source '{owner}': Profile is Custom Curve but Profile "
+        raise BakeError(f"{source_at(owner)}: Profile is Custom Curve but Profile "
                         "Curve is empty: pick a curve object drawn from the base to the tip")
     if not ob.data.splines or len(ob.data.splines[0].points) + len(
             ob.data.splines[0].bezier_points) < 2:
-        raise BakeError(f"Plume: Flame Source '{owner}': Profile Curve '{ob.name}' needs a "
+        raise BakeError(f"{source_at(owner)}: Profile Curve '{ob.name}' needs a "
                         "spline of at least 2 points")
     sp = ob.data.splines[0]
     pts = ([p.co[:3] for p in sp.bezier_points] if sp.type == 'BEZIER'
@@ -109,7 +115,7 @@ def source_input(ob, depsgraph, seed, settings, fps):
     fl = ob.plume.flame
     lo, hi = flames.FLAMES_PER_SOURCE_RANGE
     if not lo <= fl.flames <= hi:
-        raise BakeError(f"Plume: Flame Source '{ob.name}': Flames must be in [{lo}, {hi}] "
+        raise BakeError(f"{source_at(ob.name)}: Flames must be in [{lo}, {hi}] "
                         f"(got {fl.flames})")
     src = flames.FlameSourceInput(name=ob.name, profile=fl.profile)
     if fl.profile == 'CUSTOM':
@@ -121,7 +127,8 @@ def source_input(ob, depsgraph, seed, settings, fps):
     order = place.canonical_order(tris)
     tris = tris[order]
     if len(tris) == 0:
-        raise BakeError(f"Plume: Flame Source '{ob.name}' has no faces to burn on")
+        raise BakeError(f"Plume: Flame Source '{ob.name}' has no faces to burn on: make a mesh "
+                        "with faces the Flame Source")
     m = np.array(ob.matrix_world, np.float64)
     world = verts.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
     faces, bary = place.place_flames(world, tris, int(fl.flames), seed)
@@ -142,11 +149,13 @@ def source_input(ob, depsgraph, seed, settings, fps):
 def _maps(ob, fl, depsgraph, faces, bary, src, order):
     """§6.2: activation, duration, intensity, diameter and height maps on the UVs."""
     if fl.activation_map is None:
-        raise BakeError(f"Plume: Flame Source '{ob.name}': Spread is Maps but Activation Map "
-                        "is empty")
+        raise BakeError(f"{source_at(ob.name)}: Spread is Maps but Activation Map "
+                        "is empty: pick the image whose brightness gives each point's ignition time")
     corner_uvs = _corner_uvs(ob, depsgraph)
     if corner_uvs is None:
-        raise BakeError(f"Plume: Flame Source '{ob.name}' has no UV map for its spread maps")
+        raise BakeError(f"Plume: Flame Source '{ob.name}' has no UV map for its spread maps: "
+                        "add one (Object Data Properties › UV Maps › +), or set Spread to "
+                        f"Always Burning ({FLAME_SOURCE})")
     uvs = place.interpolate(corner_uvs[order], faces, bary)
 
     def sample(image, setting):
@@ -167,7 +176,7 @@ def _maps(ob, fl, depsgraph, faces, bary, src, order):
 def _spread_model(ob, fl, settings, world_corners, faces, bary, src):
     """§6.2 eq. 7 from the Ignition object (or the source's origin)."""
     if not (fl.spread_temperature > 0.0 and fl.spread_thickness > 0.0):
-        raise BakeError(f"Plume: Flame Source '{ob.name}': Flame Temperature (T_f) and Thermal "
+        raise BakeError(f"{source_at(ob.name)}: Flame Temperature (T_f) and Thermal "
                         "Thickness (L) of eq. 7 must be > 0")
     origin = (fl.ignition or ob).matrix_world.translation
     points = place.interpolate(world_corners, faces, bary)
@@ -218,7 +227,8 @@ def flames_snapshot(context):
     if not objs:
         raise BakeError(flames.NO_SOURCE)
     if f.frame_end < f.frame_start:
-        raise BakeError(f"Plume: Flames: End ({f.frame_end}) must be >= Start ({f.frame_start})")
+        raise BakeError(f"Plume: Flames: {ui('flames', 'frame_end')} must be >= Start (got "
+                        f"{f.frame_start} to {f.frame_end})")
     fps = scene.render.fps / scene.render.fps_base
     wind_domain = None
     if f.wind_domain is not None:

@@ -6,6 +6,7 @@ import numpy as np
 
 from .. import flowgraph
 from ..settings import BakeError, PathlineSettings
+from ..ui_words import ui
 from .scene import from_properties
 
 
@@ -82,9 +83,9 @@ def fire_source(domain, owner):
     if ob is None:
         return None
     if ob.type != 'MESH':
-        raise BakeError(f"Plume: {owner}: Fire Source '{ob.name}' must be a mesh (its type is "
-                        f"{ob.type}): choose a mesh object, the fire is attached to it, or clear "
-                        "the setting")
+        raise BakeError(f"Plume: {owner}: {ui('flowgraph', 'fire_source')} '{ob.name}' must be "
+                        f"a mesh (its type is {ob.type.title()}): choose a mesh object, the "
+                        "fire is attached to it, or clear the setting")
     return ob
 
 

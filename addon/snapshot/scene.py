@@ -26,7 +26,8 @@ def active_domain(context):
     if obj is None or getattr(obj, "plume", None) is None or obj.plume.role != 'DOMAIN':
         raise BakeError(NOT_A_DOMAIN)
     if obj.type != 'MESH':
-        raise BakeError(f"Plume: domain '{obj.name}' must be a mesh object (got {obj.type})")
+        raise BakeError(f"Plume: domain '{obj.name}' must be a mesh object (its type is "
+                        f"{obj.type.title()}): make a box mesh the domain")
     return obj
 
 
@@ -200,7 +201,7 @@ def point_source_vertices(context, objs, snaps, frame_start):
     for mesh_obj, snap in picked:
         if mesh_obj.type != 'MESH':  # a script can bypass the property's poll
             raise BakeError(f"Plume: source '{snap.name}': point_source_mesh '{mesh_obj.name}' "
-                            f"must be a mesh object (got {mesh_obj.type})")
+                            f"must be a mesh object (its type is {mesh_obj.type.title()})")
     if not picked:
         return
     scene = context.scene

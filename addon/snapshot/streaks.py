@@ -16,8 +16,8 @@ def sheet_settings(d):
     for name in ("density_k_u", "density_k_v"):
         k = getattr(d, name)
         if k < 0:
-            raise BakeError(f"Plume: {name} must be >= 0 (samples between particles, §3.4; "
-                            f"got {k})")
+            raise BakeError(f"Plume: domain '{d.id_data.name}': {name} must be >= 0 (samples "
+                            f"between particles, §3.4; got {k})")
     return {"k_u": int(d.density_k_u), "k_v": int(d.density_k_v), "falloff": d.sheet_falloff,
             "color": tuple(d.sheet_color), "brightness": float(d.sheet_brightness),
             "opacity": float(d.sheet_opacity), "shading": d.sheet_shading}
