@@ -19,6 +19,11 @@ class Shot(NamedTuple):
     image: str                   # file name in the recipe's images/ folder, ui_*.png
     editor: str = 'PROPERTIES'   # the editor maximized for the picture: PROPERTIES or VIEW_3D
     tab: str = 'PHYSICS'         # the Properties tab shown (ignored for VIEW_3D)
+    #: Panels (their class names, e.g. "PHYSICS_PT_plume_combustion") shown open in the picture
+    #: while the tab's other closable Plume panels are shown closed; () leaves every panel as
+    #: Blender draws it (the screenshot runner sets this, an artist clicks the headers).
+    open_panels: tuple = ()
+    scroll: int = 0              # pixels the editor is scrolled down, to a panel's lower part
 
 
 def new_file():

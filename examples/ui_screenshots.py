@@ -24,6 +24,8 @@ EXAMPLES = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, EXAMPLES)
 #: Timer steps (0.3 s) given to Blender to draw an editor before it is saved.
 SETTLE_STEPS = 3
+#: Pixels Blender's view2d.scroll_down moves per call, whatever its deltay (3.4.1, measured).
+SCROLL_STEP = 40
 
 
 def recipes(names):
@@ -74,6 +76,67 @@ def show(window, shot):
     return area
 
 
+#: The domain's Plume panels' own bl_options, while set_panels_open has changed them.
+PANEL_OPTIONS = {}
+
+
+def domain_panels():
+    """The classes of the domain's Plume panels (Properties › Physics › Plume's sub-panels of a
+    Domain), in the order the add-on registers them, which is the order they are drawn in."""
+    from plume.ui import panels
+    return [c for c in panels.classes if issubclass(c, panels.PlumeDomainPanel)]
+
+
+def register_again(options_of):
+    """Registers every domain panel again, in the add-on's order (a panel registered again is
+    drawn after the others), each with the bl_options options_of(class, its own) gives."""
+    classes = domain_panels()
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
+    for cls in classes:
+        own = PANEL_OPTIONS.setdefault(cls.__name__, set(getattr(cls, "bl_options", set())))
+        cls.bl_options = options_of(cls, own)
+        bpy.utils.register_class(cls)
+
+
+def set_panels_open(open_panels):
+    """The domain panels named in `open_panels` drawn open and the others closed, in a
+    Properties editor that draws them for the first time (Blender 3.4 has no Python setting for
+    a panel's open state: a panel takes DEFAULT_CLOSED or not when an editor first draws it).
+    restore_panels() undoes it."""
+    register_again(lambda cls, own: (own - {'DEFAULT_CLOSED'} if cls.__name__ in open_panels
+                                     else own | {'DEFAULT_CLOSED'}))
+
+
+def restore_panels():
+    """The domain panels' own bl_options again, so that later recipes' editors draw them as an
+    artist's do."""
+    if PANEL_OPTIONS:
+        register_again(lambda cls, own: own)
+        PANEL_OPTIONS.clear()
+
+
+def fresh_properties(window, open_panels):
+    """A new Properties editor, maximized, showing the panels `open_panels` open and the other
+    closable Plume panels closed: the largest 3D Viewport is split and its new half (which was
+    never a Properties editor, so it draws every panel for the first time) becomes one."""
+    screen = window.screen
+    if len(screen.areas) == 1:
+        with bpy.context.temp_override(window=window, area=screen.areas[0]):
+            bpy.ops.screen.back_to_previous()
+        screen = window.screen
+    set_panels_open(open_panels)
+    view3d = max((a for a in screen.areas if a.type == 'VIEW_3D'),
+                 key=lambda a: a.width * a.height)
+    before = set(a.as_pointer() for a in screen.areas)
+    with bpy.context.temp_override(window=window, area=view3d):
+        bpy.ops.screen.area_split(direction='VERTICAL', factor=0.5)
+    area = next(a for a in screen.areas if a.as_pointer() not in before)
+    area.type = 'PROPERTIES'
+    with bpy.context.temp_override(window=window, area=area):
+        bpy.ops.screen.screen_full_area()
+
+
 def main():
     args = sys.argv[sys.argv.index("--") + 1:]
     out_root, names = os.path.abspath(args[0]), args[1:]
@@ -108,7 +171,16 @@ def main():
                 if state["shot"] is None:  # a file was read: its screen is drawn first
                     return 0.3
                 state["settle"] = 0
+            if state["settle"] == 0:
+                window.cursor_warp(0, 0)  # no tooltip of whatever the pointer rests on
+                if state["shot"].open_panels:
+                    fresh_properties(window, state["shot"].open_panels)
             area = show(window, state["shot"])
+            if state["settle"] == 1 and state["shot"].scroll:  # drawn once: its height is known
+                region = next(r for r in area.regions if r.type == 'WINDOW')
+                with bpy.context.temp_override(window=window, area=area, region=region):
+                    for _ in range(state["shot"].scroll // SCROLL_STEP):  # a step per call
+                        bpy.ops.view2d.scroll_down(deltax=0, deltay=SCROLL_STEP)
             state["settle"] += 1
             if state["settle"] < SETTLE_STEPS:
                 return 0.3
@@ -118,6 +190,7 @@ def main():
             with bpy.context.temp_override(window=window, area=area, region=region):
                 bpy.ops.screen.screenshot_area(filepath=path)
             print(f"ui_screenshots: {path} (Blender {bpy.app.version_string})", flush=True)
+            restore_panels()
             state["shot"] = None
             return 0.1
         except Exception:
