@@ -2,7 +2,7 @@
 (`examples/flames/recipe_candle.py`, which the screenshots run too): a new General scene without
 its cube, the wax and wick cylinders, the wick made a Flame Source with its defaults, Bake Flames
 over frames 1-48, the camera at (0, -0.34, 0.1) m turned (90°, 0, 0) with a 50 mm lens, a black
-world, frame 48, Auto Exposure, Cycles, render. The picture the recipe promises: a small warm
+world, Cycles, frame 48, Auto Exposure, render. The picture the recipe promises: a small warm
 flame, lit and coloured, neither black nor white, under the Blender's own view transform. Only
 the render's size and samples are set here (the recipe leaves Blender's, which would take
 minutes): 480 x 270, 32 samples.

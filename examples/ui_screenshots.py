@@ -83,6 +83,27 @@ def open_panels(names):
         bpy.utils.register_class(cls)
 
 
+def fresh_properties(window):
+    """A new Properties editor, maximized: the largest 3D Viewport is split and its new half,
+    never a Properties editor before, becomes one, so it draws every panel for the first time
+    (a panel takes DEFAULT_CLOSED or not only then; an editor that drew it keeps its state)."""
+    screen = window.screen
+    if len(screen.areas) == 1:
+        with bpy.context.temp_override(window=window, area=screen.areas[0]):
+            bpy.ops.screen.back_to_previous()
+        screen = window.screen
+    view3d = max((a for a in screen.areas if a.type == 'VIEW_3D'),
+                 key=lambda a: a.width * a.height)
+    before = {a.as_pointer() for a in screen.areas}
+    with bpy.context.temp_override(window=window, area=view3d):
+        bpy.ops.screen.area_split(direction='VERTICAL', factor=0.5)
+    area = next(a for a in screen.areas if a.as_pointer() not in before)
+    area.type = 'PROPERTIES'
+    with bpy.context.temp_override(window=window, area=area):
+        bpy.ops.screen.screen_full_area()
+    return window.screen.areas[0]
+
+
 def show(window, shot):
     """Maximizes the editor the shot names (restoring the layout first if another one is) and
     returns its area."""
@@ -139,9 +160,15 @@ def main():
                     return 0.3
                 state["settle"] = 0
             shot = state["shot"]
-            if state["settle"] == 0:
+            if state["settle"] == 0 and shot.open:  # panels an artist opened: a new editor
                 open_panels(shot.open)
-            area = show(window, shot)
+                area = fresh_properties(window)
+                area.spaces.active.context = shot.tab
+            elif state["settle"] == 0:
+                open_panels(())
+                area = show(window, shot)
+            else:
+                area = window.screen.areas[0]
             region = next(r for r in area.regions if r.type == 'WINDOW')
             with bpy.context.temp_override(window=window, area=area, region=region):
                 if state["settle"] == 0:  # the top of the editor, no tooltip under the pointer

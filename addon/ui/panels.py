@@ -348,10 +348,11 @@ class PHYSICS_PT_plume_flowgraph(PlumeDomainPanel, bpy.types.Panel):
             img = bpy.data.images.get("Plume Flow Graph " + ob.name)
             if img is not None and img.preview is not None:
                 layout.template_icon(icon_value=img.preview.icon_id, scale=10.0)
-        col = layout.column(heading="Synthesis")
-        row = col.row(align=True)
-        row.prop(g, "frame_start")
-        row.prop(g, "frame_end")
+        layout.label(text="Synthesis")
+        col = layout.column(align=True)  # as the Settings panel lays out a frame range
+        col.prop(g, "frame_start", text="Frame Start")
+        col.prop(g, "frame_end", text="End")
+        col = layout.column()
         for name in ("seed", "traversal", "gamma", "transition_hold"):
             col.prop(g, name)
         sub = col.column()

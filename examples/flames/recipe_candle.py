@@ -34,7 +34,7 @@ def steps(cache_dir):
     cam.data.lens = LENS
     world = scene.world.node_tree.nodes["Background"]       # 7. World › Surface › Color: black
     world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-    scene.frame_set(FRAME_END)                              # 8. frame 48, Auto Exposure
+    scene.render.engine = 'CYCLES'                          # 8. Render Engine: Cycles,
+    scene.frame_set(FRAME_END)                              #    frame 48, Auto Exposure
     press(bpy.ops.plume.flames_auto_exposure)
-    scene.render.engine = 'CYCLES'                          #    Render Engine: Cycles
     return wick
