@@ -42,7 +42,7 @@ class PlumeFarmSettings(bpy.types.PropertyGroup):
                                           "cluster's default")
     account: StringProperty(name="Account", default="",
                             description="The Slurm account to charge; empty for yours")
-    time_limit: IntProperty(name="Time Limit", default=60, min=1, soft_max=24 * 60,
+    time_limit: IntProperty(name="Time Limit (min)", default=60, min=1, soft_max=24 * 60,
                             description="Minutes each task may run before Slurm stops it")
     cpus: IntProperty(name="CPUs per Task", default=2, min=1, soft_max=64,
                       description="Processor cores each task asks for")
