@@ -8,6 +8,7 @@ SUDO=""
 
 PACKAGES=(blender cmake g++ pybind11-dev libopenvdb-dev libglm-dev libosd-dev libtbb-dev
           libboost-dev libboost-iostreams-dev googletest libgtest-dev libbenchmark-dev python3-pytest python3-numpy python3-matplotlib python3-markdown
+          slurm-wlm munge
           xvfb xauth libgl1-mesa-dri python3-venv patchelf zip unzip binutils python3-openvdb
           ninja-build dpkg-dev clang-14 libclang-rt-14-dev)  # clang: .ci/fuzz's, installed here
 # so that no apt run of .ci/fuzz meets .ci/test's background download of the portable sources

@@ -69,6 +69,10 @@ SUBSET = [
 #: later exit cleanly). Their test processes end with os._exit after the file's own result, so
 #: the tests' verdict is kept and the teardown is skipped; README "Tested Blenders" says so.
 EXIT_WITHOUT_TEARDOWN = {"4.2"}
+#: Files that run in the packaged Blender only under the policy (named on the command line they
+#: run anywhere): the farm tests start a Blender per task on the single-node Slurm cluster,
+#: minutes per run, and what they test (Slurm, paths, resume) does not change with the Blender.
+ONE_BLENDER = {"test_farm.py"}
 #: Files that need a window (Xvfb + the real executable): only the packaged Blender has one.
 WINDOWED = {"test_ui_jobs.py", "test_ui_screenshots.py"}
 TIMEOUT_S = 1800
@@ -222,6 +226,11 @@ def plan(label, named, full):
         if len(kept) < len(files):
             why += f", not {' '.join(sorted(WINDOWED))} (no window)"
         files = kept
+        if not named:
+            kept = [f for f in files if os.path.basename(f) not in ONE_BLENDER]
+            if len(kept) < len(files):
+                why += f", not {' '.join(sorted(ONE_BLENDER))} (3.4 runs it)"
+            files = kept
     return files, why
 
 
