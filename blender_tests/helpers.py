@@ -188,6 +188,26 @@ def density_com_z(path):
     return mass, float((vals.sum(axis=(0, 1)) * z).sum() / mass)
 
 
+def render_recipe(name, samples=32, size=(480, 270)):
+    """A recipe's test render of the current scene at its own engine: only the size and samples
+    (Cycles, on the CPU, no denoiser) are the test's. Returns (path, seconds)."""
+    import time
+    scene = bpy.context.scene
+    if scene.render.engine == 'CYCLES':
+        scene.cycles.device = 'CPU'
+        scene.cycles.samples = samples
+        scene.cycles.use_denoising = False
+    scene.render.resolution_x, scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+    scene.render.image_settings.file_format = 'PNG'
+    out = os.path.join(OUT_DIR, f"recipe_{name}")
+    os.makedirs(out, exist_ok=True)
+    scene.render.filepath = os.path.join(out, f"{name}.png")
+    t0 = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    return scene.render.filepath, time.perf_counter() - t0
+
+
 def image_pixels(path):
     """RGBA float pixels (h, w, 4) of an image file, read through Blender."""
     img = bpy.data.images.load(path, check_existing=False)

@@ -435,6 +435,54 @@ class FarmTest(unittest.TestCase):
         self.assertEqual([(ts.name, ts.states) for ts in polled],
                          [(ts.name, ts.states) for ts in status.read(folder)])
 
+    def test_flames_then_render_and_a_render_of_existing_caches(self):
+        """The README's candle (recipe_candle.py) as a Flames job: Bake Flames on the farm,
+        then its frames rendered in two chunks; the farm's flames equal a local bake. Then a
+        Render job of the local bake: the copy renders the caches where they are."""
+        sys.path[:0] = [os.path.join(REPO, "examples"), os.path.join(REPO, "examples", "flames")]
+        import recipe_candle
+        import recipe_kit
+        base = os.path.join(self.tmp, "candle")
+        recipe_kit.run(recipe_candle.steps("//plume_cache/flames/"))
+        scene = bpy.context.scene
+        scene.frame_start, scene.frame_end = 1, recipe_candle.FRAME_END
+        scene.render.resolution_x, scene.render.resolution_y = 96, 54
+        scene.cycles.samples, scene.cycles.use_denoising = 8, False
+        os.makedirs(base, exist_ok=True)
+        bpy.ops.wm.save_as_mainfile(filepath=os.path.join(base, "candle.blend"))
+        farm = scene.plume_farm
+        farm.folder, farm.time_limit, farm.cpus = os.path.join(base, "farm") + "/", 10, 1
+        farm.job, farm.chunk = 'FLAMES', recipe_candle.FRAME_END // 2
+        folder = self.submit()
+        states = wait_done(self, folder)
+        self.assertEqual([(ts.name, ts.summary) for ts in states],
+                         [("flames", "DONE"), ("render", "DONE")], [ts.failures for ts in states])
+        self.assertEqual(len(states[1].states), 2)
+
+        def flame_frame(root, f):
+            return os.path.join(root, f"flames_{f:04d}.vdb")
+        local = os.path.join(base, "plume_cache", "flames")
+        self.assertEqual(bpy.ops.plume.flames_bake(), {'FINISHED'})  # here, into //plume_cache
+        assert_same_frames(self, flame_frame, os.path.join(folder, "plume_cache", "flames"),
+                           local, range(1, recipe_candle.FRAME_END + 1), ("density",))
+
+        def lit(folder_, frame):
+            px = image_pixels(os.path.join(folder_, "render", f"{frame:04d}.png"))[..., :3]
+            return float((px.max(axis=2) > 0.3).mean())
+        farm_lit = lit(folder, recipe_candle.FRAME_END)
+        farm.job = 'RENDER'
+        render_job = self.submit()
+        with open(os.path.join(render_job, "graph.json"), encoding="utf-8") as f:
+            self.assertEqual([t["name"] for t in json.load(f)["tasks"]], ["render"])
+        states = wait_done(self, render_job)
+        self.assertEqual([ts.summary for ts in states], ["DONE"], [ts.failures for ts in states])
+        self.assertFalse(os.path.exists(os.path.join(render_job, "plume_cache")))
+        render_lit = lit(render_job, recipe_candle.FRAME_END)
+        print(f"  candle on the farm: frame 48 lit {farm_lit:.1%} (Flames job), "
+              f"{render_lit:.1%} (Render job of the local caches)")
+        self.assertGreater(farm_lit, 0.005)
+        self.assertAlmostEqual(render_lit, farm_lit, delta=0.01)
+
 
 if __name__ == "__main__":
     run(FarmTest)

@@ -29,7 +29,7 @@ from mathutils import Vector  # noqa: E402
 import fire_look  # noqa: E402
 import recipe_campfire  # noqa: E402  (the recipe's steps, shared with its screenshots)
 import recipe_kit  # noqa: E402
-from helpers import OUT_DIR, image_pixels, lit_extent, rmtree, run, temp_dir  # noqa: E402
+from helpers import image_pixels, lit_extent, render_recipe, rmtree, run, temp_dir  # noqa: E402
 
 #: Measured (frame 20; 3.4.1 Filmic / bpy 5.3 AgX) over the sky, the rows above the ground's far
 #: edge where only flames can be lit: 9.3 / 8.6 % lit, hue 33.5° / 25.9°, white 0.0 %; the lit
@@ -54,19 +54,10 @@ class RecipeCampfireTest(unittest.TestCase):
         cls.logs = recipe_kit.run(recipe_campfire.steps(cls.tmp + "/"))
         scene = bpy.context.scene
         assert scene.render.engine == 'CYCLES'
-        scene.cycles.device = 'CPU'
-        scene.cycles.samples = 32
-        scene.cycles.use_denoising = False
-        scene.render.resolution_x, scene.render.resolution_y = 480, 270
-        scene.render.resolution_percentage = 100
-        scene.render.image_settings.file_format = 'PNG'
-        out = os.path.join(OUT_DIR, "recipe_campfire")
-        os.makedirs(out, exist_ok=True)
-        scene.render.filepath = os.path.join(out, "campfire.png")
         t1 = time.perf_counter()
-        bpy.ops.render.render(write_still=True)
+        path, _ = render_recipe("campfire")
         cls.seconds = (t1 - t0, time.perf_counter() - t1)
-        px = image_pixels(scene.render.filepath)
+        px = image_pixels(path)
         h = px.shape[0]
         # the ground's far edge (y = 2 m): above it only the flames can be lit
         far = world_to_camera_view(scene, scene.camera, Vector((0.0, 2.0, 0.0))).y * h

@@ -23,7 +23,7 @@ import bpy  # noqa: E402
 import fire_look  # noqa: E402
 import recipe_candle  # noqa: E402  (the recipe's steps, shared with its screenshots)
 import recipe_kit  # noqa: E402
-from helpers import OUT_DIR, image_pixels, rmtree, run, temp_dir  # noqa: E402
+from helpers import image_pixels, render_recipe, rmtree, run, temp_dir  # noqa: E402
 
 #: The flame's share of the frame (lit pixels), hue, clipped-white share and blue base (pixels).
 #: Measured: lit 3.6 % (bpy 5.3, AgX) and 4.1 % (3.4.1, Filmic), hue 28.3° and 33.7°, white
@@ -43,17 +43,8 @@ class RecipeCandleTest(unittest.TestCase):
         cls.wick = recipe_kit.run(recipe_candle.steps(cls.tmp + "/"))
         scene = bpy.context.scene
         assert scene.render.engine == 'CYCLES'
-        scene.cycles.device = 'CPU'
-        scene.cycles.samples = 32
-        scene.cycles.use_denoising = False
-        scene.render.resolution_x, scene.render.resolution_y = 480, 270
-        scene.render.resolution_percentage = 100
-        scene.render.image_settings.file_format = 'PNG'
-        out = os.path.join(OUT_DIR, "recipe_candle")
-        os.makedirs(out, exist_ok=True)
-        scene.render.filepath = os.path.join(out, "candle.png")
-        bpy.ops.render.render(write_still=True)
-        cls.look = fire_look.measure(image_pixels(scene.render.filepath))
+        path, _ = render_recipe("candle")
+        cls.look = fire_look.measure(image_pixels(path))
         print("  candle recipe: " + fire_look.text(cls.look), flush=True)
 
     @classmethod

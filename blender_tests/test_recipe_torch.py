@@ -25,7 +25,7 @@ import bpy  # noqa: E402
 import fire_look  # noqa: E402
 import recipe_kit  # noqa: E402
 import recipe_torch  # noqa: E402  (the recipe's steps, shared with its screenshots)
-from helpers import OUT_DIR, image_pixels, lit_extent, rmtree, run, temp_dir  # noqa: E402
+from helpers import image_pixels, lit_extent, render_recipe, rmtree, run, temp_dir  # noqa: E402
 
 #: Measured (frame 24; 3.4.1 Filmic / bpy 5.3 AgX): lit 6.2 / 6.5 % of the frame, hue 38.0° /
 #: 27.1°, white 0.0 %; the lit top 0.47 m above the head in both, the lit width 0.17 m (the
@@ -48,19 +48,10 @@ class RecipeTorchTest(unittest.TestCase):
         cls.head = recipe_kit.run(recipe_torch.steps(cls.tmp + "/"))
         scene = bpy.context.scene
         assert scene.render.engine == 'CYCLES'
-        scene.cycles.device = 'CPU'
-        scene.cycles.samples = 32
-        scene.cycles.use_denoising = False
-        scene.render.resolution_x, scene.render.resolution_y = 480, 270
-        scene.render.resolution_percentage = 100
-        scene.render.image_settings.file_format = 'PNG'
-        out = os.path.join(OUT_DIR, "recipe_torch")
-        os.makedirs(out, exist_ok=True)
-        scene.render.filepath = os.path.join(out, "torch.png")
         t1 = time.perf_counter()
-        bpy.ops.render.render(write_still=True)
+        path, _ = render_recipe("torch")
         cls.seconds = (t1 - t0, time.perf_counter() - t1)
-        px = image_pixels(scene.render.filepath)
+        px = image_pixels(path)
         cls.look = fire_look.measure(px)
         lit = px[..., :3].max(axis=2) > fire_look.LIT
         cls.bottom, cls.top, cls.width = lit_extent(scene, lit)

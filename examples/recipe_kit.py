@@ -70,3 +70,20 @@ def sphere_domain(cache_dir, streaks=False):
     d.resolution, d.frame_end, d.streaks = 40, 60, streaks
     d.cache_directory = cache_dir
     return domain
+
+
+def flame_view(camera_location, camera_rotation_deg, lens, frame):
+    """The flame recipes' last steps: the camera placed (N › Item) with its Focal Length, a black
+    world (World › Surface › Color), Render Engine Cycles, the frame, then the Flames panel's
+    Auto Exposure (it sets Cycles' film exposure, so Cycles comes first)."""
+    import math
+    scene = bpy.context.scene
+    cam = scene.camera
+    cam.location = camera_location
+    cam.rotation_euler = tuple(math.radians(a) for a in camera_rotation_deg)
+    cam.data.lens = lens
+    world = scene.world.node_tree.nodes["Background"]
+    world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    scene.render.engine = 'CYCLES'
+    scene.frame_set(frame)
+    press(bpy.ops.plume.flames_auto_exposure)

@@ -8,7 +8,7 @@ import math
 
 import bpy
 
-from recipe_kit import Shot, new_file, press
+from recipe_kit import Shot, flame_view, new_file, press
 
 GROUND = dict(size=4.0)
 LOG = dict(radius=0.05, depth=0.55, location=(0.0, -0.09, 0.05),
@@ -40,13 +40,6 @@ def steps(cache_dir):
           TRANSFORM_OT_translate=dict(value=UPPER_LAYER))
     press(bpy.ops.transform.rotate, value=math.radians(90.0), orient_axis='Z')
     press(bpy.ops.plume.flames_bake)                        # 7. Flames › Bake Flames
-    cam = scene.camera                                      # 8. the camera
-    cam.location = CAMERA_LOCATION
-    cam.rotation_euler = tuple(math.radians(a) for a in CAMERA_ROTATION_DEG)
-    cam.data.lens = LENS
-    world = scene.world.node_tree.nodes["Background"]       # 9. World › Surface › Color: black
-    world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-    scene.render.engine = 'CYCLES'                          # 10. Render Engine: Cycles,
-    scene.frame_set(FRAME_END)                              #     frame 20, Auto Exposure
-    press(bpy.ops.plume.flames_auto_exposure)
+    flame_view(CAMERA_LOCATION, CAMERA_ROTATION_DEG, LENS,  # 8-10. camera, black world,
+               FRAME_END)                                  #    Cycles, frame 20, Auto Exposure
     return [ob for ob in scene.objects if ob.plume.role == 'FLAME_SOURCE']

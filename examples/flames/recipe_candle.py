@@ -2,11 +2,9 @@
 the render, is the artist's F12). `blender_tests/test_recipe_candle.py` performs it and checks
 the flame; `bash .ci/screenshots` saves its panel picture. See examples/recipe_kit.py."""
 
-import math
-
 import bpy
 
-from recipe_kit import Shot, new_file, press
+from recipe_kit import Shot, flame_view, new_file, press
 
 WAX = dict(radius=0.012, depth=0.08, location=(0.0, 0.0, 0.04))
 WICK = dict(vertices=8, radius=0.0008, depth=0.008, location=(0.0, 0.0, 0.082))
@@ -28,13 +26,6 @@ def steps(cache_dir):
     flames.cache_directory = cache_dir
     yield Shot("ui_flame_source.png")
     press(bpy.ops.plume.flames_bake)                        #    Bake Flames
-    cam = scene.camera                                      # 6. the camera
-    cam.location = CAMERA_LOCATION
-    cam.rotation_euler = tuple(math.radians(a) for a in CAMERA_ROTATION_DEG)
-    cam.data.lens = LENS
-    world = scene.world.node_tree.nodes["Background"]       # 7. World › Surface › Color: black
-    world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-    scene.render.engine = 'CYCLES'                          # 8. Render Engine: Cycles,
-    scene.frame_set(FRAME_END)                              #    frame 48, Auto Exposure
-    press(bpy.ops.plume.flames_auto_exposure)
+    flame_view(CAMERA_LOCATION, CAMERA_ROTATION_DEG, LENS,  # 6-8. camera, black world,
+               FRAME_END)                                  #    Cycles, frame 48, Auto Exposure
     return wick

@@ -3,11 +3,9 @@ a handle and a head, the head made a Flame Source from the Torch preset, Bake Fl
 a black world, Auto Exposure. `blender_tests/test_recipe_torch.py` performs it and checks the
 flames; `bash .ci/screenshots` saves its panel picture. See examples/recipe_kit.py."""
 
-import math
-
 import bpy
 
-from recipe_kit import Shot, new_file, press
+from recipe_kit import Shot, flame_view, new_file, press
 
 HANDLE = dict(radius=0.015, depth=0.5, location=(0.0, 0.0, 0.75))
 HEAD = dict(radius=0.04, location=(0.0, 0.0, 1.0))
@@ -30,13 +28,6 @@ def steps(cache_dir):
     flames.cache_directory = cache_dir
     yield Shot("ui_torch_preset.png")
     press(bpy.ops.plume.flames_bake)                        #    Bake Flames
-    cam = scene.camera                                      # 6. the camera
-    cam.location = CAMERA_LOCATION
-    cam.rotation_euler = tuple(math.radians(a) for a in CAMERA_ROTATION_DEG)
-    cam.data.lens = LENS
-    world = scene.world.node_tree.nodes["Background"]       # 7. World › Surface › Color: black
-    world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-    scene.render.engine = 'CYCLES'                          # 8. Render Engine: Cycles,
-    scene.frame_set(FRAME_END)                              #    frame 24, Auto Exposure
-    press(bpy.ops.plume.flames_auto_exposure)
+    flame_view(CAMERA_LOCATION, CAMERA_ROTATION_DEG, LENS,  # 6-8. camera, black world,
+               FRAME_END)                                  #    Cycles, frame 24, Auto Exposure
     return head
