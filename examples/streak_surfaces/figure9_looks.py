@@ -165,9 +165,11 @@ def match_light(scene, path, apply, value, target, samples, rounds=3):
     for _ in range(rounds):
         apply(value)
         render(scene, path, samples)
-        light = measure(path)["light"]
-        if light <= 0.0:
-            break
+        m = measure(path)
+        light = m["light"]
+        if light <= 0.0:  # never silently keep the starting value: say what the probe saw
+            raise RuntimeError(f"figure9_looks.match_light: the probe render {path} at "
+                               f"{samples} samples shows no smoke ({m}), value {value:g}")
         value *= min(max(target / light, 0.25), 4.0)
     apply(value)
     return value
