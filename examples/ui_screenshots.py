@@ -126,7 +126,7 @@ def show(window, shot):
 def main():
     args = sys.argv[sys.argv.index("--") + 1:]
     out_root, names = os.path.abspath(args[0]), args[1:]
-    todo = recipes(names)
+    to_run = recipes(names)
     # A fixed cache folder: the panels that show it draw the same text on every run.
     cache = os.path.join(tempfile.gettempdir(), "plume_screenshots")
     shutil.rmtree(cache, ignore_errors=True)
@@ -143,10 +143,10 @@ def main():
             window = bpy.context.window_manager.windows[0]
             if state["shot"] is None:  # the recipe's next steps, up to its next Shot
                 if state["steps"] is None:
-                    if state["recipe"] == len(todo):
+                    if state["recipe"] == len(to_run):
                         quit_with(0)
                         return None
-                    folder, module = todo[state["recipe"]]
+                    folder, module = to_run[state["recipe"]]
                     state["folder"] = folder
                     state["steps"] = module.steps(os.path.join(cache, folder) + "/")
                 try:
