@@ -67,6 +67,6 @@ def steps(cache_dir):
     domain.hide_render = True                                # 8. hide the domain and its smoke
     bpy.data.objects[d.volume_object].hide_render = True
     scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = SKY  # 9. the look
-    scene.view_settings.view_transform = 'Standard'
+    scene.view_settings.view_transform = 'Standard'  # toon's flat colours: Filmic/AgX grey them
     scene.frame_set(SHOW_FRAME)
     return domain
