@@ -75,7 +75,7 @@ class RecipeCampfireTest(unittest.TestCase):
         lit[:int(far) + 2] = False
         cls.bottom, cls.top, cls.width = lit_extent(scene, lit)
         cls.ground_lit = float((px[:int(far) - 2, :, :3].max(axis=2) > fire_look.LIT).mean())
-        cls.dark_ground = cls._dark_ground(scene, out)
+        cls.dark_ground = cls._dark_ground(scene, os.path.dirname(path))
         with open(os.path.join(cls.tmp, "flames_manifest.json"), encoding="utf-8") as fh:
             cls.flames = json.load(fh)["flames"][-1]
         print(f"  campfire recipe, over the sky: {fire_look.text(cls.look)}; flames up to "
