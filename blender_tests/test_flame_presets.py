@@ -184,7 +184,8 @@ class FlamePresetsTest(unittest.TestCase):
             self.assertLess(m["white_share"], 0.06, preset)
         # Eq. 5's r^7 puts the presets 10-22 stops apart; their Intensity brings each to the
         # candle's level (measured in 3.4.1, 4.5 and 5.3: candle 6.28, torch 6.05-6.07,
-        # campfire 7.37, dragon 7.07-7.25: within 0.23 stops).
+        # campfire 7.37, dragon 7.07-7.25: within 0.23 stops; in 3.4.1 since the glow fades out
+        # at the shell's edge: candle 6.82, torch 5.95, campfire 7.06, dragon 7.17, within 0.2).
         for preset, level in levels.items():
             self.assertLess(abs(math.log2(level / levels['CANDLE'])), 0.5, (preset, levels))
 

@@ -7,7 +7,13 @@ emission material that renders without the add-on:
   lights a floor 13.0× as much as a P-watt point light (4π = 12.6), so the flame looks as bright
   as the light it casts;
 - absorption: the `density` grid (§5.3's opacity, ∝ (d/I)²), a black scattering colour: real
-  flames are "highly transparent", only bright things show through their core.
+  flames are "highly transparent", only bright things show through their core;
+- both gated off for diffuse, glossy and shadow rays (Light Path), as the object's ray
+  visibility already hides the volume from them (see build()): Cycles tests an object's ray
+  visibility only where a ray enters its bounds, and a ray leaving a surface inside them (the
+  ground under a campfire, inside the flames' padded voxel blocks) already carries the volume.
+  Ungated, the ground inside the bounds took the volume's glow on top of the flames' lights: a
+  lighter patch with straight edges (leaf blocks in 3.4, the bounding box in 5.x) on the ground.
 """
 
 import math
@@ -21,7 +27,7 @@ from ..snapshot import blend_relative
 OBJECT_NAME = "Plume Flames"
 MATERIAL = "Plume Flames"
 #: The material's layout version (custom property): an older Plume Flames material is rebuilt.
-MATERIAL_VERSION = 2
+MATERIAL_VERSION = 3
 #: Volume emission strength per W/m³ (isotropic radiance per metre, see above).
 EMISSION_PER_WATT = 1.0 / (4.0 * math.pi)
 
@@ -48,7 +54,32 @@ def _build_nodes(mat):
     strength = nt.nodes.new("ShaderNodeValue")
     strength.location = (-700, -400)
     strength.name = strength.label = "Plume Emission"
-    L(strength.outputs[0], pv.inputs["Emission Strength"])
+    # The gate 1 − max(diffuse, glossy, shadow): 1 on camera (and transmission) rays, else 0.
+    path = N("ShaderNodeLightPath")
+    path.location = (-1100, -550)
+    hidden = N("ShaderNodeMath")
+    hidden.operation = 'MAXIMUM'
+    hidden.location = (-900, -500)
+    L(path.outputs["Is Diffuse Ray"], hidden.inputs[0])
+    L(path.outputs["Is Glossy Ray"], hidden.inputs[1])
+    hidden2 = N("ShaderNodeMath")
+    hidden2.operation = 'MAXIMUM'
+    hidden2.location = (-700, -550)
+    L(hidden.outputs[0], hidden2.inputs[0])
+    L(path.outputs["Is Shadow Ray"], hidden2.inputs[1])
+    gate = N("ShaderNodeMath")
+    gate.operation = 'SUBTRACT'
+    gate.name = gate.label = "Plume Ray Gate"
+    gate.location = (-500, -550)
+    gate.inputs[0].default_value = 1.0
+    L(hidden2.outputs[0], gate.inputs[1])
+    gated = N("ShaderNodeMath")
+    gated.operation = 'MULTIPLY'
+    gated.location = (-300, -400)
+    L(strength.outputs[0], gated.inputs[0])
+    L(gate.outputs[0], gated.inputs[1])
+    L(gated.outputs[0], pv.inputs["Emission Strength"])
+    L(gate.outputs[0], pv.inputs["Density"])
     L(pv.outputs["Volume"], out.inputs["Volume"])
     mat["plume_version"] = MATERIAL_VERSION
 

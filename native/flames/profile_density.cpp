@@ -22,6 +22,11 @@ constexpr double kSideMargin = 1e-9;
 
 }  // namespace
 
+double glowWindow(double dist, double shell) {
+  const double t = std::clamp(2.0 * dist / shell - 1.0, 0.0, 1.0);
+  return 1.0 - t * t * (3.0 - 2.0 * t);
+}
+
 void DensityParams::validate() const {
   if (!(falloff > 0.0 && falloff <= 100.0))
     throw std::invalid_argument("falloff must be in (0, 100] widest radii (got " + std::to_string(falloff) + ")");
@@ -94,7 +99,7 @@ ProfileDensity::ProfileDensity(const FlameProfile& profile, const DensityParams&
         const glm::dvec2 p(r0 + (a + 0.5) * h, z0 + (b + 0.5) * h);
         const double dd = surfaceDistance(p);
         if (dd > mShell) continue;
-        const double d = 1.0 / (1.0 + dd * dd / l2);
+        const double d = glowWindow(dd, mShell) / (1.0 + dd * dd / l2);
         m += 2.0 * kPi * p.x * d * h * h;
         m2 += 2.0 * kPi * p.x * d * d * h * h;
       }
@@ -105,7 +110,7 @@ ProfileDensity::ProfileDensity(const FlameProfile& profile, const DensityParams&
     // Bound for rejection: the cell is at least (distance at its centre - hd) from the surface.
     const double dc = surfaceDistance({r0 + 0.5 * mCell, z0 + 0.5 * mCell});
     const double near = std::max(0.0, dc - hd);
-    mCellMaxDensity[std::size_t(c)] = near > mShell ? 0.0 : 1.0 / (1.0 + near * near / l2);
+    mCellMaxDensity[std::size_t(c)] = glowWindow(near, mShell) / (1.0 + near * near / l2);
   }
   // Strata ordered by the cells' mean d: consecutive samples then fall in cells of alike d at
   // any count, so the stratification removes most of the variance of mean d(x_i) (eq. 6's sum).
@@ -160,7 +165,7 @@ double ProfileDensity::surfaceDistance(glm::dvec2 rhoZ) const {
 
 double ProfileDensity::density(const glm::dvec3& p) const {
   const double dist = surfaceDistance({std::hypot(p.x, p.y), p.z});
-  return 1.0 / (1.0 + dist * dist / (mParams.falloff * mParams.falloff));
+  return glowWindow(dist, mShell) / (1.0 + dist * dist / (mParams.falloff * mParams.falloff));
 }
 
 void ProfileDensity::classifyCells() {
@@ -228,11 +233,11 @@ ProfileSample ProfileDensity::sample(double u, Rng& rng) const {
         dist = surfaceDistance({rho, z});
       }
     }
-    const double d = 1.0 / (1.0 + dist * dist / l2);
+    const double d = glowWindow(dist, mShell) / (1.0 + dist * dist / l2);
     s.position.z = z;
     s.density = d;
     s.inside = dist == 0.0;  // surfaceDistance is 0 exactly inside the surface
-    if (dist <= mShell && rng.uniform() * bound <= d) break;
+    if (dist < mShell && rng.uniform() * bound <= d) break;
   }
   // The angle only places the accepted candidate: its cosine and sine once, in single precision
   // (positions end as floats; θ ∈ [0, 2π) to ~2e-7 rad).

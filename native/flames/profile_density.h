@@ -13,7 +13,12 @@
 /// has ℓ = 1 in the paper's (unstated) normalized units; here distances are in units of the
 /// profile's widest radius and ℓ (`falloff`) sets how far the glow reaches, so ℓ = 1 is eq. 4
 /// literally. The density is sampled inside the shell |x_f(x) − x| ≤ cutoff · ℓ (eq. 4 decays as
-/// 1/dist², so its integral over all space diverges: some bound is needed).
+/// 1/dist², so its integral over all space diverges: some bound is needed). Over the shell's
+/// outer half eq. 4 is faded to 0 by a smoothstep window W (glowWindow()), so the glow ends
+/// softly: cut off plainly, it stopped at d = I / (1 + cutoff²) (I/5 at the default cutoff, and
+/// the emission, ∝ d², at 4 % of the surface's) and showed a hard edge, e.g. a band with a
+/// straight border on the ground beside a campfire's logs. At the default cutoff (2) the window
+/// starts at distance ℓ, so d still falls to I/2 there.
 ///
 /// Built once per profile: a grid over the meridian half-plane (ρ, z) holding, per cell, the
 /// profile segments that can be closest to any point of the cell (exact closest points at the
@@ -32,10 +37,14 @@
 
 namespace plume {
 
+/// Eq. 4's fade over the outer half of the sampling shell: 1 at distances up to shell/2, then a
+/// smoothstep down to 0 at `shell` (and beyond).
+double glowWindow(double dist, double shell);
+
 /// Settings of eq. 4 and of its sampling shell.
 struct DensityParams {
   double falloff = 0.5;  ///< ℓ, in widest radii: d falls to I/2 at distance ℓ from the surface
-  double cutoff = 2.0;   ///< the shell sampled: distances up to cutoff · ℓ (d ≥ I / (1 + cutoff²))
+  double cutoff = 2.0;   ///< the shell sampled: distances up to cutoff · ℓ, eq. 4 faded to 0 there
   /// Throws std::invalid_argument naming the setting and its accepted range.
   void validate() const;
 };
@@ -57,7 +66,8 @@ class ProfileDensity {
   glm::dvec2 closestPoint(glm::dvec2 rhoZ, double* distance) const;
   /// |x_f − x| outside the surface of revolution, 0 inside it.
   double surfaceDistance(glm::dvec2 rhoZ) const;
-  /// d(x)/I (eq. 4 with I = 1, and 1 inside the surface) at a canonical position.
+  /// d(x)/I (eq. 4 with I = 1 times glowWindow(), and 1 inside the surface) at a canonical
+  /// position: 0 beyond the shell.
   double density(const glm::dvec3& p) const;
   /// Whether (ρ, z) is inside the surface of revolution.
   bool inside(glm::dvec2 rhoZ) const;

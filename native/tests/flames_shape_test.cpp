@@ -80,7 +80,7 @@ TEST(FlamesShape, DensityMatchesBruteForceClosestPointOnSurfaceOfRevolution) {
       }
       double best = 1e30;
       for (const glm::dvec3& s : surface) best = std::min(best, glm::length(s - x));
-      const double dist = std::sqrt(std::max(0.0, (1.0 / d - 1.0)) * params.falloff * params.falloff);
+      const double dist = density.surfaceDistance({rho, x.z});
       // The tessellation lies on the surface, so its nearest sample is no closer than x_f; it is
       // at most half a sample gap further: gaps are ≤ 2π/360 · ρ ≤ 0.0175 around and 0.005
       // along, so ≤ ½ √(0.0175² + 0.005²) ≈ 0.0091.
@@ -90,13 +90,44 @@ TEST(FlamesShape, DensityMatchesBruteForceClosestPointOnSurfaceOfRevolution) {
       double exact = 1e30;
       const glm::dvec2 p(std::hypot(x.x, x.y), x.z);
       for (std::size_t j = 0; j + 1 < m.size(); ++j) exact = std::min(exact, segmentDistance(m[j], m[j + 1], p));
-      EXPECT_NEAR(d, 1.0 / (1.0 + exact * exact / (params.falloff * params.falloff)), 1e-12);
+      EXPECT_NEAR(dist, exact, 1e-12);
+      const double shell = params.cutoff * params.falloff;
+      EXPECT_NEAR(d, glowWindow(exact, shell) / (1.0 + exact * exact / (params.falloff * params.falloff)), 1e-12);
     }
     // d = I on the surface.
     for (std::size_t j = 0; j + 1 < m.size(); ++j) {
       const glm::dvec2 rz = 0.5 * (m[j] + m[j + 1]);
       EXPECT_NEAR(density.density({rz.x * std::cos(1.0), rz.x * std::sin(1.0), rz.y}), 1.0, 1e-12);
     }
+  }
+}
+
+TEST(FlamesShape, GlowFadesToZeroAtTheShellsEdge) {
+  // Eq. 4 cut off plainly at the shell (distance cutoff · ℓ) left the glow's last particles at
+  // d = I / (1 + cutoff²) = I/5, their emission (∝ d²: as many particles as d, each of power ∝ d)
+  // at 4 % of the surface's: a hard edge (a band with a straight border on the ground beside a
+  // campfire's logs). Faded by glowWindow(), the samples in the shell's outer tenth stay below
+  // d = 0.03 I (measured 0.0244 in each profile, the window's 0.104 / (1 + 0.9² cutoff²); plain
+  // eq. 4 gives 1 / (1 + 0.9² cutoff²) = 0.236 there), so their emission is < 0.1 % of the
+  // surface's, and the glow still reaches: d = I/2 at distance ℓ, samples out to the edge.
+  const DensityParams params;
+  const double shell = params.cutoff * params.falloff;
+  for (ProfileShape shape : {ProfileShape::Candle, ProfileShape::Torch, ProfileShape::Campfire}) {
+    const ProfileDensity density(FlameProfile::library(shape), params);
+    EXPECT_DOUBLE_EQ(glowWindow(params.falloff, shell) / 2.0, 0.5);  // d(ℓ) = I/2, eq. 4's own
+    double outerMax = 0.0, farthest = 0.0;
+    int outer = 0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+      const ProfileSample s = sampleFlame(density, 5, 1, i, n);
+      const double dist = density.surfaceDistance({std::hypot(s.position.x, s.position.y), s.position.z});
+      ASSERT_LT(dist, shell);
+      farthest = std::max(farthest, dist);
+      if (dist >= 0.9 * shell) outerMax = std::max(outerMax, s.density), ++outer;
+    }
+    EXPECT_GT(outer, 0) << "no glow in the shell's outer tenth";
+    EXPECT_GT(farthest, 0.95 * shell);
+    EXPECT_LT(outerMax, 0.03);
   }
 }
 
