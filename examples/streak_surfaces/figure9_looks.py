@@ -155,13 +155,14 @@ def render_matched(scene, path, seconds, probe=PROBE_SAMPLES):
     return wall, samples
 
 
-def match_light(scene, path, apply, value, target, samples, rounds=3):
+def match_light(scene, path, apply, value, target, samples, rounds=6, tolerance=0.08):
     """Scales a panel's look setting (`apply(value)`: a volume's density scale, the specks'
     opacity) until its light (measure()) is about `target`, the sheets': a probe render at
     `samples` per round (near the final count: a grainy render measures more light than a clean
     one, 0.20 against 0.11 mean brightness at 8 and 512 samples), the value scaled by
-    target / light (light grows about in proportion for faint smoke). Leaves the last value
-    applied and returns it."""
+    target / light (light grows about in proportion for faint smoke), until a probe is within
+    `tolerance` of the target (a probe that misjudged the light is caught by the next one).
+    Leaves the last value applied and returns it."""
     for _ in range(rounds):
         apply(value)
         render(scene, path, samples)
@@ -170,6 +171,8 @@ def match_light(scene, path, apply, value, target, samples, rounds=3):
         if light <= 0.0:  # never silently keep the starting value: say what the probe saw
             raise RuntimeError(f"figure9_looks.match_light: the probe render {path} at "
                                f"{samples} samples shows no smoke ({m}), value {value:g}")
+        if abs(light / target - 1.0) <= tolerance:
+            return value
         value *= min(max(target / light, 0.25), 4.0)
     apply(value)
     return value
