@@ -443,8 +443,9 @@ class FarmTest(unittest.TestCase):
         import recipe_candle
         import recipe_kit
         base = os.path.join(self.tmp, "candle")
-        recipe_kit.run(recipe_candle.steps("//plume_cache/flames/"))
+        recipe_kit.run(recipe_candle.steps(os.path.join(base, "plume_cache", "flames") + "/"))
         scene = bpy.context.scene
+        scene.plume_flames.cache_directory = "//plume_cache/flames/"  # the same, once saved
         scene.frame_start, scene.frame_end = 1, recipe_candle.FRAME_END
         scene.render.resolution_x, scene.render.resolution_y = 96, 54
         scene.cycles.samples, scene.cycles.use_denoising = 8, False

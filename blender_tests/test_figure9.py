@@ -70,21 +70,33 @@ class Figure9Test(unittest.TestCase):
         target = looks.measure(path)["light"]
         # The example's matching (compare_representations.panels): each alternative's look
         # setting scaled until its probe renders send the sheets' light.
-        looks.show_only(scene, {volume})
-        looks.match_light(scene, os.path.join(cls.tmp, "probe.png"),
-                          lambda v: looks.set_volume_look(volume, v), compare.VOLUME_DENSITY[50],
-                          target, VOLUME_SAMPLES)
-        looks.show_only(scene, {specks})
-        looks.match_light(scene, os.path.join(cls.tmp, "probe.png"),
-                          lambda v: looks.set_speck_opacity(specks, v),
-                          compare.PARTICLE_OPACITY[50], target, 16)
+        matched = {"volume": ({volume}, lambda v: looks.set_volume_look(volume, v),
+                              compare.VOLUME_DENSITY[50], VOLUME_SAMPLES),
+                   "particles": ({specks}, lambda v: looks.set_speck_opacity(specks, v),
+                                 compare.PARTICLE_OPACITY[50], 16)}
+        values = {}
+        for name, (shown, apply, start, samples) in matched.items():
+            looks.show_only(scene, shown)
+            values[name] = looks.match_light(scene, os.path.join(cls.tmp, "probe.png"), apply,
+                                             start, target, samples)
         for name, shown, samples in (("sheets", sheets, 16), ("particles", {specks}, 16),
                                      ("volume", {volume}, VOLUME_SAMPLES)):
             looks.show_only(scene, shown)
             path = os.path.join(cls.tmp, name + ".png")
             looks.render(scene, path, samples)
-            shutil.copy(path, os.path.join(out, name + ".png"))
             cls.m[name] = looks.measure(path)
+            if name in matched and not 0.85 < cls.m[name]["light"] / target < 1.18:
+                # In 3.4.1 a full run's probes sometimes misjudge the light (3 of 6 runs left
+                # the panel at its starting look, 3x the sheets' light; never when run alone):
+                # the match runs once more from here, and the panel is rendered again.
+                print(f"figure 9, {name}: light {cls.m[name]['light']:.3f} after the match "
+                      f"(target {target:.3f}): matching again", flush=True)
+                _shown, apply, _start, _samples = matched[name]
+                values[name] = looks.match_light(scene, os.path.join(cls.tmp, "probe.png"),
+                                                 apply, values[name], target, samples)
+                looks.render(scene, path, samples)
+                cls.m[name] = looks.measure(path)
+            shutil.copy(path, os.path.join(out, name + ".png"))
             print(f"figure 9, {name}: " + ", ".join(f"{k} {v:.3f}" for k, v in
                                                      cls.m[name].items()), flush=True)
 
