@@ -72,10 +72,9 @@ def sphere_domain(cache_dir, streaks=False):
     return domain
 
 
-def flame_view(camera_location, camera_rotation_deg, lens, frame):
-    """The flame recipes' last steps: the camera placed (N › Item) with its Focal Length, a black
-    world (World › Surface › Color), Render Engine Cycles, the frame, then the Flames panel's
-    Auto Exposure (it sets Cycles' film exposure, so Cycles comes first)."""
+def dark_view(camera_location, camera_rotation_deg, lens):
+    """The fire recipes' view: the camera placed (N › Item) with its Focal Length, a black
+    world (World › Surface › Color), Render Engine Cycles."""
     import math
     scene = bpy.context.scene
     cam = scene.camera
@@ -85,5 +84,11 @@ def flame_view(camera_location, camera_rotation_deg, lens, frame):
     world = scene.world.node_tree.nodes["Background"]
     world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     scene.render.engine = 'CYCLES'
-    scene.frame_set(frame)
+
+
+def flame_view(camera_location, camera_rotation_deg, lens, frame):
+    """The flame recipes' last steps: dark_view(), the frame, then the Flames panel's Auto
+    Exposure (it sets Cycles' film exposure, so Cycles comes first)."""
+    dark_view(camera_location, camera_rotation_deg, lens)
+    bpy.context.scene.frame_set(frame)
     press(bpy.ops.plume.flames_auto_exposure)

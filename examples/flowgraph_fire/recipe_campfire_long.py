@@ -7,11 +7,9 @@ together; only the synthesized fire rendered, the camera, a black world, the fil
 `blender_tests/test_recipe_campfire_long.py` performs it and checks the fire;
 `bash .ci/screenshots` saves its panel pictures. See examples/recipe_kit.py."""
 
-import math
-
 import bpy
 
-from recipe_kit import Shot, new_file, press
+from recipe_kit import Shot, dark_view, new_file, press
 
 BURNER = dict(radius=0.1, depth=0.05, location=(0.0, 0.0, 0.025))
 #: The box: a 1 m cube squeezed to 0.6 x 0.6 x 1 m over the burner, its floor at z = 0.
@@ -91,14 +89,8 @@ def steps(cache_dir):
         vo = bpy.data.objects.get(ob.plume.domain.volume_object)   # renders; camera, world,
         if vo is not None:                                  #     Cycles, exposure
             vo.hide_render = True
+    dark_view(CAMERA_LOCATION, CAMERA_ROTATION_DEG, LENS)
     scene = bpy.context.scene
-    cam = scene.camera
-    cam.location = CAMERA_LOCATION
-    cam.rotation_euler = tuple(math.radians(a) for a in CAMERA_ROTATION_DEG)
-    cam.data.lens = LENS
-    world = scene.world.node_tree.nodes["Background"]
-    world.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-    scene.render.engine = 'CYCLES'
     scene.cycles.film_exposure = FILM_EXPOSURE
     scene.frame_end = SYNTH_END
     return domains, bpy.data.objects[g.fire_object]
