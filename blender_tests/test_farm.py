@@ -484,6 +484,23 @@ class FarmTest(unittest.TestCase):
         self.assertGreater(farm_lit, 0.005)
         self.assertAlmostEqual(render_lit, farm_lit, delta=0.01)
 
+    def test_cancel_job_stops_what_is_queued_and_running(self):
+        base = os.path.join(self.tmp, "cancel")
+        dom = shot(base, frames=24)
+        farm = bpy.context.scene.plume_farm
+        farm.job, farm.wedge_domain, farm.wedge_frame = 'WEDGE', dom, 24
+        farm.wedge_settings = "seed = 1, 2, 3"
+        os.environ["PLUME_JOB_GATE"] = os.path.join(base, "never") + "@4"  # held at frame 4
+        try:
+            folder = self.submit()
+        finally:
+            del os.environ["PLUME_JOB_GATE"]
+        self.assertEqual(bpy.ops.plume.farm_cancel(), {'FINISHED'})
+        states = wait_done(self, folder, timeout=60)
+        print("  after Cancel Job: " + ", ".join(f"{ts.name} {ts.summary}" for ts in states))
+        self.assertEqual([ts.summary for ts in states], ["MISSING", "MISSING"])
+        self.assertFalse(os.path.exists(os.path.join(folder, "wedge", "contact_sheet.png")))
+
 
 if __name__ == "__main__":
     run(FarmTest)
