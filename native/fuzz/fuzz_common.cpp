@@ -14,14 +14,14 @@
 
 namespace plume::fuzz {
 
-TempInput::TempInput(const std::string& target) {
+TempInput::TempInput(const std::string& target, const std::string& extension) {
   struct stat st;
   std::string dir = "/dev/shm";
   if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || access(dir.c_str(), W_OK) != 0) {
     const char* tmp = std::getenv("TMPDIR");
     dir = tmp && *tmp ? tmp : "/tmp";
   }
-  mPath = dir + "/plume_fuzz_" + target + "_" + std::to_string(getpid()) + ".bin";
+  mPath = dir + "/plume_fuzz_" + target + "_" + std::to_string(getpid()) + extension;
 }
 
 TempInput::~TempInput() { std::remove(mPath.c_str()); }

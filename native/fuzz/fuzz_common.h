@@ -16,10 +16,10 @@
 namespace plume::fuzz {
 
 /// A file in /dev/shm (else the temporary directory) named after the target and the process,
-/// rewritten for every input and removed at exit.
+/// with the reader's extension (".vdb" for OpenVDB), rewritten for every input and removed at exit.
 class TempInput {
  public:
-  explicit TempInput(const std::string& target);
+  explicit TempInput(const std::string& target, const std::string& extension = ".bin");
   ~TempInput();
   TempInput(const TempInput&) = delete;
   TempInput& operator=(const TempInput&) = delete;

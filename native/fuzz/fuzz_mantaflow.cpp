@@ -12,16 +12,13 @@
 #include <string>
 #include <unistd.h>
 
+#include "fuzz_common.h"
 #include "fuzz/vdb_seeds.h"
 #include "io/mantaflow_cache.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::string path =
-      "/tmp/plume_fuzz_mantaflow_" + std::to_string(::getpid()) + ".vdb";
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
-  }
+  static plume::fuzz::TempInput input("mantaflow", ".vdb");
+  const std::string& path = input.write(data, size);
   try {
     plume::readMantaflowFrame(path, plume::seeds::mantaflowGrid());
   } catch (const std::runtime_error& e) {

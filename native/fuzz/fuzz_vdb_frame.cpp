@@ -14,15 +14,17 @@
 #include <unistd.h>
 #include <vector>
 
+#include "fuzz_common.h"
 #include "io/vdb_frame.h"
 
 namespace {
 
-const std::string& inputPath() {
-  static const std::string path =
-      "/tmp/plume_fuzz_vdb_frame_" + std::to_string(::getpid()) + ".vdb";
-  return path;
+plume::fuzz::TempInput& input() {
+  static plume::fuzz::TempInput file("vdb_frame", ".vdb");
+  return file;
 }
+
+const std::string& inputPath() { return input().path(); }
 
 void expectNamed(const std::runtime_error& e) {
   if (std::string(e.what()).find(inputPath()) == std::string::npos) {
@@ -34,10 +36,7 @@ void expectNamed(const std::runtime_error& e) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  {
-    std::ofstream out(inputPath(), std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
-  }
+  input().write(data, size);
   std::vector<std::string> names = {"density", "temperature", "flame", "velocity"};
   try {
     const std::vector<std::string> listed = plume::vdbGridNames(inputPath());

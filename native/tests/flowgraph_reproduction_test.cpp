@@ -28,12 +28,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include <unistd.h>
 
@@ -44,10 +46,20 @@ constexpr int kRes = 24;
 constexpr int kFrames = 40;
 
 /// A recorded fire bake: its pathline file and the integrated positions of every sample.
+/// A recorded bake; its pathline file is deleted with it, so test runs leave nothing in /tmp.
 struct Bake {
   std::string path;
   PathlineLayout layout;
   std::vector<std::vector<glm::vec3>> trails;  ///< per node, index group.index(p, s)
+
+  Bake() = default;
+  Bake(const Bake&) = delete;
+  Bake& operator=(const Bake&) = delete;
+  Bake(Bake&& o) noexcept
+      : path(std::exchange(o.path, {})), layout(o.layout), trails(std::move(o.trails)) {}
+  ~Bake() {
+    if (!path.empty()) std::remove(path.c_str());
+  }
 };
 
 Bake bakeFire(int nodesPerFrame, float lifetime, int threads, bool half, const std::string& name) {
