@@ -342,9 +342,11 @@ class FarmTest(unittest.TestCase):
                            os.path.join(src, "plume_cache", name), range(1, 41), GRIDS)
 
     def test_flow_graph_fire_on_the_farm_equals_a_local_run(self):
-        """States side by side, then Build Flow Graph, Synthesize Fire and the render in two
-        chunks, each after the one before; the synthesized fire equals the same pipeline run
-        here, frame by frame, bit for bit."""
+        """States side by side, then Build Flow Graph, Synthesize Fire in two chunks side by
+        side, the chunks gathered into the fire Volume, and the render in two chunks, each after
+        the one before; the synthesized fire equals the same pipeline run here, frame by frame,
+        bit for bit (and so does a local synthesis in chunks, which refuses to gather while a
+        chunk is missing)."""
         sys.path.insert(0, os.path.join(REPO, "examples", "flowgraph_fire"))
         sys.path.insert(0, os.path.join(REPO, "examples"))
         import flowgraph_kit
@@ -378,8 +380,12 @@ class FarmTest(unittest.TestCase):
               ", ".join(f"{ts.name} {ts.summary}" for ts in done))
         self.assertEqual([(ts.name, ts.summary) for ts in done],
                          [("states", "DONE"), ("graph", "DONE"), ("synthesis", "DONE"),
-                          ("render", "DONE")], [ts.failures for ts in done])
-        self.assertEqual(len(done[3].states), 2)  # two chunks
+                          ("fire", "DONE"), ("render", "DONE")], [ts.failures for ts in done])
+        self.assertEqual(len(done[2].states), 2)  # two synthesis chunks
+        self.assertEqual(len(done[4].states), 2)  # two render chunks
+        self.assertFalse(os.path.exists(os.path.join(folder, "plume_cache", owner.name,
+                                                     "farm_synthesis")),
+                         "the gathered chunks are left behind")
         renders = sorted(os.listdir(os.path.join(folder, "render")))
         self.assertEqual(renders, [f"{f:04d}.png" for f in range(1, GRAPH_FRAMES + 1)])
         last = image_pixels(os.path.join(folder, "render", renders[-1]))[..., :3].max(axis=2)
@@ -402,6 +408,24 @@ class FarmTest(unittest.TestCase):
         assert_same_frames(self, fire, os.path.join(folder, "plume_cache"),
                            os.path.join(base, "plume_cache"), range(1, GRAPH_FRAMES + 1),
                            ("density", "temperature"))
+        # The farm's tasks here, last chunk first: gathering refuses while a chunk is missing.
+        whole = os.path.join(self.tmp, "graph_whole")
+        shutil.copytree(os.path.join(base, "plume_cache", owner.name, "fire"), whole)
+        half = GRAPH_FRAMES // 2
+        self.assertEqual(bpy.ops.plume.fire_synthesize(farm_chunk=(half + 1, GRAPH_FRAMES)),
+                         {'FINISHED'})
+        with self.assertRaises(RuntimeError) as refused:
+            bpy.ops.plume.fire_synthesize(farm_gather=True)
+        self.assertIn(f"miss frames 1-{half}", str(refused.exception))
+        self.assertIn("Plume Farm › Resubmit Missing", str(refused.exception))
+        self.assertEqual(bpy.ops.plume.fire_synthesize(farm_chunk=(1, half)), {'FINISHED'})
+        self.assertEqual(bpy.ops.plume.fire_synthesize(farm_gather=True), {'FINISHED'})
+        assert_same_frames(self, lambda folder_, f: os.path.join(folder_, f"fire_{f:04d}.vdb"),
+                           os.path.join(base, "plume_cache", owner.name, "fire"), whole,
+                           range(1, GRAPH_FRAMES + 1), ("density", "temperature"))
+        self.assertEqual(np.load(os.path.join(whole, "walk.npz"))["nodes"].tolist(),
+                         np.load(os.path.join(base, "plume_cache", owner.name, "fire",
+                                              "walk.npz"))["nodes"].tolist())
 
     def test_path_mapping_and_the_panels_background_poll(self):
         """The farm sees the storage at another path (a symbolic link stands for the farm's

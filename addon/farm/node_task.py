@@ -12,6 +12,11 @@ Steps (made by plan.py):
     flowgraph <owner> <state> [<state> …]  Build Flow Graph of the states into the owner
     synthesize <owner>                     Synthesize Fire on the owner's graph, the shot saved
                                            (the render tasks open it with its fire Volume)
+    synthesize_chunk <owner> <size> <index>
+                                           frames of chunk <index> of that synthesis, into their
+                                           chunk folder (flowgraph_chunks.py)
+    synthesize_gather <owner>              the chunks' frames committed as one Synthesize Fire
+                                           (its fire Volume), the shot saved
     wedge <domain> <index>                 variant <index> of wedge.json: bake, render a still
     contact_sheet                          the wedge's stills side by side (wedge/contact_sheet.png)
     render <chunk size> <index>            frames of chunk <index> into render/####.png
@@ -114,6 +119,16 @@ def contact_sheet():
     out.save()
 
 
+def synthesize_chunk(owner, size, index):
+    """Frames start + index·size … of the owner's synthesis range (Synthesize Fire refuses a
+    chunk outside it)."""
+    _select(owner)
+    g = bpy.data.objects[owner].plume.domain.flowgraph
+    first = int(g.frame_start) + int(index) * int(size)
+    _press(bpy.ops.plume.fire_synthesize,
+           farm_chunk=(first, min(int(g.frame_end), first + int(size) - 1)))
+
+
 def render(chunk, index):
     scene = bpy.context.scene
     first = scene.frame_start + int(index) * int(chunk)
@@ -138,6 +153,12 @@ def main():
     elif step == "synthesize":
         _select(*args)
         _press(bpy.ops.plume.fire_synthesize)
+        bpy.ops.wm.save_mainfile()
+    elif step == "synthesize_chunk":
+        synthesize_chunk(*args)
+    elif step == "synthesize_gather":
+        _select(*args)
+        _press(bpy.ops.plume.fire_synthesize, farm_gather=True)
         bpy.ops.wm.save_mainfile()
     elif step == "wedge":
         wedge(*args)

@@ -79,14 +79,22 @@ def flowgraph(spec, job):
 
 
 def synthesis(spec, job):
-    """The random walk and the rasterized frames, staged."""
-    from .. import flowgraph as graph
+    """The random walk and the rasterized frames, staged: all of them; a farm chunk's frames
+    with its chunk.json; or, gathering, every chunk's frames linked in (flowgraph_chunks.py)."""
+    from .. import flowgraph as graph, flowgraph_chunks as chunks
     native, settings = _native(), spec["settings"]
+    if spec["gather"]:
+        job.set_progress(0, 0, "gathering the farm's chunks")
+        return chunks.gather(spec["folder"], spec["staging"], settings, spec["key"],
+                             spec["owner"])
     g, states = graph.load_graph(native, spec["folder"], spec["owner"])
     runner = graph.SynthesisRunner(native, g, states, settings, spec["staging"],
                                    progress=lambda done, total: job.set_progress(done, total),
                                    cancel=lambda: job.cancelled, owner=spec["owner"])
-    return runner.run()
+    result = runner.run(write=spec["chunk"])
+    if spec["chunk"] is not None and not result.cancelled:
+        chunks.write_record(spec["staging"], *spec["chunk"], spec["key"], result)
+    return result
 
 
 def surfaces(spec, job):

@@ -10,7 +10,7 @@ import time
 
 import bpy
 
-from .. import cache, flowgraph
+from .. import cache, flowgraph, flowgraph_chunks
 from ..native import _native
 from ..build import fire_points, fire_volume
 from ..jobs.operator import JobOperator
@@ -112,11 +112,20 @@ SYNTHESIS_KEY = ("fire synthesis",)
 class SynthesisJob(JobRunner):
     """Synthesize Fire as a job: the random walk and the rasterized frames in the child into the
     staging folder's fire/; finish() commits them and builds the fire Volume (and the point
-    preview)."""
+    preview).
+
+    On the farm (flowgraph_chunks.py) the same job runs as many tasks: `chunk` = (first, last)
+    writes only those frames into their chunk folder (no Volume: the chunk folder is the one
+    folder it locks, so chunks run side by side), then `gather` takes every chunk's frames as
+    the child's result and finishes as a local run does."""
 
     title = "Synthesize Fire"
     kind = "synthesis"
     prepare_errors = (BakeError, ValueError)
+
+    def __init__(self, chunk=None, gather=False):
+        super().__init__()
+        self.chunk, self.gather = chunk, gather
 
     def prepare(self, context):
         self.t0 = time.perf_counter()
@@ -126,7 +135,10 @@ class SynthesisJob(JobRunner):
         self.folder = folder = cache_folder_of(domain)
         self.objects = (domain.name,)
         self.claim(domain_key(domain.name), SYNTHESIS_KEY)
-        self.lock_folder(folder, cache_setting(domain))
+        self.out_folder = folder
+        if self.chunk is not None:
+            self.out_folder = flowgraph_chunks.chunk_folder(folder, *self.chunk)
+        self.lock_folder(self.out_folder, cache_setting(domain))
         graph, states = flowgraph.load_graph(_native, folder, owner)
         settings = synthesis_settings(domain)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)
@@ -141,21 +153,40 @@ class SynthesisJob(JobRunner):
                 context, source, settings.frame_start, settings.frame_end, steps_per_frame)
         flowgraph.validate_synthesis(settings, graph.state_count, owner)
         flowgraph.SynthesisRunner(_native, graph, states, settings, folder, owner=owner)  # checks
+        if self.chunk is not None:
+            if not settings.frame_start <= self.chunk[0] <= self.chunk[1] <= settings.frame_end:
+                raise BakeError(f"Plume: {owner}: synthesis chunk {self.chunk[0]}-"
+                                f"{self.chunk[1]} is outside the synthesis range "
+                                f"{settings.frame_start}-{settings.frame_end}")
+        self.key = flowgraph_chunks.settings_key(settings, folder)
         self.settings, self.states, self.owner = settings, states, owner
-        self.set_progress(0, settings.frame_end - settings.frame_start + 1, "frame")
+        last = settings.frame_end if self.chunk is None else self.chunk[1]
+        self.set_progress(0, last - settings.frame_start + 1, "frame")
+
+    def job_folder(self):
+        return self.out_folder  # a chunk's job file and log are its own
 
     def job_spec(self):
         return {"settings": self.settings, "folder": self.folder, "owner": self.owner,
-                "staging": self.stage(self.folder)}
+                "staging": self.stage(self.out_folder), "chunk": self.chunk,
+                "gather": self.gather, "key": self.key}
 
     def finish(self, context):
-        domain = bpy.data.objects[self.domain_name]
-        folder, result, settings = self.folder, self.result, self.settings
+        folder, result, settings = self.out_folder, self.result, self.settings
         fire = os.path.join(folder, flowgraph.FIRE_FOLDER)
         old = [os.path.join(fire, n) for n in (os.listdir(fire) if os.path.isdir(fire) else ())
                if (n.startswith("fire_") and n.endswith(".vdb"))
-               or (n.startswith("points_") and n.endswith(".npz"))]
+               or (n.startswith("points_") and n.endswith(".npz"))
+               or n == flowgraph.WALK_NAME]
         self.staging.commit(replaced=old)
+        if self.chunk is not None:
+            return 'INFO', (f"Plume: synthesized frames {self.chunk[0]}-{self.chunk[1]} of "
+                            f"{settings.frame_start}-{settings.frame_end} for the farm "
+                            f"({time.perf_counter() - self.t0:.1f} s)")
+        if self.gather:
+            flowgraph_chunks.remove(self.folder)
+        domain = bpy.data.objects[self.domain_name]
+        folder = self.folder
         frames = result.last_frame - result.frame_start + 1
         ob = fire_volume.build_fire_volume(domain, folder, result.frame_start, frames,
                                            settings.max_temperature)
@@ -199,8 +230,19 @@ class PLUME_OT_fire_synthesize(JobOperator, bpy.types.Operator):
     bl_label = "Synthesize Fire"
     bl_options = {'REGISTER'}
 
+    # A farm's tasks (farm/node_task.py), not the artist's button.
+    farm_chunk: bpy.props.IntVectorProperty(
+        name="Farm Chunk", size=2, default=(0, -1), options={'HIDDEN', 'SKIP_SAVE'},
+        description="A farm task's frames: only these are written, into their own folder "
+                    "(the whole range when the second is below the first)")
+    farm_gather: bpy.props.BoolProperty(
+        name="Gather Farm Chunks", default=False, options={'HIDDEN', 'SKIP_SAVE'},
+        description="A farm's last synthesis task: the fire from every chunk's frames")
+
     def make_runner(self, context):
-        return SynthesisJob()
+        first, last = self.farm_chunk
+        return SynthesisJob(chunk=(first, last) if last >= first else None,
+                            gather=self.farm_gather)
 
 
 classes = (PLUME_OT_flowgraph_build, PLUME_OT_fire_synthesize)

@@ -47,7 +47,8 @@ class PlumeFarmSettings(bpy.types.PropertyGroup):
     cpus: IntProperty(name="CPUs per Task", default=2, min=1, soft_max=64,
                       description="Processor cores each task asks for")
     chunk: IntProperty(name="Frames per Task", default=10, min=1, soft_max=1000,
-                       description="Frames one render task renders")
+                       description="Frames one render task renders, and one task of a "
+                                   "flow-graph fire's synthesis writes")
     flowgraph_domain: PointerProperty(
         type=bpy.types.Object, poll=_is_domain, name="Graph Domain",
         description="The domain whose flow graph and synthesized fire the farm makes; every "

@@ -186,6 +186,16 @@ def _render_task(scene, farm, run, after):
                 label=f"render frames {scene.frame_start}-{scene.frame_end}, {farm.chunk} a task")
 
 
+def _synthesis_task(owner, farm, run):
+    """Synthesize Fire in chunks of Frames per Task, side by side: each replays the walk from
+    the first frame and writes its own frames (flowgraph_chunks.py)."""
+    g = owner.plume.domain.flowgraph
+    frames = g.frame_end - g.frame_start + 1
+    return Task("synthesis", run + ["synthesize_chunk", owner.name, str(farm.chunk), "{index}"],
+                count=max(1, math.ceil(frames / farm.chunk)), after=["graph"], cpus=farm.cpus,
+                label=f"Synthesize Fire frames {g.frame_start}-{g.frame_end}, {farm.chunk} a task")
+
+
 def plan(context):
     """The FarmJob of Scene › Plume Farm; FarmError (the artist's words) on anything that
     would fail on the farm."""
@@ -218,9 +228,10 @@ def plan(context):
                       cpus=cpus, label=f"bake the {len(names)} states"),
                  Task("graph", run + ["flowgraph", owner.name, *names], after=["states"],
                       cpus=cpus, label="Build Flow Graph"),
-                 Task("synthesis", run + ["synthesize", owner.name], after=["graph"],
-                      cpus=cpus, label="Synthesize Fire")]
-        tasks.append(_render_task(scene, farm, run, ["synthesis"]))
+                 _synthesis_task(owner, farm, run),
+                 Task("fire", run + ["synthesize_gather", owner.name], after=["synthesis"],
+                      label="the synthesized fire's Volume")]
+        tasks.append(_render_task(scene, farm, run, ["fire"]))
     elif farm.job == 'WEDGE':
         dom = farm.wedge_domain
         if dom is None:
