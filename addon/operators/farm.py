@@ -10,7 +10,9 @@ from ..snapshot import farm as farm_snapshot
 
 #: The panel's view of the last job: {"folder": str, "states": [TaskState] or None}.
 LAST = {"folder": "", "states": None, "poll": None}
-POLL_S = 3.0
+#: Seconds between two polls of a job, and between two looks at a poll's answer (squeue answers
+#: in tens of ms; the first state shows a moment after Submit, not a poll later).
+POLL_S, ANSWER_S = 3.0, 0.2
 
 
 def cluster_of(farm):
@@ -19,32 +21,40 @@ def cluster_of(farm):
 
 
 def _poll_timer():
-    """Every POLL_S while a job is shown: collects the background squeue, starts the next."""
+    """While a job is shown and has not ended: starts squeue in the background, looks for its
+    answer every ANSWER_S, shows it, and starts the next POLL_S later. Once every task is done,
+    failed or missing it stops (Refresh, Resubmit Missing and Cancel Job start it again)."""
     poll = LAST.get("poll")
     if poll is not None:
         states = poll.result()
         if states is None:
-            return POLL_S
-        LAST["states"] = states
+            return ANSWER_S
+        LAST["states"], LAST["poll"] = states, None
         for window in bpy.context.window_manager.windows:
             for area in window.screen.areas:
                 if area.type == 'PROPERTIES':
                     area.tag_redraw()
+        ended = {ts.summary for ts in states} <= {status.DONE, status.FAILED, status.MISSING}
+        return None if ended else POLL_S
     if not LAST["folder"]:
         return None
     try:
         LAST["poll"] = status.Poll(LAST["folder"])
     except FarmError:
-        LAST["poll"] = None
-    return POLL_S
+        return None
+    return ANSWER_S
 
 
 def show(folder, wait=False):
-    """Shows the job in `folder` in the panel; `wait` reads its state now (scripts, tests)."""
+    """Shows the job in `folder` in the panel, followed by the background poll; `wait` reads
+    its state now (scripts, tests, Refresh)."""
+    if LAST["folder"] != folder:  # another job's states and poll are not this one's
+        LAST["states"] = LAST["poll"] = None
     LAST["folder"] = folder
     if wait or bpy.app.background:
         LAST["states"] = status.read(folder)
-        return
+        if bpy.app.background:
+            return
     if not bpy.app.timers.is_registered(_poll_timer):
         bpy.app.timers.register(_poll_timer, first_interval=0.1)
 
