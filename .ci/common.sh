@@ -96,6 +96,29 @@ setup_bpy() {
   /usr/bin/python3 "$ROOT/blender_tests/run.py" --setup all
 }
 
+# openjd-cli, Open Job Description's own runner (the job format of AWS Deadline Cloud), for
+# blender_tests/test_farm_openjd.py: a venv ~/.cache/plume/venvs/openjd from Debian's Python with
+# the CLI and every dependency pinned (installed without resolving, then `pip check`), created
+# once and made again when the pins change.
+OPENJD_PINS=(openjd-cli==0.8.0 openjd-model==0.13.0 openjd-sessions==0.13.0 pydantic==2.14.4
+             pydantic_core==2.50.5 annotated-types==0.8.0 typing-inspection==0.4.5
+             typing_extensions==4.16.0 PyYAML==6.0.4)
+setup_openjd() {
+  local venv="${PLUME_VENV_ROOT:-$HOME/.cache/plume/venvs}/openjd"
+  if [ "$(cat "$venv/plume-pins" 2>/dev/null)" = "${OPENJD_PINS[*]}" ] && \
+     "$venv/bin/openjd" --version >/dev/null 2>&1; then
+    echo "== openjd-cli: venv ready ($venv)"
+    return
+  fi
+  echo "== openjd-cli: making its venv ($venv)"
+  rm -rf "$venv"
+  /usr/bin/python3 -m venv "$venv"
+  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps "${OPENJD_PINS[@]}"
+  "$venv/bin/pip" check -q --disable-pip-version-check >/dev/null
+  echo "${OPENJD_PINS[*]}" >"$venv/plume-pins"
+  "$venv/bin/openjd" --version
+}
+
 setup_all() {
   install_packages
   build_native

@@ -71,8 +71,9 @@ SUBSET = [
 EXIT_WITHOUT_TEARDOWN = {"4.2"}
 #: Files that run in the packaged Blender only under the policy (named on the command line they
 #: run anywhere): the farm tests start a Blender per task on the single-node Slurm cluster,
-#: minutes per run, and what they test (Slurm, paths, resume) does not change with the Blender.
-ONE_BLENDER = {"test_farm.py"}
+#: minutes per run, and what they test (Slurm, paths, resume) does not change with the Blender;
+#: the same for the farm job run by Open Job Description's runner.
+ONE_BLENDER = {"test_farm.py", "test_farm_openjd.py"}
 #: Files that need a window (Xvfb + the real executable): only the packaged Blender has one.
 WINDOWED = {"test_ui_jobs.py", "test_ui_screenshots.py"}
 TIMEOUT_S = 1800

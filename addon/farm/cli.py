@@ -5,14 +5,18 @@
                                                       failed or went missing (exit 1)
     python -m plume.farm resubmit <job folder>        what is missing or failed, again
     python -m plume.farm cancel <job folder>          scancel the job's Slurm jobs
+    python -m plume.farm openjd <job folder>          (re)writes the job's Open Job Description
+                                                      template, job.openjd.json (no Slurm needed)
 
 A job is submitted from its scene: Scene › Plume Farm › Submit, or headless
 `blender -b shot.blend --python-expr "import bpy; bpy.ops.plume.farm_submit()"`."""
 
+import os
 import sys
 import time
 
-from . import slurm, status
+from . import graph as farm_graph
+from . import openjd, slurm, status
 from .graph import FarmError
 
 
@@ -31,7 +35,8 @@ def _print(states):
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
-    if len(argv) < 2 or argv[0] not in ("status", "wait", "resubmit", "cancel"):
+    if len(argv) < 2 or argv[0] not in ("status", "wait", "resubmit", "cancel",
+                                           "openjd"):
         print(__doc__, file=sys.stderr)
         return 2
     cmd, root = argv[0], argv[1]
@@ -51,6 +56,17 @@ def main(argv=None):
                     print("plume farm: still running", file=sys.stderr)
                     return 1
                 time.sleep(1.0)
+        elif cmd == "openjd":
+            root = os.path.abspath(root)
+            graph = farm_graph.load(root)
+            cluster, farm_root = slurm.load_cluster(root)
+            slurm.write_scripts(graph, root)
+            path = openjd.write(graph, root, 60 * max(1, int(cluster.time_minutes))
+                                if farm_root else None)
+            print(path)
+            print(f"run it with openjd-cli: openjd run {path}  (every task in order; the job "
+                  f"folder is the template's, -p {openjd.FOLDER_PARAM}=PATH where the runner "
+                  "sees it elsewhere)")
         elif cmd == "resubmit":
             print(slurm.resubmit(root, status.pending(status.read(root))))
         else:

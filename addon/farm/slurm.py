@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 from ..files import atomic
 from . import graph as farm_graph
+from . import openjd
 from .graph import FarmError
 
 RECORD_NAME = "farm.json"
@@ -124,6 +125,16 @@ exit "$rc"
 """
 
 
+def write_scripts(graph, root):
+    """scripts/<task>.sh of every task of `graph` (the same text each time for the same graph):
+    what Slurm runs, and what the job's Open Job Description template (openjd.py) runs."""
+    os.makedirs(os.path.join(root, "scripts"), exist_ok=True)
+    for task in graph.tasks:
+        script = os.path.join(root, "scripts", f"{task.name}.sh")
+        atomic.write_bytes(script, task_script(task).encode("utf-8"))
+        os.chmod(script, 0o755)
+
+
 def _array_spec(indices):
     return ",".join(str(i) for i in sorted(indices))
 
@@ -141,6 +152,8 @@ def submit(graph, root, cluster=None, pending=None, farm_root=None):
         os.makedirs(os.path.join(root, sub), exist_ok=True)
     farm_graph.save(graph, root)
     save_cluster(root, cluster, farm_root or root)
+    write_scripts(graph, root)
+    openjd.write(graph, root, 60 * max(1, int(cluster.time_minutes)))  # the same job, for OpenJD
     pending = pending or {}
     record = load_record(root)
     waits = {}  # task -> job ids its dependants wait for
@@ -152,9 +165,6 @@ def submit(graph, root, cluster=None, pending=None, farm_root=None):
         waits[task.name] = sorted(set(running.values()))
         if not missing:
             continue
-        script = os.path.join(root, "scripts", f"{task.name}.sh")
-        atomic.write_bytes(script, task_script(task).encode("utf-8"))
-        os.chmod(script, 0o755)
         argv = [sbatch, "--parsable", f"--job-name=plume-{task.name}",
                 f"--array={_array_spec(missing)}",
                 f"--chdir={farm_root or root}", f"--output=logs/{task.name}.%a.log",
