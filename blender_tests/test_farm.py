@@ -214,6 +214,10 @@ class FarmTest(unittest.TestCase):
         print(f"  wedge of {len(values)} on the farm: {time.monotonic() - t0:.1f} s")
         self.assertEqual([(ts.name, ts.summary) for ts in states],
                          [("variants", "DONE"), ("contact_sheet", "DONE")])
+        with open(os.path.join(folder, "job.openjd.json"), encoding="utf-8") as f:
+            steps = json.load(f)["steps"]  # the same job for OpenJD (test_farm_openjd runs one)
+        self.assertEqual([(s["name"], [d["dependsOn"] for d in s.get("dependencies", ())])
+                          for s in steps], [("variants", []), ("contact_sheet", ["variants"])])
         for i, v in enumerate(values):
             here = os.path.join(base, f"local_{i}")
             local_bake(dom, here, turbulence=v)

@@ -34,8 +34,7 @@ def _poll_timer():
             for area in window.screen.areas:
                 if area.type == 'PROPERTIES':
                     area.tag_redraw()
-        ended = {ts.summary for ts in states} <= {status.DONE, status.FAILED, status.MISSING}
-        return None if ended else POLL_S
+        return None if {ts.summary for ts in states} <= status.ENDED else POLL_S
     if not LAST["folder"]:
         return None
     try:

@@ -10,7 +10,7 @@ from ..operators import farm as farm_ops
 from ..operators.manual_open import draw_help
 
 ICONS = {status.QUEUED: 'SORTTIME', status.RUNNING: 'PLAY', status.DONE: 'CHECKMARK',
-         status.FAILED: 'ERROR', status.MISSING: 'CANCEL'}
+         status.FAILED: 'ERROR', status.MISSING: 'CANCEL', status.UNKNOWN: 'QUESTION'}
 
 
 class SCENE_PT_plume_farm(bpy.types.Panel):
@@ -62,6 +62,8 @@ def draw_job(layout, folder):
             counts[s] = counts.get(s, 0) + 1
         text = ", ".join(f"{n} {s.lower()}" for s, n in sorted(counts.items()))
         box.label(text=f"{ts.label}: {text}", icon=ICONS[ts.summary])
+        if ts.summary == status.UNKNOWN:
+            box.label(text="  Slurm did not answer (a busy controller?); asked again soon")
         for i, lines in sorted(ts.failures.items()):
             col = box.column(align=True)
             col.label(text=f"Task {i} failed; its log ends:")
