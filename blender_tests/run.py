@@ -75,7 +75,7 @@ EXIT_WITHOUT_TEARDOWN = {"4.2"}
 #: the same for the farm job run by Open Job Description's runner.
 ONE_BLENDER = {"test_farm.py", "test_farm_openjd.py"}
 #: Files that need a window (Xvfb + the real executable): only the packaged Blender has one.
-WINDOWED = {"test_ui_jobs.py", "test_ui_screenshots.py"}
+WINDOWED = {"test_farm_window.py", "test_ui_jobs.py", "test_ui_screenshots.py"}
 TIMEOUT_S = 1800
 
 _SUMMARY = re.compile(r"^(\d+) passed, (\d+) failed(?:, (\d+) skipped)?\s*$", re.M)
