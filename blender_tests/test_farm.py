@@ -117,12 +117,14 @@ def frame_of(name):
     return lambda folder, f: os.path.join(folder, name, f"volume_{f:04d}.vdb")
 
 
-class FarmTest(unittest.TestCase):
+class ClusterTest(unittest.TestCase):
+    """Tests on the single-node cluster (started once), each class in a folder of its own."""
+    TMP_PREFIX = "plume_farm_"
 
     @classmethod
     def setUpClass(cls):
         cls.lacks = cluster_up()
-        cls.tmp = temp_dir("plume_farm_")
+        cls.tmp = temp_dir(cls.TMP_PREFIX)
 
     @classmethod
     def tearDownClass(cls):
@@ -131,6 +133,9 @@ class FarmTest(unittest.TestCase):
     def setUp(self):
         if self.lacks:
             skip_machine_lacks(self, self.lacks)
+
+
+class FarmTest(ClusterTest):
 
     def submit(self):
         """Submit; the job's folder."""

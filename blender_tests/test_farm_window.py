@@ -11,7 +11,6 @@ import os
 import shutil
 import subprocess
 import sys
-import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
@@ -19,8 +18,8 @@ sys.path.insert(0, HERE)
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from helpers import rmtree, run, skip_machine_lacks, temp_dir  # noqa: E402
-from test_farm import WAIT_S, cluster_up, shot  # noqa: E402
+from helpers import run  # noqa: E402
+from test_farm import WAIT_S, ClusterTest, shot  # noqa: E402
 
 #: ui/farm_window.py's timer ticks every TICK_S; the longest gap between two ticks that is not a
 #: stall: a redraw and a poll's reading of the markers take a few ms, and measured gaps were
@@ -29,20 +28,8 @@ from test_farm import WAIT_S, cluster_up, shot  # noqa: E402
 TICK_S, MAX_STALL_S = 0.05, 0.5
 
 
-class FarmWindowTest(unittest.TestCase):
-
-    @classmethod
-    def setUpClass(cls):
-        cls.lacks = cluster_up()
-        cls.tmp = temp_dir("plume_farm_window_")
-
-    @classmethod
-    def tearDownClass(cls):
-        rmtree(cls.tmp)
-
-    def setUp(self):
-        if self.lacks:
-            skip_machine_lacks(self, self.lacks)
+class FarmWindowTest(ClusterTest):
+    TMP_PREFIX = "plume_farm_window_"
 
     def test_the_panel_in_a_window_submits_and_follows_the_job(self):
         """Scene Properties › Plume Farm in a real window (Xvfb, ui/farm_window.py): Submit
