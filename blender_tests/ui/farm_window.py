@@ -5,7 +5,8 @@ then on a timer ticks every TICK_S and records when it ran, each state the panel
 poll holds, and what the panel drew (its draw_job wrapped). When every task is done, failed or
 missing, or after WAIT_S, the record is written as JSON and Blender quits.
 
-Run: xvfb-run -a blender --factory-startup SHOT.blend --python farm_window.py -- RESULT.json
+Run: xvfb-run -a blender --factory-startup SHOT.blend --python farm_window.py -- RESULT.json GATE
+(GATE: the file that releases a bake held by PLUME_JOB_GATE, made once the job shows running)
 """
 
 import json
@@ -24,7 +25,7 @@ from helpers import enable_addon  # noqa: E402
 
 TICK_S = 0.05
 WAIT_S = 240.0
-RESULT = sys.argv[sys.argv.index("--") + 1]
+RESULT, GATE = sys.argv[sys.argv.index("--") + 1:][:2]
 REC = {"ticks": [], "polled": [], "drawn": [], "report": "", "error": ""}
 
 
@@ -84,6 +85,8 @@ def tick():
         if not REC["polled"] or REC["polled"][-1] != summary:
             REC["polled"].append(summary)
         ended = summary and all(s in ("DONE", "FAILED", "MISSING") for _, s in summary)
+        if summary and not ended and not os.path.exists(GATE):
+            open(GATE, "w").close()  # the job is shown running: its bake may go on
         drawn_ended = REC["drawn"] and REC["drawn"][-1] == summary
         if (ended and drawn_ended) or now > STATE["end"]:
             finish(0)
