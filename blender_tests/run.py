@@ -77,7 +77,8 @@ EXIT_WITHOUT_TEARDOWN = {"4.2"}
 #: least-squares nets of the core and streak_surfaces.py; the NURBS objects Blender makes of them
 #: are checked in every Blender by test_streak_surfaces (SUBSET) and, in 5.3, the other streak
 #: files.
-ONE_BLENDER = {"test_farm.py", "test_farm_openjd.py", "test_streak_net.py"}
+ONE_BLENDER = {"test_farm.py", "test_farm_flowgraph.py", "test_farm_openjd.py",
+               "test_streak_net.py"}
 #: Files that need a window (Xvfb + the real executable): only the packaged Blender has one.
 WINDOWED = {"test_farm_window.py", "test_ui_jobs.py", "test_ui_screenshots.py"}
 TIMEOUT_S = 1800
